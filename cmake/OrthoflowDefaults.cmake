@@ -1,0 +1,39 @@
+# Per-target settings (STYLE rule 14): no global flags, never force CMAKE_BUILD_TYPE.
+set(ORTHOFLOW_SHARED_DIR "${PROJECT_SOURCE_DIR}/../shared" CACHE PATH "The shared data folder beside the checkout")
+
+# orthoflow_target_defaults(tgt): C++20 and warnings as errors on our own code.
+function(orthoflow_target_defaults tgt)
+  target_compile_features(${tgt} PUBLIC cxx_std_20)
+  set_target_properties(${tgt} PROPERTIES CXX_EXTENSIONS OFF POSITION_INDEPENDENT_CODE ON)
+  target_compile_options(${tgt} PRIVATE -Wall -Wextra -Wconversion -Wshadow -Werror)
+endfunction()
+
+# orthoflow_add_library(folder SOURCES ... [PUBLIC_LIBS ...] [PRIVATE_LIBS ...])
+# One library per top-level folder, aliased orthoflow::<folder>, installed and exported.
+function(orthoflow_add_library folder)
+  cmake_parse_arguments(ARG "" "" "SOURCES;PUBLIC_LIBS;PRIVATE_LIBS" ${ARGN})
+  set(tgt orthoflow_${folder})
+  if(ARG_SOURCES)
+    add_library(${tgt} STATIC ${ARG_SOURCES})
+    orthoflow_target_defaults(${tgt})
+    target_include_directories(${tgt} PUBLIC
+      $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}>
+      $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}/orthoflow>)
+    target_link_libraries(${tgt} PUBLIC ${ARG_PUBLIC_LIBS} PRIVATE ${ARG_PRIVATE_LIBS})
+  else()
+    add_library(${tgt} INTERFACE)
+    target_compile_features(${tgt} INTERFACE cxx_std_20)
+    target_include_directories(${tgt} INTERFACE
+      $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}>
+      $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}/orthoflow>)
+    target_link_libraries(${tgt} INTERFACE ${ARG_PUBLIC_LIBS})
+  endif()
+  set_target_properties(${tgt} PROPERTIES EXPORT_NAME ${folder})
+  add_library(orthoflow::${folder} ALIAS ${tgt})
+  install(TARGETS ${tgt} EXPORT orthoflowTargets
+    ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
+    LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
+  install(DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/
+    DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/orthoflow/${folder}
+    FILES_MATCHING PATTERN "*.hpp" PATTERN "*.inl")
+endfunction()
