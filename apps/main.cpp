@@ -1,8 +1,18 @@
-#include <CLI/CLI.hpp>
+// The orthoflow command-line tool: one binary, one sub-command per job.
+#include <cstdio>
+
+#include "apps/commands.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"orthoflow: real-time open-ended 3D object perception"};
   app.require_subcommand(1);
-  CLI11_PARSE(app, argc, argv);
-  return 0;
+  app.set_version_flag("--version", ORTHOFLOW_VERSION);
+  orthoflow::apps::add_info_command(app);
+  orthoflow::apps::add_synth_commands(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  return orthoflow::apps::EXIT_OK;
 }

@@ -1,0 +1,19 @@
+#pragma once
+/// @file
+/// @brief Sub-commands of the `orthoflow` CLI. Each `add_*_command` registers one sub-command (with
+/// `--help`) on the top-level app. A command prints its result to stdout, its errors to stderr, and
+/// reports failure by throwing `CLI::RuntimeError(exit_code)` from its callback (exit codes below).
+#include <CLI/CLI.hpp>
+
+namespace orthoflow::apps {
+
+/// Exit codes shared by every sub-command.
+inline constexpr int EXIT_OK = 0;
+inline constexpr int EXIT_FAILURE_GENERIC = 1;  ///< the operation failed (message on stderr)
+inline constexpr int EXIT_BAD_INPUT = 2;        ///< unreadable or malformed input file
+inline constexpr int EXIT_USAGE = 106;          ///< CLI11's own code for bad arguments (ValidationError)
+
+void add_info_command(CLI::App& app);
+void add_synth_commands(CLI::App& app);
+
+}  // namespace orthoflow::apps
