@@ -13,7 +13,5 @@ inline constexpr int EXIT_FAILURE_GENERIC = 1;  ///< the operation failed (messa
 inline constexpr int EXIT_BAD_INPUT = 2;        ///< unreadable or malformed input file
 inline constexpr int EXIT_USAGE = 106;          ///< CLI11's own code for bad arguments (ValidationError)
 
-void add_info_command(CLI::App& app);
-void add_synth_commands(CLI::App& app);
 
 }  // namespace orthoflow::apps

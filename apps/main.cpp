@@ -7,8 +7,6 @@ int main(int argc, char** argv) {
   CLI::App app{"orthoflow: real-time open-ended 3D object perception"};
   app.require_subcommand(1);
   app.set_version_flag("--version", ORTHOFLOW_VERSION);
-  orthoflow::apps::add_info_command(app);
-  orthoflow::apps::add_synth_commands(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
