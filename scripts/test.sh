@@ -1,0 +1,67 @@
+#!/usr/bin/env bash
+# The whole test suite, as CI runs it (.ci/run calls exactly this):
+#   1. release preset: unit, integration and PCL cross-check tests (ctest);
+#   2. asan preset: the same suite under AddressSanitizer + UndefinedBehaviorSanitizer;
+#   3. fuzz preset: every libFuzzer target for FUZZ_SECONDS (default 60) seconds each.
+# Prints a closing line "tests: N passed, M failed" and exits non-zero on any failure.
+set -uo pipefail
+cd "$(dirname "$0")/.."
+FUZZ_SECONDS="${FUZZ_SECONDS:-60}"
+PRESETS="${PRESETS:-release asan}"
+passed=0
+failed=0
+logdir=$(mktemp -d)
+start=$(date +%s)
+
+# run_ctest_preset NAME: configure, build and test one preset; adds its counts to the totals.
+run_ctest_preset() {
+  local preset=$1 log="$logdir/$1.log"
+  echo "=== preset $preset: configure and build"
+  if ! { cmake --preset "$preset" >"$logdir/$preset.configure.log" && cmake --build --preset "$preset"; }; then
+    cat "$logdir/$preset.configure.log"
+    echo "preset $preset: build FAILED"
+    failed=$((failed + 1))
+    return
+  fi
+  echo "=== preset $preset: ctest"
+  ctest --preset "$preset" 2>&1 | tee "$log"
+  local line total nfail
+  line=$(grep -E "tests passed, [0-9]+ tests failed out of [0-9]+" "$log" | tail -1)
+  if [ -z "$line" ]; then
+    echo "preset $preset: ctest gave no summary"
+    failed=$((failed + 1))
+    return
+  fi
+  nfail=$(echo "$line" | sed -E 's/.* ([0-9]+) tests failed out of ([0-9]+).*/\1/')
+  total=$(echo "$line" | sed -E 's/.* tests failed out of ([0-9]+).*/\1/')
+  passed=$((passed + total - nfail))
+  failed=$((failed + nfail))
+}
+
+run_fuzzers() {
+  echo "=== preset fuzz: configure and build"
+  if ! { cmake --preset fuzz >"$logdir/fuzz.configure.log" && cmake --build --preset fuzz; }; then
+    cat "$logdir/fuzz.configure.log"
+    echo "preset fuzz: build FAILED"
+    failed=$((failed + 1))
+    return
+  fi
+  local f
+  for f in build/fuzz/tests/fuzz/fuzz_*; do
+    [ -x "$f" ] || continue
+    echo "=== fuzzing $(basename "$f") for ${FUZZ_SECONDS}s"
+    if bash tests/fuzz/run_fuzzers.sh "$FUZZ_SECONDS" "$f"; then
+      passed=$((passed + 1))
+    else
+      echo "fuzzer $(basename "$f") FAILED"
+      failed=$((failed + 1))
+    fi
+  done
+}
+
+for p in $PRESETS; do run_ctest_preset "$p"; done
+if [ "$FUZZ_SECONDS" -gt 0 ]; then run_fuzzers; fi
+rm -rf "$logdir"
+echo "elapsed: $(( $(date +%s) - start )) s"
+echo "tests: $passed passed, $failed failed"
+[ "$failed" -eq 0 ] && [ "$passed" -gt 0 ]
