@@ -6,6 +6,10 @@ function(orthoflow_target_defaults tgt)
   target_compile_features(${tgt} PUBLIC cxx_std_20)
   set_target_properties(${tgt} PROPERTIES CXX_EXTENSIONS OFF POSITION_INDEPENDENT_CODE ON)
   target_compile_options(${tgt} PRIVATE -Wall -Wextra -Wconversion -Wshadow -Werror)
+  if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU" AND CMAKE_CXX_COMPILER_VERSION VERSION_LESS 13)
+    # GCC 12 at -O3 reports -Wrestrict inside libstdc++'s std::string concatenation (GCC bug 105651).
+    target_compile_options(${tgt} PRIVATE -Wno-restrict)
+  endif()
 endfunction()
 
 # orthoflow_add_library(folder SOURCES ... [PUBLIC_LIBS ...] [PRIVATE_LIBS ...])

@@ -20,6 +20,9 @@ if(BUILD_BENCHMARKS)
 endif()
 if(ORTHOFLOW_WITH_PCL AND (BUILD_TESTS OR BUILD_BENCHMARKS))
   # PCL is a reference for tests and benchmarks only: never linked into the product.
+  # Debian's PCL config pulls VTK, whose exported targets name MPI::MPI_C: find MPI first.
+  enable_language(C)
+  find_package(MPI QUIET COMPONENTS C)
   find_package(PCL 1.13 QUIET COMPONENTS common io filters sample_consensus segmentation surface search kdtree features)
   if(PCL_FOUND)
     message(STATUS "PCL ${PCL_VERSION} found: reference cross-checks enabled")

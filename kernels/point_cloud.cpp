@@ -1,6 +1,5 @@
 #include "kernels/point_cloud.hpp"
 
-#include <algorithm>
 #include <limits>
 
 #include "memory_pool/assert.hpp"
@@ -12,9 +11,11 @@ PointCloud::PointCloud(std::pmr::memory_resource* resource)
       nx_(resource), ny_(resource), nz_(resource) {}
 
 void PointCloud::resize(std::uint32_t width, std::uint32_t height) {
-  width_ = width;
-  height_ = (width == 0) ? std::min<std::uint32_t>(height, 1) : height;
-  resize_buffers(static_cast<std::size_t>(width) * static_cast<std::size_t>(height));
+  // An empty cloud is always 0 x 1 (unorganized), as PCL writes it.
+  const bool empty = (width == 0 || height == 0);
+  width_ = empty ? 0 : width;
+  height_ = empty ? 1 : height;
+  resize_buffers(static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_));
 }
 
 void PointCloud::resize_unorganized(std::size_t n) {

@@ -72,7 +72,7 @@ class PointCloud {
   explicit PointCloud(std::pmr::memory_resource* resource = memory_pool::aligned_resource());
 
   /// @brief Sets the layout to width x height and sizes every present buffer to match.
-  /// New elements are zero; height 1 means unorganized.
+  /// New elements are zero; height 1 means unorganized; an empty cloud is 0 x 1.
   void resize(std::uint32_t width, std::uint32_t height = 1);
   /// @brief Sizes as unorganized (width = n, height = 1). @pre n <= UINT32_MAX
   void resize_unorganized(std::size_t n);
@@ -118,7 +118,7 @@ class PointCloud {
   void resize_buffers(std::size_t n);
 
   std::uint32_t width_ = 0;
-  std::uint32_t height_ = 0;
+  std::uint32_t height_ = 1;
   Buffer<float> x_, y_, z_;
   Buffer<std::uint32_t> rgb_, label_;
   Buffer<float> nx_, ny_, nz_;
