@@ -72,6 +72,7 @@ Result<void, IoError> read_compressed(std::span<const char> bytes, const PcdHead
     }
   }
   shape(h, cloud);
+  if (need == 0) { return {}; }
   for (const PointField& f : h.fields) {  // field-major: all points' values of one field, then the next
     decode_field(soa.data() + h.points * f.offset, f.bytes(), f, cloud);
   }

@@ -22,7 +22,7 @@ void append_binary(const kernels::PointCloud& cloud, std::span<const PointField>
 void append_compressed(const kernels::PointCloud& cloud, std::span<const PointField> fields, std::string& out) {
   const std::size_t n = cloud.size();
   std::vector<char> soa(n * packed_size(fields));
-  for (const PointField& f : fields) { encode_field(cloud, f, soa.data() + n * f.offset, f.bytes()); }
+  for (const PointField& f : n == 0 ? std::span<const PointField>{} : fields) { encode_field(cloud, f, soa.data() + n * f.offset, f.bytes()); }
   // LZF may grow incompressible data slightly: one control byte per 32 literals.
   std::vector<char> packed(soa.size() + soa.size() / 16 + 64);
   unsigned packed_size_bytes = 0;

@@ -49,6 +49,9 @@ Result<void, IoError> apply(std::span<const std::string_view> tok, PlyHeader& h,
     if (list && (!ply_type(tok[2], p.count_type) || !ply_type(tok[3], p.type))) {
       return bad(IoError::Code::UNSUPPORTED, "unknown list property type");
     }
+    if (list && (p.count_type == ScalarType::FLOAT32 || p.count_type == ScalarType::FLOAT64)) {
+      return bad(IoError::Code::UNSUPPORTED, "a list length must have an integer type");
+    }
     if (!list && !ply_type(tok[1], p.type)) {
       return bad(IoError::Code::UNSUPPORTED, "unknown property type '" + std::string(tok[1]) + "'");
     }

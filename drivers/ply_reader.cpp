@@ -170,7 +170,7 @@ Result<void, IoError> read_element(Source& src, const PlyElement& e, bool is_ver
                         (got == Read::END ? "ends early" : "not a valid value"));
       }
       if (p.is_list) {
-        if (value < 0 || value > static_cast<double>(MAX_LIST_LENGTH)) { return fail(IoError::Code::CORRUPT_DATA, "list length out of range"); }
+        if (!(value >= 0.0 && value <= static_cast<double>(MAX_LIST_LENGTH))) { return fail(IoError::Code::CORRUPT_DATA, "list length out of range"); }
         for (auto n = static_cast<std::uint64_t>(value); n > 0; --n) {
           double item = 0;
           if (src.read(p.type, item) != Read::OK) { return fail(IoError::Code::TRUNCATED, "list of '" + p.name + "' ends early or holds a non-number"); }

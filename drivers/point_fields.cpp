@@ -164,10 +164,12 @@ void encode_field(const kernels::PointCloud& cloud, const PointField& field, cha
 
 void decode_records(std::span<const char> data, std::span<const PointField> fields, std::size_t point_step,
                     kernels::PointCloud& cloud) noexcept {
+  if (cloud.empty()) { return; }  // an empty buffer may have no address to offset from
   for (const PointField& f : fields) { decode_field(data.data() + f.offset, point_step, f, cloud); }
 }
 
 void encode_records(const kernels::PointCloud& cloud, std::span<const PointField> fields, std::span<char> out) noexcept {
+  if (cloud.empty()) { return; }
   const std::size_t step = packed_size(fields);
   for (const PointField& f : fields) { encode_field(cloud, f, out.data() + f.offset, step); }
 }
