@@ -113,7 +113,7 @@ BlockPool::BlockPool(const PoolConfig& config, std::span<std::byte> memory, std:
 
 BlockPool::~BlockPool() {
   OF_ENFORCE(free_count_.load() == block_count_, "BlockPool destroyed while handles are still alive");
-  if (owned_ != nullptr) ::operator delete(owned_, owned_bytes_, std::align_val_t{CACHE_LINE_BYTES});
+  if (owned_ != nullptr) ::operator delete(owned_, std::align_val_t{CACHE_LINE_BYTES});
 }
 
 void BlockPool::push_free(std::uint32_t index) noexcept {
