@@ -13,5 +13,8 @@ inline constexpr int EXIT_FAILURE_GENERIC = 1;  ///< the operation failed (messa
 inline constexpr int EXIT_BAD_INPUT = 2;        ///< unreadable or malformed input file
 inline constexpr int EXIT_USAGE = 106;          ///< CLI11's own code for bad arguments (ValidationError)
 
+/// @brief `graph check|dot|run FILE`: validate, draw (Graphviz) and run dataflow graph files.
+void add_graph_command(CLI::App& app);
+
 
 }  // namespace orthoflow::apps

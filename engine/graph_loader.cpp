@@ -1,0 +1,167 @@
+// Graph file parsing (yaml-cpp). Every error names the file and the 1-based line of the offending
+// YAML node (yaml-cpp marks are 0-based).
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <fstream>
+#include <regex>
+#include <set>
+#include <sstream>
+
+#include "engine/graph.hpp"
+
+namespace orthoflow::engine {
+
+namespace {
+
+using Code = GraphError::Code;
+
+struct Fail {
+  GraphError error;
+};
+
+int line_of(const YAML::Node& node) { return node.Mark().line >= 0 ? node.Mark().line + 1 : 0; }
+
+[[noreturn]] void fail(Code code, const std::string& file, const YAML::Node& at, const std::string& message) {
+  throw Fail{GraphError{code, file, line_of(at), message}};
+}
+
+std::string scalar(const YAML::Node& node, const std::string& file, const std::string& what) {
+  if (!node.IsScalar()) fail(Code::BAD_STRUCTURE, file, node, what + " must be a scalar");
+  return node.Scalar();
+}
+
+double number(const YAML::Node& node, const std::string& file, const std::string& what, double max) {
+  double value = 0.0;
+  if (!node.IsScalar() || !YAML::convert<double>::decode(node, value) || !std::isfinite(value) || value < 0.0 ||
+      value > max) {
+    fail(Code::BAD_PARAMETER, file, node, what + " must be a number in [0, " + std::to_string(max) + "]");
+  }
+  return value;
+}
+
+void parse_header(const YAML::Node& graph, GraphSpec& spec) {
+  if (!graph) return;
+  if (!graph.IsMap()) fail(Code::BAD_STRUCTURE, spec.file, graph, "'graph' must be a map");
+  for (const auto& item : graph) {
+    const std::string key = item.first.Scalar();
+    const YAML::Node& value = item.second;
+    if (key == "name") {
+      spec.name = scalar(value, spec.file, "graph.name");
+    } else if (key == "period_ms") {
+      spec.period_ns = static_cast<std::int64_t>(number(value, spec.file, "graph.period_ms", 3.6e6) * 1e6);
+    } else if (key == "max_in_flight") {
+      spec.max_in_flight = static_cast<std::size_t>(number(value, spec.file, "graph.max_in_flight", 4096));
+    } else if (key == "pool" && value.IsMap()) {
+      for (const auto& p : value) {
+        const std::string pkey = p.first.Scalar();
+        if (pkey == "block_bytes") {
+          spec.block_bytes = static_cast<std::size_t>(number(p.second, spec.file, "pool.block_bytes", 1 << 30));
+        } else if (pkey == "blocks") {
+          spec.blocks = static_cast<std::size_t>(number(p.second, spec.file, "pool.blocks", 1 << 20));
+        } else {
+          fail(Code::BAD_PARAMETER, spec.file, p.first, "unknown pool key '" + pkey + "'");
+        }
+      }
+    } else {
+      fail(Code::BAD_PARAMETER, spec.file, item.first, "unknown graph key '" + key + "'");
+    }
+  }
+}
+
+void parse_node_key(const std::string& key, const YAML::Node& value, NodeSpec& node, const std::string& file) {
+  if (key == "name") {
+    node.name = scalar(value, file, "node name");
+  } else if (key == "kind") {
+    node.kind = scalar(value, file, "node kind");
+  } else if (key == "policy") {
+    const std::string policy = scalar(value, file, "policy");
+    if (policy != "queue" && policy != "latest") {
+      fail(Code::BAD_PARAMETER, file, value, "policy '" + policy + "' is not one of {queue, latest}");
+    }
+    node.policy = policy == "latest" ? Policy::LATEST : Policy::QUEUE;
+  } else if (key == "ordered") {
+    bool ordered = false;
+    if (!value.IsScalar() || !YAML::convert<bool>::decode(value, ordered)) {
+      fail(Code::BAD_PARAMETER, file, value, "ordered must be true or false");
+    }
+    node.ordered = ordered;
+  } else if (key == "deadline_ms") {
+    node.deadline_ns = static_cast<std::int64_t>(number(value, file, "deadline_ms", 3.6e6) * 1e6);
+  } else if (key == "params") {
+    if (!value.IsMap()) fail(Code::BAD_STRUCTURE, file, value, "params must be a map");
+    for (const auto& p : value) {
+      node.params.set(p.first.Scalar(), scalar(p.second, file, "parameter '" + p.first.Scalar() + "'"),
+                      line_of(p.first));
+    }
+  } else {
+    fail(Code::BAD_STRUCTURE, file, value, "unknown node key '" + key + "'");
+  }
+}
+
+void parse_nodes(const YAML::Node& nodes, GraphSpec& spec) {
+  if (!nodes || !nodes.IsSequence()) fail(Code::BAD_STRUCTURE, spec.file, nodes, "'nodes' must be a list");
+  std::set<std::string> names;
+  for (const auto& item : nodes) {
+    if (!item.IsMap()) fail(Code::BAD_STRUCTURE, spec.file, item, "each node must be a map");
+    NodeSpec node;
+    node.line = line_of(item);
+    for (const auto& kv : item) parse_node_key(kv.first.Scalar(), kv.second, node, spec.file);
+    if (node.name.empty() || node.kind.empty()) {
+      fail(Code::BAD_STRUCTURE, spec.file, item, "a node needs both 'name' and 'kind'");
+    }
+    if (!names.insert(node.name).second) {
+      fail(Code::DUPLICATE_NODE, spec.file, item, "node name '" + node.name + "' is used twice");
+    }
+    spec.nodes.push_back(std::move(node));
+  }
+}
+
+void parse_edges(const YAML::Node& edges, GraphSpec& spec) {
+  if (!edges) return;
+  if (!edges.IsSequence()) fail(Code::BAD_STRUCTURE, spec.file, edges, "'edges' must be a list");
+  static const std::regex EDGE(R"(^\s*([\w-]+)\.([\w-]+)\s*->\s*([\w-]+)\.([\w-]+)\s*$)");
+  for (const auto& item : edges) {
+    const std::string text = scalar(item, spec.file, "edge");
+    std::smatch m;
+    if (!std::regex_match(text, m, EDGE)) {
+      fail(Code::BAD_STRUCTURE, spec.file, item, "edge '" + text + "' is not of the form 'node.port -> node.port'");
+    }
+    spec.edges.push_back({m[1].str(), m[2].str(), m[3].str(), m[4].str(), line_of(item)});
+  }
+}
+
+}  // namespace
+
+Result<GraphSpec, GraphError> parse_graph(const std::string& text, const std::string& file) {
+  GraphSpec spec;
+  spec.file = file;
+  try {
+    const YAML::Node root = YAML::Load(text);
+    if (!root.IsMap()) fail(Code::BAD_STRUCTURE, file, root, "a graph file must be a map with 'nodes' and 'edges'");
+    for (const auto& item : root) {
+      const std::string key = item.first.Scalar();
+      if (key != "graph" && key != "nodes" && key != "edges") {
+        fail(Code::BAD_STRUCTURE, file, item.first, "unknown top-level key '" + key + "'");
+      }
+    }
+    parse_header(root["graph"], spec);
+    parse_nodes(root["nodes"], spec);
+    parse_edges(root["edges"], spec);
+  } catch (const Fail& f) {
+    return err(f.error);
+  } catch (const YAML::Exception& e) {
+    return err(GraphError{Code::SYNTAX, file, e.mark.line >= 0 ? e.mark.line + 1 : 0, e.msg});
+  }
+  return spec;
+}
+
+Result<GraphSpec, GraphError> load_graph_file(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) return err(GraphError{Code::FILE_UNREADABLE, path, 0, "cannot open the graph file"});
+  std::ostringstream text;
+  text << in.rdbuf();
+  return parse_graph(text.str(), path);
+}
+
+}  // namespace orthoflow::engine
