@@ -1,0 +1,40 @@
+#pragma once
+/// @file
+/// @brief The synthetic object categories (the thesis's restaurant set plus boxes and cans) and
+/// their parametric instances, built from the solids in shape_primitives.hpp.
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string_view>
+
+#include "drivers/shape_primitives.hpp"
+
+namespace orthoflow::drivers {
+
+enum class Category : std::uint8_t { BOTTLE, BOWL, FLASK, FORK, KNIFE, MUG, PLATE, SPOON, TEAPOT, VASE, BOX, CAN };
+inline constexpr std::size_t CATEGORY_COUNT = 12;
+
+/// @brief Lower-case name ("bottle", ...).
+[[nodiscard]] const char* category_name(Category c) noexcept;
+/// @brief The category with that name, if any.
+[[nodiscard]] std::optional<Category> category_from_name(std::string_view name) noexcept;
+
+inline constexpr std::size_t MAX_PRIMITIVES = 16;
+
+/// @brief One object instance in its own frame: z up (the table normal), origin on the table.
+struct ObjectModel {
+  Category category = Category::BOX;
+  std::uint32_t instance = 0;
+  std::array<Primitive, MAX_PRIMITIVES> parts{};
+  std::size_t part_count = 0;
+  double footprint_radius = 0.0;  ///< radius of a circle around the origin that holds the footprint
+  double height = 0.0;            ///< top of the highest part above the table
+  std::uint32_t rgb = 0xFFFFFFFFU;
+};
+
+/// @brief The model of instance @p instance of @p category: shape parameters drawn from a generator
+/// seeded by (category, instance), so the same instance is the same object in every scene and dataset.
+[[nodiscard]] ObjectModel make_object_model(Category category, std::uint32_t instance) noexcept;
+
+}  // namespace orthoflow::drivers
