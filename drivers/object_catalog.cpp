@@ -143,11 +143,12 @@ std::optional<Category> category_from_name(std::string_view name) noexcept {
   return std::nullopt;
 }
 
-ObjectModel make_object_model(Category category, std::uint32_t instance) noexcept {
+ObjectModel make_object_model(Category category, std::uint32_t instance, std::uint64_t shape_seed) noexcept {
   ObjectModel m;
   m.category = category;
   m.instance = instance;
-  Random r(0x0B1EC7ULL * 1000003ULL + static_cast<std::uint64_t>(category) * 65537ULL + instance);
+  Random r(0x0B1EC7ULL * 1000003ULL + static_cast<std::uint64_t>(category) * 65537ULL + instance +
+           shape_seed * 0x9E3779B97F4A7C15ULL);
   Builder b{m};
   build(b, r, category);
   measure(m);

@@ -34,7 +34,9 @@ struct ObjectModel {
 };
 
 /// @brief The model of instance @p instance of @p category: shape parameters drawn from a generator
-/// seeded by (category, instance), so the same instance is the same object in every scene and dataset.
-[[nodiscard]] ObjectModel make_object_model(Category category, std::uint32_t instance) noexcept;
+/// seeded by (category, instance, @p shape_seed), so the same triple is the same object in every
+/// scene and dataset; another shape_seed gives a fresh set of instances (e.g. a held-out test set).
+[[nodiscard]] ObjectModel make_object_model(Category category, std::uint32_t instance,
+                                            std::uint64_t shape_seed = 0) noexcept;
 
 }  // namespace orthoflow::drivers
