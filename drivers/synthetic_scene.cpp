@@ -1,6 +1,7 @@
 // Scene geometry and random scene layout. The rendering itself is in synthetic_render.cpp.
 #include "drivers/synthetic_scene.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "memory_pool/assert.hpp"
@@ -94,19 +95,27 @@ Scene make_scene(const SceneConfig& config, std::uint64_t seed) {
   scene.table.distance_m = rng.uniform(0.7, 1.2);
   scene.table.tilt_rad = rng.uniform(30.0, 60.0) * PI / 180.0;
   // About as wide as the view at the table centre (58 degrees horizontal field of view), so the
-  // side edges show at the far end and the near and far edges show whole.
-  scene.table.width_m = scene.table.distance_m * rng.uniform(0.95, 1.1);
-  scene.table.depth_m = rng.uniform(0.55, 0.75);
+  // side edges show at the far end and the near and far edges show whole; at least 0.9 m so that
+  // ten objects usually fit.
+  scene.table.width_m = std::max(scene.table.distance_m * rng.uniform(0.95, 1.1), rng.uniform(0.9, 1.0));
+  scene.table.depth_m = rng.uniform(0.6, 0.8);
   scene.table.floor_drop_m = config.floor ? rng.uniform(0.65, 0.78) : 0.0;
-  scene.objects.reserve(config.objects);
+  std::array<ObjectModel, MAX_SCENE_OBJECTS> models{};
   for (std::uint32_t i = 0; i < config.objects; ++i) {
     const Category category = pick_category(config, rng);
-    const auto instance = static_cast<std::uint32_t>(rng.below(config.instances_per_category));
-    const ObjectModel model = make_object_model(category, instance);
+    models[i] = make_object_model(category, static_cast<std::uint32_t>(rng.below(config.instances_per_category)));
+  }
+  // Large footprints first: packing them while the table is empty lets more objects fit.
+  if (!config.touching) {
+    std::stable_sort(models.begin(), models.begin() + config.objects,
+                     [](const ObjectModel& a, const ObjectModel& b) { return a.footprint_radius > b.footprint_radius; });
+  }
+  scene.objects.reserve(config.objects);
+  for (std::uint32_t i = 0; i < config.objects; ++i) {
     const bool touch = config.touching && i % 2 == 1 && !scene.objects.empty();
     const PlacedObject* anchor = touch ? &scene.objects.back() : nullptr;
     PlacedObject placed;
-    if (place(model, scene, anchor, rng, placed)) { scene.objects.push_back(placed); }
+    if (place(models[i], scene, anchor, rng, placed)) { scene.objects.push_back(placed); }
   }
   return scene;
 }
