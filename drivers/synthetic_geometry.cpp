@@ -26,6 +26,7 @@ SceneGeometry::SceneGeometry(const Scene& scene) noexcept : table_(table_frame(s
     if (count_ == poses_.size()) { break; }
     Pose& p = poses_[count_++];
     p.model = &o.model;
+    p.label = OBJECT_LABEL_BASE + o.id;
     const double c = std::cos(o.yaw), s = std::sin(o.yaw);
     p.ax = c * table_.right + s * table_.forward;
     p.ay = -s * table_.right + c * table_.forward;
@@ -51,7 +52,7 @@ void SceneGeometry::cast_objects(const Vec3& o, const Vec3& d, double t_min, Sur
     if (any) {
       best.t = h.t;
       best.normal = h.normal[0] * p.ax + h.normal[1] * p.ay + h.normal[2] * p.az;
-      best.label = OBJECT_LABEL_BASE + static_cast<std::uint32_t>(i);
+      best.label = p.label;
       best.rgb = p.model->rgb;
     }
   }

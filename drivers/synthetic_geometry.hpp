@@ -28,6 +28,7 @@ class SceneGeometry {
     Vec3 origin{}, ax{}, ay{}, az{};
     Vec3 sphere_center{};
     double sphere_radius = 0.0;
+    std::uint32_t label = 0;
   };
   void cast_objects(const Vec3& o, const Vec3& d, double t_min, SurfaceHit& best) const noexcept;
 

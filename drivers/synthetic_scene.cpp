@@ -115,7 +115,10 @@ Scene make_scene(const SceneConfig& config, std::uint64_t seed) {
     const bool touch = config.touching && i % 2 == 1 && !scene.objects.empty();
     const PlacedObject* anchor = touch ? &scene.objects.back() : nullptr;
     PlacedObject placed;
-    if (place(models[i], scene, anchor, rng, placed)) { scene.objects.push_back(placed); }
+    if (place(models[i], scene, anchor, rng, placed)) {
+      placed.id = static_cast<std::uint32_t>(scene.objects.size());
+      scene.objects.push_back(placed);
+    }
   }
   return scene;
 }

@@ -9,7 +9,8 @@
 /// What is not: speckle and IR texture, lens distortion, multipath, the colour camera's offset
 /// (colours are per-surface constants), table legs and clutter.
 ///
-/// Labels: 0 = no reading, 1 = table, 2 = floor, OBJECT_LABEL_BASE + i = object i of the scene.
+/// Labels: 0 = no reading, 1 = table, 2 = floor, OBJECT_LABEL_BASE + id = the object with that id
+/// (make_scene numbers objects by their index; sequences keep an object's id while it lives).
 /// Determinism: all randomness comes from Random; the same seed gives the same bytes.
 #include <array>
 #include <cstddef>
@@ -46,6 +47,7 @@ struct PlacedObject {
   double table_x = 0.0;
   double table_y = 0.0;
   double yaw = 0.0;
+  std::uint32_t id = 0;  ///< its pixels get label OBJECT_LABEL_BASE + id (make_scene: the index)
 };
 
 /// @brief Derived geometry of a table in the sensor frame (x right, y down, z forward).
@@ -103,7 +105,7 @@ struct RenderOptions {
 /// @pre scene.objects.size() <= MAX_SCENE_OBJECTS. Deterministic; not thread-safe on one @p rng.
 void render_scene(const Scene& scene, const RenderOptions& options, Random& rng, kernels::PointCloud& out);
 
-/// @brief Object index of a label, or -1 for table, floor and no reading.
+/// @brief Object id of a label, or -1 for table, floor and no reading.
 [[nodiscard]] inline int object_of_label(std::uint32_t label) noexcept {
   return label >= OBJECT_LABEL_BASE ? static_cast<int>(label - OBJECT_LABEL_BASE) : -1;
 }
