@@ -1,5 +1,7 @@
 // Maps a validated Graph onto a oneTBB flow graph (STYLE rule 7) and keeps per-frame accounting so
-// the limiter is released exactly when the last message of a frame has been consumed.
+// that a frame's admission token comes back exactly when the last message of the frame has been
+// consumed. The token ring plays the role of a limiter_node sized to the pool; unlike a limiter it
+// also names the frame's slot, which must stay valid when frames complete out of order.
 #include "engine/engine.hpp"
 
 #include <oneapi/tbb/flow_graph.h>
@@ -25,8 +27,8 @@ struct Target {
   std::uint32_t port = 0;
 };
 
-/// Messages still to be consumed for one frame; the slot is reused by frame_id + max_in_flight,
-/// which the limiter only admits after this frame completed.
+/// Messages still to be consumed for one frame in flight. Slot i belongs to admission token i, so
+/// it is reused only after its frame completed, whatever order frames complete in.
 struct FrameSlot {
   std::atomic<std::int64_t> pending{0};
   std::int64_t stamp_ns = 0;
@@ -51,8 +53,15 @@ struct Engine::Impl {
   struct Router final : Emitter {
     Impl* impl;
     NodeRuntime* from;
-    Router(Impl* i, NodeRuntime* f) : impl(i), from(f) {}
-    void emit(std::size_t port, const Message& message) noexcept override { impl->send(*from, port, message); }
+    const Message* in;
+    Router(Impl* i, NodeRuntime* f, const Message* m) : impl(i), from(f), in(m) {}
+    void emit(std::size_t port, const Message& message) noexcept override {
+      Message out = message;  // frame identity is the engine's: it follows the input message
+      out.frame_id = in->frame_id;
+      out.stamp_ns = in->stamp_ns;
+      out.slot = in->slot;
+      impl->send(*from, port, out);
+    }
   };
 
   Graph& graph;
@@ -62,13 +71,12 @@ struct Engine::Impl {
   std::size_t slot_count;
   std::vector<std::unique_ptr<NodeRuntime>> runtimes;
   std::unique_ptr<flow::graph> g;
-  std::unique_ptr<flow::input_node<Message>> input;
-  std::unique_ptr<flow::limiter_node<Message>> limiter;
   std::unique_ptr<flow::function_node<Message, flow::continue_msg>> dispatch;
   std::atomic<bool> stop_requested{false};
   const std::atomic<bool>* external_stop = nullptr;
   std::uint64_t max_frames = 0;
   std::uint64_t next_frame = 0;
+  bool source_ended = false;  // touched only by the serial admission node
   std::int64_t next_tick_ns = 0;
   StopReason reason = StopReason::SOURCE_END;
   bool ran = false;
@@ -120,15 +128,11 @@ struct Engine::Impl {
         rt->entry = rt->sequencer.get();
       }
     }
-    input = std::make_unique<flow::input_node<Message>>(*g, [this](tbb::flow_control& fc) { return produce(fc); });
-    limiter = std::make_unique<flow::limiter_node<Message>>(*g, slot_count);
     dispatch = std::make_unique<flow::function_node<Message, flow::continue_msg>>(
-        *g, flow::serial, [this](const Message& m) {
-          start_frame(m);
+        *g, flow::serial, [this](const Message& token) {
+          admit(token.slot);
           return flow::continue_msg();
         });
-    flow::make_edge(*input, *limiter);
-    flow::make_edge(*limiter, *dispatch);
   }
 
   bool should_stop() const noexcept {
@@ -136,45 +140,50 @@ struct Engine::Impl {
            (external_stop != nullptr && external_stop->load(std::memory_order_relaxed));
   }
 
-  // Paces the source at the graph period; sleeps in short slices so a stop is seen within ~2 ms.
-  Message produce(tbb::flow_control& fc) {
-    Message m;
-    if (max_frames > 0 && next_frame >= max_frames) reason = StopReason::FRAME_LIMIT;
+  // Admission (the limiter): exactly max_in_flight tokens circulate. run() puts them all into
+  // this serial node; each completed frame puts its token back (done()). A token either becomes
+  // the next frame (paced at the graph period) or is retired when the run is stopping, so frames in
+  // flight never exceed the pool's blocks and the source never takes a block it cannot use yet.
+  void admit(std::uint32_t token) noexcept {
+    if (max_frames > 0 && next_frame >= max_frames && reason == StopReason::SOURCE_END) {
+      reason = StopReason::FRAME_LIMIT;
+    }
     while (reason == StopReason::SOURCE_END && graph.spec.period_ns > 0 && now_ns() < next_tick_ns &&
            !should_stop()) {
-      std::this_thread::sleep_for(std::chrono::microseconds(std::min<std::int64_t>(
-          2000, (next_tick_ns - now_ns()) / 1000 + 1)));
+      // Short slices so that a stop request is seen within ~2 ms.
+      std::this_thread::sleep_for(
+          std::chrono::microseconds(std::min<std::int64_t>(2000, (next_tick_ns - now_ns()) / 1000 + 1)));
     }
-    if (should_stop()) reason = StopReason::STOP_REQUESTED;
+    if (reason == StopReason::SOURCE_END && should_stop()) reason = StopReason::STOP_REQUESTED;
+    if (reason != StopReason::SOURCE_END || source_ended) return;  // token retired
+    Message m;
     const std::int64_t start = now_ns();
-    if (reason != StopReason::SOURCE_END || graph.nodes[graph.source]->produce(m) == SourceStatus::END) {
-      fc.stop();
-      return {};
+    if (graph.nodes[graph.source]->produce(m) == SourceStatus::END) {
+      source_ended = true;
+      return;
     }
+    next_tick_ns = std::max(next_tick_ns + graph.spec.period_ns, now_ns());
     NodeStats& source_stats = *runtimes[graph.source]->stats;
     source_stats.processed.fetch_add(1, std::memory_order_relaxed);
     source_stats.service.record(now_ns() - start);
-    next_tick_ns = std::max(next_tick_ns + graph.spec.period_ns, now_ns());
     m.frame_id = next_frame++;
     m.stamp_ns = now_ns();
-    return m;
-  }
-
-  void start_frame(const Message& m) noexcept {
-    FrameSlot& slot = slots[m.frame_id % slot_count];
+    m.slot = token;
+    FrameSlot& slot = slots[token];
     slot.stamp_ns = m.stamp_ns;
     slot.pending.store(1, std::memory_order_relaxed);  // the dispatcher's own hold, released below
     stats.frames_in.fetch_add(1, std::memory_order_relaxed);
     if (m.skipped) stats.source_drops.fetch_add(1, std::memory_order_relaxed);
     NodeRuntime& source = *runtimes[graph.source];
     for (std::size_t port = 0; port < source.out.size(); ++port) send(source, port, m);
-    done(m.frame_id);
+    m.payload.reset();
+    done(m.slot);
   }
 
   void send(NodeRuntime& from, std::size_t port, const Message& message) noexcept {
     for (const Target& t : from.out[port]) {
       NodeRuntime& to = *runtimes[t.node];
-      slots[message.frame_id % slot_count].pending.fetch_add(1, std::memory_order_relaxed);
+      slots[message.slot].pending.fetch_add(1, std::memory_order_relaxed);
       if (to.policy == Policy::LATEST) {
         std::uint64_t seen = to.newest.load(std::memory_order_relaxed);
         while (message.frame_id > seen && !to.newest.compare_exchange_weak(seen, message.frame_id)) {
@@ -195,14 +204,16 @@ struct Engine::Impl {
 
   void run_node(NodeRuntime& rt, const Message& m) noexcept {
     const std::int64_t start = now_ns();
-    if (m.skipped && !rt.node->wants_skipped()) {
+    if ((m.skipped || m.object_count == 0) && !rt.node->wants_skipped()) {
+      // Tombstones and empty frames (no objects) flow through untouched so joins and sequencers
+      // downstream still see exactly one message per frame.
       rt.stats->skipped.fetch_add(1, std::memory_order_relaxed);
-      forward_tombstone(rt, m);
+      for (std::size_t port = 0; port < rt.out.size(); ++port) send(rt, port, m);
     } else if (rt.policy == Policy::LATEST && m.frame_id < rt.newest.load(std::memory_order_relaxed)) {
       rt.stats->dropped.fetch_add(1, std::memory_order_relaxed);  // a newer frame is already queued
       forward_tombstone(rt, m);
     } else {
-      Router router(this, &rt);
+      Router router(this, &rt, &m);
       rt.node->process(m, router);
       const std::int64_t end = now_ns();
       rt.stats->processed.fetch_add(1, std::memory_order_relaxed);
@@ -210,18 +221,24 @@ struct Engine::Impl {
       if (rt.deadline_ns > 0 && end - start > rt.deadline_ns) rt.stats->deadline_misses.fetch_add(1);
       if (rt.stats->sink) rt.stats->age.record(end - m.stamp_ns);
     }
-    done(m.frame_id);
+    // TBB hands the body a reference to its own non-const copy (held by the task or buffer);
+    // releasing the block here, before the frame can complete, guarantees admission never
+    // admits a frame while the previous frame's block is still held by a finishing task.
+    const_cast<Message&>(m).payload.reset();
+    done(m.slot);
   }
 
   // Called once per consumed message; the call that takes the count to zero completes the frame.
-  void done(std::uint64_t frame_id) noexcept {
-    FrameSlot& slot = slots[frame_id % slot_count];
+  void done(std::uint32_t slot_index) noexcept {
+    FrameSlot& slot = slots[slot_index];
     if (slot.pending.fetch_sub(1, std::memory_order_acq_rel) != 1) return;
     const std::int64_t latency = now_ns() - slot.stamp_ns;
     stats.frame_latency.record(latency);
     if (graph.spec.period_ns > 0 && latency > graph.spec.period_ns) stats.deadline_misses.fetch_add(1);
     stats.frames_done.fetch_add(1, std::memory_order_relaxed);
-    limiter->decrementer().try_put(flow::continue_msg());
+    Message token;
+    token.slot = slot_index;
+    dispatch->try_put(token);  // hand the token back: the next frame may start
   }
 };
 
@@ -237,7 +254,11 @@ StopReason Engine::run(const RunOptions& options) {
   const std::int64_t start = now_ns();
   impl_->next_tick_ns = start;
   impl_->arena.execute([this] {
-    impl_->input->activate();
+    for (std::size_t i = 0; i < impl_->slot_count; ++i) {
+      Message token;
+      token.slot = static_cast<std::uint32_t>(i);
+      impl_->dispatch->try_put(token);
+    }
     impl_->g->wait_for_all();
   });
   impl_->stats.elapsed_ns.store(now_ns() - start);

@@ -1,7 +1,7 @@
 #pragma once
 /// @file
 /// @brief Engine: runs a validated Graph on a oneTBB flow graph inside one task_arena it owns.
-/// Source -> limiter (frames in flight <= pool blocks) -> nodes; stateless nodes run with unlimited
+/// Admission (max_in_flight tokens, <= pool blocks) -> source -> nodes; stateless nodes run with unlimited
 /// concurrency, stateful ones serially; `ordered` nodes sit behind a sequencer keyed by frame id;
 /// `latest` nodes skip stale frames. See engine/README.md for the model.
 #include <atomic>

@@ -45,14 +45,15 @@ class Ticker final : public Node {
   std::uint64_t produced_ = 0;
 };
 
-/// Stateless pass-through that optionally burns CPU (spin_us) and adds a constant to the value.
+/// Pass-through that optionally burns CPU (spin_us) and adds a constant to the value; stateless
+/// unless serial=1 (then the engine runs it one message at a time, e.g. to model a slow tracker).
 class Busy final : public Node {
  public:
-  Busy(const std::string& type, std::int64_t spin_us, std::int64_t add)
-      : ports_{{"in", type, true}, {"out", type, false}}, spin_us_(spin_us), add_(add) {}
+  Busy(const std::string& type, std::int64_t spin_us, std::int64_t add, bool serial)
+      : ports_{{"in", type, true}, {"out", type, false}}, spin_us_(spin_us), add_(add), serial_(serial) {}
   std::span<const PortSpec> inputs() const noexcept override { return {ports_.data(), 1}; }
   std::span<const PortSpec> outputs() const noexcept override { return {ports_.data() + 1, 1}; }
-  bool stateful() const noexcept override { return false; }
+  bool stateful() const noexcept override { return serial_; }
   void process(const Message& in, Emitter& out) noexcept override {
     if (spin_us_ > 0) {
       const auto until = std::chrono::steady_clock::now() + std::chrono::microseconds(spin_us_);
@@ -68,6 +69,7 @@ class Busy final : public Node {
   std::vector<PortSpec> ports_;
   std::int64_t spin_us_;
   std::int64_t add_;
+  bool serial_;
 };
 
 /// Splits a frame into `objects` object messages (value = frame value + object index); with
@@ -97,7 +99,7 @@ class Fanout final : public Node {
 };
 
 /// Collects the object messages of each frame and emits one frame message with their value sum.
-/// Slots are keyed by frame id modulo the frames in flight, so the table never grows.
+/// Per-frame state lives in the engine's frame slot (Message::slot), so the table never grows.
 class Join final : public Node {
  public:
   explicit Join(std::size_t slots) : slots_(slots) {}
@@ -106,12 +108,12 @@ class Join final : public Node {
   bool stateful() const noexcept override { return true; }
   bool wants_skipped() const noexcept override { return true; }
   void process(const Message& in, Emitter& out) noexcept override {
-    Slot& slot = slots_[in.frame_id % slots_.size()];
+    Slot& slot = slots_[in.slot];
     if (slot.arrived == 0) slot = Slot{in.frame_id, 0, 0, false};
     OF_ENFORCE(slot.frame_id == in.frame_id, "join: more frames in flight than slots");
     ++slot.arrived;
     slot.skipped = slot.skipped || in.skipped;
-    if (!in.skipped) slot.sum += in.value;
+    if (!in.skipped && in.object_count > 0) slot.sum += in.value;  // an empty frame adds nothing
     if (slot.arrived < (in.object_count == 0 ? 1u : in.object_count)) return;
     Message frame = in;
     frame.object_index = 0;
@@ -144,14 +146,16 @@ Made make_ticker(const ParamMap& params, const NodeContext& context) {
 }
 
 Made make_busy(const ParamMap& params) {
-  if (auto ok = params.only({"type", "spin_us", "add"}); !ok) return err(ok.error());
+  if (auto ok = params.only({"type", "spin_us", "add", "serial"}); !ok) return err(ok.error());
+  auto serial_result = params.integer("serial", 0, 0, 1);
+  if (!serial_result) return err(serial_result.error());
   auto type_result = params.choice("type", "frame", PORT_TYPES);
   auto spin_result = params.integer("spin_us", 0, 0, 10'000'000);
   auto add_result = params.integer("add", 0, -1'000'000, 1'000'000);
   if (!type_result) return err(type_result.error());
   if (!spin_result) return err(spin_result.error());
   if (!add_result) return err(add_result.error());
-  return std::unique_ptr<Node>(new Busy(*type_result, *spin_result, *add_result));
+  return std::unique_ptr<Node>(new Busy(*type_result, *spin_result, *add_result, *serial_result == 1));
 }
 
 Made make_fanout(const ParamMap& params) {
@@ -213,7 +217,7 @@ void add_generic_nodes(NodeRegistry& registry) {
   const char* const descriptions[][2] = {
       {"ticker", "source: frames=N (0 = endless), payload_bytes=B (pool block per frame)"},
       {"pass", "stateless pass-through: type=frame|object"},
-      {"busy", "stateless pass-through with work: type, spin_us, add (added to value)"},
+      {"busy", "pass-through with work: type, spin_us, add (added to value), serial=0|1"},
       {"fanout", "splits a frame into objects=N object messages (vary=1: 0..N by frame id)"},
       {"join", "stateful: joins the object messages of each frame, value = sum"},
       {"count", "stateful sink: counts frames, checks order and payload; type=frame|object"}};

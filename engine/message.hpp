@@ -16,6 +16,8 @@ struct Message {
   std::uint32_t object_index = 0;  ///< per-object multiplexing: which object of the frame
   std::uint32_t object_count = 1;  ///< objects the frame was split into (0 = frame had none)
   std::uint32_t port = 0;          ///< input port index at the receiving node (set by the engine)
+  std::uint32_t slot = 0;          ///< set by the engine: in [0, max_in_flight), unique among the
+                                   ///< frames in flight; key per-frame state (joins) by it
   bool skipped = false;            ///< tombstone: frame dropped or produced no data upstream
   std::int64_t value = 0;          ///< small scalar result (generic nodes use it; domain nodes may)
   memory_pool::BlockHandle payload;  ///< optional data block (empty handle = none)
