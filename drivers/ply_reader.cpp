@@ -125,7 +125,8 @@ Slot slot_of(const std::string& n) {
   return Slot::NONE;
 }
 
-std::uint32_t channel(double v) { return static_cast<std::uint32_t>(std::clamp(v, 0.0, 255.0)); }
+/// A colour channel clamped to 0..255 (a float property may hold NaN or anything else).
+std::uint32_t channel(double v) { return v >= 0.0 ? static_cast<std::uint32_t>(std::min(v, 255.0)) : 0U; }
 
 void store(kernels::PointCloud& c, std::size_t i, const std::array<double, 11>& v) {
   c.x()[i] = static_cast<float>(v[1]);
