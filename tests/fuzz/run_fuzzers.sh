@@ -1,34 +1,51 @@
 #!/usr/bin/env bash
-# usage: run_fuzzers.sh SECONDS FUZZER...
-# Runs each libFuzzer binary for SECONDS on a fresh corpus seeded with the committed seeds and the
-# shared data files; exits non-zero on any crash, leak, timeout or sanitizer report.
+# usage: run_fuzzers.sh SECONDS [FUZZ_BUILD_DIR]
+# Runs every libFuzzer binary of an already built fuzz tree (default: build/fuzz, the `fuzz` preset)
+# for SECONDS each, on a fresh temporary corpus seeded with the committed seeds and the small PCD files
+# of the shared data. Builds nothing. Exits non-zero on any crash, leak, timeout, OOM or sanitizer report.
+# Set KEEP_CORPUS=DIR to keep the grown corpora in DIR/<fuzzer>.
 set -euo pipefail
+if [ $# -lt 1 ]; then
+  echo "usage: $0 SECONDS [FUZZ_BUILD_DIR]" >&2
+  exit 2
+fi
 seconds=$1
-shift
 here=$(cd "$(dirname "$0")" && pwd)
-shared="${ORTHOFLOW_SHARED_DIR:-$here/../../../shared}"
+build=${2:-$here/../../build/fuzz}
+shared="${ORTHOFLOW_SHARED_DIR:-/work/shared}"
 status=0
-for fuzzer in "$@"; do
-  name=$(basename "$fuzzer")
-  kind=${name#fuzz_}
-  kind=${kind%_reader}
+found=0
+for kind in pcd ply; do
+  fuzzer=$(find "$build" -type f -perm -u+x -name "fuzz_${kind}_reader" | head -1)
+  if [ -z "$fuzzer" ]; then
+    echo "fuzz: fuzz_${kind}_reader not found under $build (build the fuzz preset first)" >&2
+    status=1
+    continue
+  fi
+  found=$((found + 1))
   corpus=$(mktemp -d)
-  cp "$here/corpus/$kind/"* "$corpus/" 2>/dev/null || true
+  cp "$here/corpus/$kind/"* "$corpus/"
   if [ "$kind" = pcd ] && [ -d "$shared" ]; then
     # Small shared files only: big organized frames make each execution slow.
-    find "$shared" -name '*.pcd' -size -200k -exec cp {} "$corpus/" \; 2>/dev/null || true
+    find "$shared" -name '*.pcd' -size -40k -exec cp {} "$corpus/" \; 2>/dev/null || true
   fi
   artifacts=$(mktemp -d)
-  echo "fuzz: $name for ${seconds}s, $(ls "$corpus" | wc -l) seeds"
+  echo "fuzz: $(basename "$fuzzer") for ${seconds}s, $(ls "$corpus" | wc -l) seeds"
   if ! "$fuzzer" -max_total_time="$seconds" -max_len=65536 -timeout=10 -rss_limit_mb=2048 \
       -artifact_prefix="$artifacts/" -print_final_stats=1 "$corpus" 2>"$artifacts/log"; then
     tail -40 "$artifacts/log"
-    echo "fuzz: $name FAILED (artifacts in $artifacts)"
+    echo "fuzz: $(basename "$fuzzer") FAILED (log and crashing input in $artifacts)"
     status=1
   else
     grep -E "stat::number_of_executed_units|stat::peak_rss_mb" "$artifacts/log" || true
-    tail -1 "$artifacts/log"
+    grep -E "^#[0-9]+.*(cov|DONE)" "$artifacts/log" | tail -1 || true
+    echo "fuzz: corpus grew to $(ls "$corpus" | wc -l) inputs"
+    rm -rf "$artifacts"
+  fi
+  if [ -n "${KEEP_CORPUS:-}" ]; then
+    mkdir -p "$KEEP_CORPUS/$kind" && cp "$corpus/"* "$KEEP_CORPUS/$kind/"
   fi
   rm -rf "$corpus"
 done
+[ "$found" -gt 0 ] || status=1
 exit $status
