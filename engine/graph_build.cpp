@@ -97,6 +97,11 @@ std::optional<GraphError> resolve_edges(Graph& graph) {
     }
     graph.edges.push_back({from->second, *out_port, to->second, *in_port});
   }
+  return std::nullopt;
+}
+
+std::optional<GraphError> check_required_inputs(const Graph& graph) {
+  const GraphSpec& spec = graph.spec;
   for (std::size_t n = 0; n < graph.nodes.size(); ++n) {
     const auto ins = graph.nodes[n]->inputs();
     for (std::size_t p = 0; p < ins.size(); ++p) {
@@ -174,6 +179,7 @@ Built build_graph(const GraphSpec& spec, const NodeRegistry& registry) {
   graph->pool = std::move(*pool_result);
   if (auto e = make_nodes(*graph, registry)) return err(*e);
   if (auto e = resolve_edges(*graph)) return err(*e);
+  if (auto e = check_required_inputs(*graph)) return err(*e);
   if (auto e = order_nodes(*graph)) return err(*e);
   return graph;
 }
