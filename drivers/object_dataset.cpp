@@ -48,7 +48,7 @@ std::size_t render_view(const DatasetConfig& config, const ObjectModel& model, s
   for (std::uint32_t a = 0; a < VIEW_ATTEMPTS && n < MIN_VIEW_POINTS; ++a) {
     Random noise(~view_seed(config, model.category, model.instance, v, a));
     const ViewSpec spec = dataset_view(config, model.category, model.instance, v, a);
-    n = render_object_view(model, spec, RenderOptions{}, noise, frame, view);
+    n = render_object_view(model, spec, config.render, noise, frame, view);
   }
   return n;
 }

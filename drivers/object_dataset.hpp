@@ -36,6 +36,7 @@ struct DatasetConfig {
   std::uint64_t seed = 1;              ///< picks the instances' shapes, the views and the noise
   double min_elevation_deg = 20.0, max_elevation_deg = 70.0;
   double min_distance_m = 0.6, max_distance_m = 1.5;
+  RenderOptions render{};              ///< sensor model (e.g. a smaller image for quick tests)
 };
 
 /// @brief Why a dataset could not be written.

@@ -52,7 +52,7 @@ TEST(SyntheticScene, OrganizedLayoutWithNanExactlyWhereNoReading) {
 
 TEST(SyntheticScene, TablePointsLieOnThePlaneWithinTheNoiseModel) {
   const RenderOptions options;
-  for (std::uint64_t seed : {1ULL, 2ULL, 3ULL}) {
+  for (std::uint64_t seed : {1ULL, 2ULL}) {
     const Rendered r = render(SceneConfig{}, seed, options);
     const TableFrame f = table_frame(r.scene.table);
     double sum_sq = 0.0;
@@ -116,20 +116,30 @@ TEST(SyntheticScene, SameSeedSameBytesDifferentSeedDifferent) {
   EXPECT_FALSE(same(a.cloud, c.cloud));
 }
 
+/// The central @p w x @p h window of the 640x480 camera (same rays, fewer of them: quicker tests).
+RenderOptions window(std::uint32_t w, std::uint32_t h) {
+  RenderOptions o;
+  o.intrinsics.cx -= (640 - w) / 2.0;
+  o.intrinsics.cy -= (480 - h) / 2.0;
+  o.intrinsics.width = w;
+  o.intrinsics.height = h;
+  return o;
+}
+
 TEST(SyntheticScene, DepthIsQuantisedToTheDisparitySteps) {
-  const RenderOptions options;
+  const RenderOptions options = window(160, 120);
   const DepthTable table = make_depth_table(options.depth);
   const std::set<float> levels(table.begin(), table.end());
   const Scene scene = make_scene(SceneConfig{}, SEED);
   std::set<float> at_centre;
   kernels::PointCloud cloud;
-  for (std::uint64_t s = 0; s < 8; ++s) {
+  for (std::uint64_t s = 0; s < 12; ++s) {
     Random rng(s);
     render_scene(scene, options, rng, cloud);
     for (float z : cloud.z()) {
       if (!std::isnan(z)) { ASSERT_EQ(levels.count(z), 1U) << z << " is not a Kinect depth level"; }
     }
-    const std::size_t centre = 240 * 640 + 320;
+    const std::size_t centre = 60 * 160 + 80;
     if (!std::isnan(cloud.z()[centre])) { at_centre.insert(cloud.z()[centre]); }
   }
   // The noise spreads one pixel's depth over a few levels, one step (> 1 mm at >= 0.7 m) apart.
