@@ -17,6 +17,8 @@ inline constexpr int EXIT_USAGE = 106;          ///< CLI11's own code for bad ar
 void add_graph_command(CLI::App& app);
 /// @brief `synth` and `synth-dataset`: synthetic Kinect tabletop frames and the object-view dataset.
 void add_synth_command(CLI::App& app);
+/// @brief `info FILE [--json]`: fields, point count, layout, finite points, bounding box of a .pcd/.ply file.
+void add_info_command(CLI::App& app);
 
 
 }  // namespace orthoflow::apps

@@ -8,6 +8,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   orthoflow::apps::add_graph_command(app);
   orthoflow::apps::add_synth_command(app);
+  orthoflow::apps::add_info_command(app);
   app.set_version_flag("--version", ORTHOFLOW_VERSION);
   try {
     app.parse(argc, argv);
