@@ -3,7 +3,7 @@
 # Runs every libFuzzer binary of an already built fuzz tree (default: build/fuzz, the `fuzz` preset)
 # for SECONDS each, on a fresh temporary corpus seeded with the committed seeds and the small PCD files
 # of the shared data. Builds nothing. Exits non-zero on any crash, leak, timeout, OOM or sanitizer report.
-# Set KEEP_CORPUS=DIR to keep the grown corpora in DIR/<fuzzer>.
+# Set FUZZERS="pcd" (or "ply") to run only some; KEEP_CORPUS=DIR keeps the grown corpora in DIR/<kind>.
 set -euo pipefail
 if [ $# -lt 1 ]; then
   echo "usage: $0 SECONDS [FUZZ_BUILD_DIR]" >&2
@@ -15,7 +15,7 @@ build=${2:-$here/../../build/fuzz}
 shared="${ORTHOFLOW_SHARED_DIR:-/work/shared}"
 status=0
 found=0
-for kind in pcd ply; do
+for kind in ${FUZZERS:-pcd ply}; do
   fuzzer=$(find "$build" -type f -perm -u+x -name "fuzz_${kind}_reader" | head -1)
   if [ -z "$fuzzer" ]; then
     echo "fuzz: fuzz_${kind}_reader not found under $build (build the fuzz preset first)" >&2
