@@ -2,9 +2,10 @@
 // YAML node (yaml-cpp marks are 0-based).
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <fstream>
-#include <regex>
 #include <set>
 #include <sstream>
 
@@ -117,17 +118,42 @@ void parse_nodes(const YAML::Node& nodes, GraphSpec& spec) {
   }
 }
 
+bool is_name(const std::string& text) {
+  return !text.empty() && std::all_of(text.begin(), text.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '_' || c == '-';
+  });
+}
+
+std::string trim(const std::string& text) {
+  const auto first = text.find_first_not_of(" \t");
+  const auto last = text.find_last_not_of(" \t");
+  return first == std::string::npos ? std::string() : text.substr(first, last - first + 1);
+}
+
+// Splits "node.port" into its two names; false if either is not a plain identifier.
+bool split_endpoint(const std::string& text, std::string& node, std::string& port) {
+  const std::string endpoint = trim(text);
+  const auto dot = endpoint.find('.');
+  if (dot == std::string::npos) return false;
+  node = endpoint.substr(0, dot);
+  port = endpoint.substr(dot + 1);
+  return is_name(node) && is_name(port);
+}
+
+// Edges are written "from.port -> to.port" (no std::regex: GCC 12 warns inside it under ASan).
 void parse_edges(const YAML::Node& edges, GraphSpec& spec) {
   if (!edges) return;
   if (!edges.IsSequence()) fail(Code::BAD_STRUCTURE, spec.file, edges, "'edges' must be a list");
-  static const std::regex EDGE(R"(^\s*([\w-]+)\.([\w-]+)\s*->\s*([\w-]+)\.([\w-]+)\s*$)");
   for (const auto& item : edges) {
     const std::string text = scalar(item, spec.file, "edge");
-    std::smatch m;
-    if (!std::regex_match(text, m, EDGE)) {
+    EdgeSpec edge;
+    edge.line = line_of(item);
+    const auto arrow = text.find("->");
+    if (arrow == std::string::npos || !split_endpoint(text.substr(0, arrow), edge.from_node, edge.from_port) ||
+        !split_endpoint(text.substr(arrow + 2), edge.to_node, edge.to_port)) {
       fail(Code::BAD_STRUCTURE, spec.file, item, "edge '" + text + "' is not of the form 'node.port -> node.port'");
     }
-    spec.edges.push_back({m[1].str(), m[2].str(), m[3].str(), m[4].str(), line_of(item)});
+    spec.edges.push_back(std::move(edge));
   }
 }
 
