@@ -1,0 +1,117 @@
+#pragma once
+// SIMD bodies of GOOD's two passes: frame statistics (AABB + sign counts) and the three projections.
+// Lane-wise transform and bin indices; the histogram increments stay scalar (scatter has no SIMD win).
+#include <limits>
+
+#include "kernels/detail/good_kernel.hpp"
+
+namespace orthoflow::kernels::detail {
+
+namespace good_simd {
+
+template <class B>
+struct Q {
+  B x, y, z;
+};
+
+template <class B>
+Q<B> transform(const GoodTransform& t, const float* px, const float* py, const float* pz) noexcept {
+  const B dx = B::load_unaligned(px) - B(t.c[0]);
+  const B dy = B::load_unaligned(py) - B(t.c[1]);
+  const B dz = B::load_unaligned(pz) - B(t.c[2]);
+  Q<B> q;
+  // (r0 dx + r1 dy) + r2 dz: the grouping of good_transform_point().
+  q.x = (B(t.r[0][0]) * dx + B(t.r[0][1]) * dy) + B(t.r[0][2]) * dz;
+  q.y = (B(t.r[1][0]) * dx + B(t.r[1][1]) * dy) + B(t.r[1][2]) * dz;
+  q.z = (B(t.r[2][0]) * dx + B(t.r[2][1]) * dy) + B(t.r[2][2]) * dz;
+  return q;
+}
+
+}  // namespace good_simd
+
+template <class Arch>
+GoodStats GoodStatsKernel::operator()(Arch /*arch*/, PointsView points, const GoodTransform& t,
+                                      float threshold) const noexcept {
+  using batch = xsimd::batch<float, Arch>;
+  constexpr std::size_t LANES = batch::size;
+  const std::size_t n = points.size();
+  const float inf = std::numeric_limits<float>::infinity();
+  batch lo[3] = {batch(inf), batch(inf), batch(inf)};
+  batch hi[3] = {batch(-inf), batch(-inf), batch(-inf)};
+  batch cnt[4] = {batch(0.0F), batch(0.0F), batch(0.0F), batch(0.0F)};  // pos x, neg x, pos y, neg y
+  GoodStats s;
+  const auto flush = [&] {
+    for (std::size_t k = 0; k < 2; ++k) {
+      s.pos[k] += static_cast<std::size_t>(xsimd::hadd(cnt[2 * k]));
+      s.neg[k] += static_cast<std::size_t>(xsimd::hadd(cnt[2 * k + 1]));
+    }
+    for (auto& c : cnt) { c = batch(0.0F); }
+  };
+  std::size_t i = 0;
+  std::size_t since_flush = 0;
+  const batch one(1.0F), zero(0.0F), tp(threshold), tn(-threshold);
+  for (; i + LANES <= n; i += LANES) {
+    const batch x = batch::load_unaligned(points.x.data() + i);
+    const batch y = batch::load_unaligned(points.y.data() + i);
+    const batch z = batch::load_unaligned(points.z.data() + i);
+    const auto ok = ((x - x) == zero) && ((y - y) == zero) && ((z - z) == zero);  // all finite
+    const auto q = good_simd::transform<batch>(t, points.x.data() + i, points.y.data() + i, points.z.data() + i);
+    const batch qs[3] = {q.x, q.y, q.z};
+    for (std::size_t a = 0; a < 3; ++a) {
+      lo[a] = xsimd::select(ok, xsimd::min(lo[a], qs[a]), lo[a]);
+      hi[a] = xsimd::select(ok, xsimd::max(hi[a], qs[a]), hi[a]);
+    }
+    for (std::size_t a = 0; a < 2; ++a) {
+      cnt[2 * a] = cnt[2 * a] + xsimd::select(ok && (qs[a] > tp), one, zero);
+      cnt[2 * a + 1] = cnt[2 * a + 1] + xsimd::select(ok && (qs[a] < tn), one, zero);
+    }
+    if (++since_flush == (1U << 20)) {  // float counters are exact up to 2^24 per lane
+      flush();
+      since_flush = 0;
+    }
+  }
+  flush();
+  alignas(64) float buf[LANES];
+  for (std::size_t a = 0; a < 3; ++a) {
+    s.min[a] = inf;
+    s.max[a] = -inf;
+    lo[a].store_unaligned(buf);
+    for (std::size_t l = 0; l < LANES; ++l) { s.min[a] = std::min(s.min[a], buf[l]); }
+    hi[a].store_unaligned(buf);
+    for (std::size_t l = 0; l < LANES; ++l) { s.max[a] = std::max(s.max[a], buf[l]); }
+  }
+  good_stats_scalar(points, t, threshold, i, n, s);
+  return s;
+}
+
+template <class Arch>
+void GoodBinKernel::operator()(Arch /*arch*/, PointsView points, const GoodBinParams& p,
+                               std::span<std::uint32_t> counts, std::array<std::size_t, 3>& kept) const noexcept {
+  using batch = xsimd::batch<float, Arch>;
+  constexpr std::size_t LANES = batch::size;
+  const std::size_t n = points.size();
+  const batch half(p.half), width(p.width), lo(-1.0F), hi(static_cast<float>(p.bins)), none(-1.0F);
+  alignas(64) std::int32_t k[3][LANES];
+  std::size_t i = 0;
+  for (; i + LANES <= n; i += LANES) {
+    const auto q = good_simd::transform<batch>(p.t, points.x.data() + i, points.y.data() + i, points.z.data() + i);
+    const batch qs[3] = {q.x, q.y, q.z};
+    for (std::size_t a = 0; a < 3; ++a) {
+      const batch f = (qs[a] + half) / width;  // the division of good_bin_scalar(), exact IEEE in both
+      const batch kf = xsimd::select((f > lo) && (f < hi), xsimd::trunc(f), none);
+      xsimd::to_int(kf).store_unaligned(k[a]);
+    }
+    for (std::size_t l = 0; l < LANES; ++l) { good_add_bins(k[0][l], k[1][l], k[2][l], p.bins, counts, kept); }
+  }
+  good_bin_range_scalar(points, p, i, n, counts, kept);
+}
+
+}  // namespace orthoflow::kernels::detail
+
+#ifdef OF_SIMD_ARCH
+template orthoflow::kernels::detail::GoodStats orthoflow::kernels::detail::GoodStatsKernel::operator()<OF_SIMD_ARCH>(
+    OF_SIMD_ARCH, orthoflow::kernels::PointsView, const orthoflow::kernels::detail::GoodTransform&, float) const noexcept;
+template void orthoflow::kernels::detail::GoodBinKernel::operator()<OF_SIMD_ARCH>(
+    OF_SIMD_ARCH, orthoflow::kernels::PointsView, const orthoflow::kernels::detail::GoodBinParams&,
+    std::span<std::uint32_t>, std::array<std::size_t, 3>&) const noexcept;
+#endif

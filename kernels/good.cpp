@@ -1,0 +1,179 @@
+#include "kernels/good.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "kernels/detail/good_kernel.hpp"
+#include "kernels/detail/good_order.hpp"
+
+namespace orthoflow::kernels {
+
+namespace {
+
+using detail::GoodStats;
+using detail::GoodTransform;
+
+GoodTransform make_transform(const PcaFrame& f, const std::array<int, 3>& signs) noexcept {
+  GoodTransform t;
+  for (std::size_t a = 0; a < 3; ++a) {
+    t.c[a] = static_cast<float>(f.centroid[a]);
+    for (std::size_t k = 0; k < 3; ++k) { t.r[a][k] = static_cast<float>(signs[a] * f.axes[a][k]); }
+  }
+  return t;
+}
+
+// Third central moment sum q^3 and second sum q^2 along one provisional axis, in double.
+std::array<double, 2> moments_along(PointsView points, const PcaFrame& f, std::size_t axis) noexcept {
+  std::array<double, 2> m{0.0, 0.0};
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const double d[3] = {points.x[i] - f.centroid[0], points.y[i] - f.centroid[1], points.z[i] - f.centroid[2]};
+    const double q = f.axes[axis][0] * d[0] + f.axes[axis][1] * d[1] + f.axes[axis][2] * d[2];
+    if (!std::isfinite(q)) { continue; }
+    m[0] += q * q;
+    m[1] += q * q * q;
+  }
+  return m;
+}
+
+// Invariant sign of a provisional axis (docs/GOOD.md, "tie rule"). Every rule reads only the shape in
+// the provisional frame, and flipping the axis flips each statistic, so the chosen direction is pose-free:
+// 1. counts beyond +-t: the side with more points wins if it leads by more than 1 % of the points;
+// 2. else the sign of the third moment (skewness), if |skew| > 1e-3;
+// 3. else the side that reaches farther from the centroid, if it is farther by > 1e-4 of the extent;
+// 4. else +1 and SIGN_AMBIGUOUS (the shape is symmetric along the axis: both signs look alike).
+int invariant_sign(PointsView points, const PcaFrame& f, const GoodStats& s, std::size_t axis,
+                   std::uint32_t& flags) noexcept {
+  const std::size_t margin = f.finite / 100;
+  if (s.pos[axis] > s.neg[axis] + margin) { return 1; }
+  if (s.neg[axis] > s.pos[axis] + margin) { return -1; }
+  const std::array<double, 2> m = moments_along(points, f, axis);
+  const double count = static_cast<double>(f.finite);
+  const double sigma3 = std::pow(m[0] / count, 1.5);
+  if (std::abs(m[1] / count) > 1e-3 * sigma3) { return m[1] > 0.0 ? 1 : -1; }
+  const double reach = static_cast<double>(s.max[axis]) + static_cast<double>(s.min[axis]);
+  const double extent = static_cast<double>(s.max[axis]) - static_cast<double>(s.min[axis]);
+  if (std::abs(reach) > 1e-4 * extent) { return reach > 0.0 ? 1 : -1; }
+  flags |= SIGN_AMBIGUOUS;
+  return 1;
+}
+
+// Reference rule (GOOD_REFERENCE.md section 4): flip only if neg > pos and neg - pos >= floor(m/10),
+// m counting every input point, NaN included.
+int reference_sign(const GoodStats& s, std::size_t axis, std::size_t all_points) noexcept {
+  const std::size_t margin = all_points / 10;
+  return (s.neg[axis] > s.pos[axis] && s.neg[axis] - s.pos[axis] >= margin) ? -1 : 1;
+}
+
+std::array<float, 16> frame_matrix(const GoodTransform& t) noexcept {
+  std::array<float, 16> m{};
+  for (std::size_t a = 0; a < 3; ++a) {
+    double tr = 0.0;
+    for (std::size_t k = 0; k < 3; ++k) {
+      m[a * 4 + k] = t.r[a][k];
+      tr -= static_cast<double>(t.r[a][k]) * static_cast<double>(t.c[k]);
+    }
+    m[a * 4 + 3] = static_cast<float>(tr);
+  }
+  m[15] = 1.0F;
+  return m;
+}
+
+std::optional<GoodError> validate(PointsView points, const GoodConfig& cfg, const GoodScratch& scratch,
+                                  std::span<float> out) noexcept {
+  const float t = cfg.effective_threshold();
+  if (cfg.bins == 0 || cfg.bins > GOOD_MAX_BINS) { return GoodError::BAD_BINS; }
+  if (!std::isfinite(t) || t < 0.0F) { return GoodError::BAD_THRESHOLD; }
+  if (scratch.max_bins() < cfg.bins) { return GoodError::SCRATCH_TOO_SMALL; }
+  if (out.size() < 3 * cfg.bins * cfg.bins) { return GoodError::OUTPUT_TOO_SMALL; }
+  if (points.empty()) { return GoodError::EMPTY_CLOUD; }
+  return std::nullopt;
+}
+
+template <class StatsFn, class BinFn>
+Result<GoodResult, GoodError> run_good(PointsView points, const GoodConfig& cfg, GoodScratch& scratch,
+                                       std::span<float> out, StatsFn&& stats_fn, BinFn&& bin_fn) noexcept {
+  if (const auto bad = validate(points, cfg, scratch, out)) { return err(*bad); }
+  const auto frame_result = compute_pca_frame(points);
+  if (!frame_result) { return err(GoodError::NO_FINITE_POINTS); }
+  const PcaFrame& f = frame_result.value();
+  GoodResult r;
+  r.flags = f.flags;
+  const GoodStats s = stats_fn(points, make_transform(f, {1, 1, 1}), cfg.effective_threshold());
+  if (cfg.mode == GoodMode::INVARIANT) {
+    const int sx = invariant_sign(points, f, s, 0, r.flags);
+    const int sy = invariant_sign(points, f, s, 1, r.flags);
+    r.signs = {sx, sy, sx * sy};  // Z = X x Y = (Sx v1) x (Sy v2) = Sx Sy v3
+  } else {
+    const int sign = reference_sign(s, 0, points.size()) * reference_sign(s, 1, points.size());
+    r.signs = {sign, sign, 1};  // s multiplies x and y only; z is never flipped
+  }
+  detail::GoodBinParams p;
+  p.t = make_transform(f, r.signs);
+  p.bins = cfg.bins;
+  for (std::size_t a = 0; a < 3; ++a) { r.bbox[a] = s.max[a] - s.min[a]; }
+  // L = largest edge + 0.02 m in double, square centred on the centroid (section 5).
+  const double side = static_cast<double>(std::max({r.bbox[0], r.bbox[1], r.bbox[2]})) + GOOD_SQUARE_MARGIN;
+  p.half = static_cast<float>(side / 2.0);
+  p.width = static_cast<float>(side / static_cast<double>(cfg.bins));
+  const std::size_t len = 3 * cfg.bins * cfg.bins;
+  const std::span<std::uint32_t> counts = scratch.buffer().subspan(0, len);
+  std::fill(counts.begin(), counts.end(), 0U);
+  bin_fn(points, p, counts, r.kept);
+  const detail::GoodOrderOut o = detail::good_normalise_and_order(counts, r.kept, cfg.bins, out.subspan(0, len));
+  r.length = len;
+  r.frame = frame_matrix(p.t);
+  r.order = o.order;
+  r.entropy = o.entropy;
+  r.variance = o.variance;
+  for (std::size_t a = 0; a < 3; ++a) { r.eigenvalues[a] = static_cast<float>(f.eigenvalues[a]); }
+  r.side = static_cast<float>(side);
+  r.points_used = f.finite;
+  if (o.empty_view) { r.flags |= EMPTY_VIEW; }
+  return r;
+}
+
+}  // namespace
+
+const char* to_string(GoodView view) noexcept {
+  switch (view) {
+    case GoodView::YOZ: return "YoZ";
+    case GoodView::XOZ: return "XoZ";
+    case GoodView::XOY: return "XoY";
+  }
+  return "?";
+}
+
+const char* to_string(GoodError error) noexcept {
+  switch (error) {
+    case GoodError::EMPTY_CLOUD: return "compute_good: the cloud has no points";
+    case GoodError::NO_FINITE_POINTS: return "compute_good: every point has a NaN or infinite coordinate";
+    case GoodError::BAD_BINS: return "compute_good: config.bins must be between 1 and 256";
+    case GoodError::BAD_THRESHOLD: return "compute_good: config.threshold must be finite and >= 0";
+    case GoodError::OUTPUT_TOO_SMALL: return "compute_good: descriptor_out holds fewer than 3*bins*bins values";
+    case GoodError::SCRATCH_TOO_SMALL: return "compute_good: the GoodScratch was made for fewer bins than requested";
+  }
+  return "compute_good: unknown error";
+}
+
+Result<GoodResult, GoodError> compute_good_scalar(PointsView points, const GoodConfig& cfg, GoodScratch& scratch,
+                                                  std::span<float> descriptor_out) noexcept {
+  const auto stats = [](PointsView pts, const GoodTransform& t, float thr) {
+    const float inf = std::numeric_limits<float>::infinity();
+    GoodStats s{{inf, inf, inf}, {-inf, -inf, -inf}, {0, 0}, {0, 0}};
+    detail::good_stats_scalar(pts, t, thr, 0, pts.size(), s);
+    return s;
+  };
+  const auto bins = [](PointsView pts, const detail::GoodBinParams& p, std::span<std::uint32_t> c,
+                       std::array<std::size_t, 3>& kept) { detail::good_bin_range_scalar(pts, p, 0, pts.size(), c, kept); };
+  return run_good(points, cfg, scratch, descriptor_out, stats, bins);
+}
+
+Result<GoodResult, GoodError> compute_good(PointsView points, const GoodConfig& cfg, GoodScratch& scratch,
+                                           std::span<float> descriptor_out) noexcept {
+  static auto stats = xsimd::dispatch<SimdArchs>(detail::GoodStatsKernel{});
+  static auto bins = xsimd::dispatch<SimdArchs>(detail::GoodBinKernel{});
+  return run_good(points, cfg, scratch, descriptor_out, stats, bins);
+}
+
+}  // namespace orthoflow::kernels

@@ -1,0 +1,60 @@
+#pragma once
+/// @file
+/// @brief Principal-axes frame of a point cloud (PIPELINE.md section 6): centroid, covariance
+/// C = (1/m) sum (p - c)(p - c)^T, eigenvalues sorted descending, eigenvectors, and flags saying when
+/// the axes are not well defined. Sign disambiguation is done by compute_good() (kernels/good.hpp).
+#include <array>
+#include <cstddef>
+#include <cstdint>
+
+#include "kernels/point_cloud.hpp"
+#include "memory_pool/result.hpp"
+
+namespace orthoflow::kernels {
+
+/// @brief Bits of PcaFrame::flags and GoodResult::flags. Any bit of FRAME_UNRELIABLE means the frame
+/// (and therefore a pose-invariant descriptor) may change with the pose or with tiny perturbations.
+enum FrameFlag : std::uint32_t {
+  FEW_POINTS = 1U << 0,      ///< fewer than 3 finite points
+  COLLINEAR = 1U << 1,       ///< lambda2 <= 1e-6 lambda1 (includes identical points, lambda1 == 0)
+  COPLANAR = 1U << 2,        ///< lambda3 <= 1e-6 lambda1: the normal is defined, the in-plane axes may not be
+  AXES_AMBIGUOUS = 1U << 3,  ///< a relative eigenvalue gap (l1-l2)/l1 or (l2-l3)/l1 is below 2 %
+  SIGN_AMBIGUOUS = 1U << 4,  ///< an axis sign fell through every rule of the invariant tie chain
+  NAN_IGNORED = 1U << 5,     ///< some points had a non-finite coordinate and were skipped
+  EMPTY_VIEW = 1U << 6,      ///< a projection kept no point (only with extents that overflow float)
+};
+/// @brief The flags that make a frame unreliable (NAN_IGNORED and EMPTY_VIEW are informative).
+inline constexpr std::uint32_t FRAME_UNRELIABLE = FEW_POINTS | COLLINEAR | COPLANAR | AXES_AMBIGUOUS | SIGN_AMBIGUOUS;
+
+/// @brief Relative eigenvalue gap below which AXES_AMBIGUOUS is set.
+inline constexpr double AXES_GAP_MIN = 0.02;
+/// @brief Relative eigenvalue size below which COLLINEAR / COPLANAR are set.
+inline constexpr double FLAT_RATIO = 1e-6;
+
+/// @brief Principal axes of the finite points of a cloud.
+struct PcaFrame {
+  std::array<double, 3> centroid{};     ///< mean of the finite points
+  std::array<double, 3> eigenvalues{};  ///< lambda1 >= lambda2 >= lambda3 >= 0 of the /m covariance
+  /// @brief axes[k] is the unit eigenvector of eigenvalues[k]; axes[2] = axes[0] x axes[1] (right-handed).
+  /// Their signs are whatever the eigen solver returns: deterministic for one input, arbitrary across poses.
+  std::array<std::array<double, 3>, 3> axes{};
+  std::size_t finite = 0;   ///< points used (x, y and z finite)
+  std::uint32_t flags = 0;  ///< FrameFlag bits
+};
+
+/// @brief Why no frame could be computed.
+enum class PcaError : std::uint8_t {
+  EMPTY_CLOUD,       ///< the cloud has no points
+  NO_FINITE_POINTS,  ///< every point has a NaN or infinite coordinate
+};
+/// @brief What the error means, as a sentence.
+[[nodiscard]] const char* to_string(PcaError error) noexcept;
+
+/// @brief Centroid, covariance (accumulated in double about the first finite point, which keeps
+/// clouds far from the origin exact enough) and the eigen-decomposition (Eigen's SelfAdjointEigenSolver
+/// on the double 3x3 matrix). Non-finite points are skipped and not counted.
+/// @pre x, y and z have equal lengths.
+/// @note No allocation; thread-safe; deterministic (same input, same output, bit for bit).
+[[nodiscard]] Result<PcaFrame, PcaError> compute_pca_frame(PointsView points) noexcept;
+
+}  // namespace orthoflow::kernels
