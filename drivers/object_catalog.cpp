@@ -48,65 +48,67 @@ void cutlery(Builder& b, Random& r, Category c) {
   }
 }
 
+/// Turned shapes: stacks of frusta (bottle, flask, vase, can).
+void turned(Builder& b, Random& r, Category c) {
+  if (c == Category::BOTTLE) {
+    const double rad = r.uniform(0.03, 0.045), h = r.uniform(0.12, 0.2), neck = r.uniform(0.012, 0.018);
+    const double sh = r.uniform(0.03, 0.05);
+    b.frustum(0, rad, rad, h);
+    b.frustum(h, rad, neck, sh);
+    b.frustum(h + sh, neck, neck, r.uniform(0.04, 0.07));
+  } else if (c == Category::FLASK) {
+    const double rb = r.uniform(0.05, 0.07), rt = r.uniform(0.015, 0.02), h = r.uniform(0.1, 0.14);
+    b.frustum(0, rb, rt, h);
+    b.frustum(h, rt, rt, r.uniform(0.04, 0.06));
+  } else if (c == Category::VASE) {
+    const double rb = r.uniform(0.035, 0.05), rm = r.uniform(0.055, 0.08), rn = r.uniform(0.02, 0.03);
+    const double h1 = r.uniform(0.08, 0.14), h2 = r.uniform(0.06, 0.1);
+    b.frustum(0, rb, rm, h1);
+    b.frustum(h1, rm, rn, h2);
+    b.frustum(h1 + h2, rn, rn * 1.3, r.uniform(0.03, 0.06), true);
+  } else {  // can: a standard 330 ml can varies little
+    const double rad = r.uniform(0.032, 0.034);
+    b.frustum(0, rad, rad, r.uniform(0.1, 0.123));
+  }
+}
+
+/// Tableware with an opening or a handle (bowl, mug, plate, teapot).
+void tableware(Builder& b, Random& r, Category c) {
+  if (c == Category::BOWL) {
+    const double rad = r.uniform(0.06, 0.1), depth = rad * r.uniform(0.5, 0.7);
+    b.ellipsoid({0, 0, depth}, {rad, rad, depth}, 0.0, depth);
+  } else if (c == Category::MUG) {
+    const double rad = r.uniform(0.035, 0.05), h = r.uniform(0.08, 0.11);
+    b.frustum(0, rad, rad, h, true);
+    b.arc({rad, 0, h / 2}, h * r.uniform(0.25, 0.32), 0.008, 0.0, M_PI, 7);
+  } else if (c == Category::PLATE) {
+    const double rad = r.uniform(0.1, 0.14);
+    b.frustum(0, rad * 0.7, rad, r.uniform(0.015, 0.022));
+  } else {  // teapot: body, lid, spout and handle
+    const double a = r.uniform(0.07, 0.09), hz = r.uniform(0.05, 0.07);
+    b.ellipsoid({0, 0, hz}, {a, a, hz});
+    b.ellipsoid({0, 0, 2 * hz}, {a * 0.4, a * 0.4, 0.015});
+    b.arc({a * 0.85, 0, hz * 0.9}, hz * 0.9, 0.01, 0.6, 1.6, 5);
+    b.arc({-a, 0, hz}, hz * 0.6, 0.008, -M_PI, 0.0, 7);
+  }
+}
+
 void build(Builder& b, Random& r, Category c) {
   switch (c) {
-    case Category::BOTTLE: {
-      const double rad = r.uniform(0.03, 0.045), h = r.uniform(0.12, 0.2), neck = r.uniform(0.012, 0.018);
-      const double sh = r.uniform(0.03, 0.05);
-      b.frustum(0, rad, rad, h);
-      b.frustum(h, rad, neck, sh);
-      b.frustum(h + sh, neck, neck, r.uniform(0.04, 0.07));
-      break;
-    }
-    case Category::BOWL: {
-      const double rad = r.uniform(0.06, 0.1), depth = rad * r.uniform(0.5, 0.7);
-      b.ellipsoid({0, 0, depth}, {rad, rad, depth}, 0.0, depth);
-      break;
-    }
-    case Category::FLASK: {
-      const double rb = r.uniform(0.05, 0.07), rt = r.uniform(0.015, 0.02), h = r.uniform(0.1, 0.14);
-      b.frustum(0, rb, rt, h);
-      b.frustum(h, rt, rt, r.uniform(0.04, 0.06));
-      break;
-    }
+    case Category::BOTTLE:
+    case Category::FLASK:
+    case Category::VASE:
+    case Category::CAN: turned(b, r, c); break;
+    case Category::BOWL:
+    case Category::MUG:
+    case Category::PLATE:
+    case Category::TEAPOT: tableware(b, r, c); break;
     case Category::FORK:
     case Category::KNIFE:
     case Category::SPOON: cutlery(b, r, c); break;
-    case Category::MUG: {
-      const double rad = r.uniform(0.035, 0.05), h = r.uniform(0.08, 0.11);
-      b.frustum(0, rad, rad, h, true);
-      b.arc({rad, 0, h / 2}, h * r.uniform(0.25, 0.32), 0.008, 0.0, std::numbers::pi, 7);
-      break;
-    }
-    case Category::PLATE: {
-      const double rad = r.uniform(0.1, 0.14);
-      b.frustum(0, rad * 0.7, rad, r.uniform(0.015, 0.022));
-      break;
-    }
-    case Category::TEAPOT: {
-      const double a = r.uniform(0.07, 0.09), hz = r.uniform(0.05, 0.07);
-      b.ellipsoid({0, 0, hz}, {a, a, hz});
-      b.ellipsoid({0, 0, 2 * hz}, {a * 0.4, a * 0.4, 0.015});
-      b.arc({a * 0.85, 0, hz * 0.9}, hz * 0.9, 0.01, 0.6, 1.6, 5);
-      b.arc({-a, 0, hz}, hz * 0.6, 0.008, -std::numbers::pi, 0.0, 7);
-      break;
-    }
-    case Category::VASE: {
-      const double rb = r.uniform(0.035, 0.05), rm = r.uniform(0.055, 0.08), rn = r.uniform(0.02, 0.03);
-      const double h1 = r.uniform(0.08, 0.14), h2 = r.uniform(0.06, 0.1);
-      b.frustum(0, rb, rm, h1);
-      b.frustum(h1, rm, rn, h2);
-      b.frustum(h1 + h2, rn, rn * 1.3, r.uniform(0.03, 0.06), true);
-      break;
-    }
     case Category::BOX: {
       const double hx = r.uniform(0.04, 0.1), hy = r.uniform(0.03, 0.08), hz = r.uniform(0.025, 0.1);
       b.box({0, 0, hz}, {hx, hy, hz});
-      break;
-    }
-    case Category::CAN: {
-      const double rad = r.uniform(0.032, 0.034);
-      b.frustum(0, rad, rad, r.uniform(0.1, 0.123));
       break;
     }
   }
