@@ -18,7 +18,7 @@ enum FrameFlag : std::uint32_t {
   FEW_POINTS = 1U << 0,      ///< fewer than 3 finite points
   COLLINEAR = 1U << 1,       ///< lambda2 <= 1e-6 lambda1 (includes identical points, lambda1 == 0)
   COPLANAR = 1U << 2,        ///< lambda3 <= 1e-6 lambda1: the normal is defined, the in-plane axes may not be
-  AXES_AMBIGUOUS = 1U << 3,  ///< a relative eigenvalue gap (l1-l2)/l1 or (l2-l3)/l1 is below 2 %
+  AXES_AMBIGUOUS = 1U << 3,  ///< a relative eigenvalue gap (l1-l2)/l1 or (l2-l3)/l1 is below 5 %
   SIGN_AMBIGUOUS = 1U << 4,  ///< an axis sign fell through every rule of the invariant tie chain
   NAN_IGNORED = 1U << 5,     ///< some points had a non-finite coordinate and were skipped
   EMPTY_VIEW = 1U << 6,      ///< a projection kept no point (only with extents that overflow float)
@@ -27,7 +27,7 @@ enum FrameFlag : std::uint32_t {
 inline constexpr std::uint32_t FRAME_UNRELIABLE = FEW_POINTS | COLLINEAR | COPLANAR | AXES_AMBIGUOUS | SIGN_AMBIGUOUS;
 
 /// @brief Relative eigenvalue gap below which AXES_AMBIGUOUS is set.
-inline constexpr double AXES_GAP_MIN = 0.02;
+inline constexpr double AXES_GAP_MIN = 0.05;
 /// @brief Relative eigenvalue size below which COLLINEAR / COPLANAR are set.
 inline constexpr double FLAT_RATIO = 1e-6;
 
