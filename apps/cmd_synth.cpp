@@ -53,6 +53,7 @@ nlohmann::json ground_truth(const drivers::Scene& scene, const kernels::PointClo
   gt["width"] = cloud.width();
   gt["height"] = cloud.height();
   gt["frame"] = "sensor: x right, y down, z forward, metres";
+  gt["pose_convention"] = "row-major 4x4 sensor_from_object; origin at the footprint centre on the table, z = table normal";
   gt["labels"] = {{"none", drivers::LABEL_NONE}, {"table", drivers::LABEL_TABLE}, {"floor", drivers::LABEL_FLOOR},
                   {"object_base", drivers::OBJECT_LABEL_BASE}};
   nlohmann::json corners = nlohmann::json::array();

@@ -84,7 +84,7 @@ TEST(SyntheticScene, TablePointsLieOnThePlaneWithinTheNoiseModel) {
 }
 
 TEST(SyntheticScene, ObjectPointsStandOnTheTableInsideTheirBoundingCylinder) {
-  const RenderOptions options;
+  const RenderOptions options = half_resolution();
   const Rendered r = render(SceneConfig{10, false, {}, 5, true}, 7, options);
   const TableFrame f = table_frame(r.scene.table);
   std::vector<std::size_t> seen(r.scene.objects.size(), 0);
@@ -105,7 +105,7 @@ TEST(SyntheticScene, ObjectPointsStandOnTheTableInsideTheirBoundingCylinder) {
     ASSERT_LE(std::sqrt(dot(radial, radial)), o.model.footprint_radius + tol);
     ++seen[static_cast<std::size_t>(id)];
   }
-  EXPECT_GT(std::count_if(seen.begin(), seen.end(), [](std::size_t s) { return s > 50; }), 3);
+  EXPECT_GT(std::count_if(seen.begin(), seen.end(), [](std::size_t s) { return s > 20; }), 3);
 }
 
 TEST(SyntheticScene, SameSeedSameBytesDifferentSeedDifferent) {
@@ -134,19 +134,19 @@ RenderOptions window(std::uint32_t w, std::uint32_t h) {
 }
 
 TEST(SyntheticScene, DepthIsQuantisedToTheDisparitySteps) {
-  const RenderOptions options = window(160, 120);
+  const RenderOptions options = window(96, 72);
   const DepthTable table = make_depth_table(options.depth);
   const std::set<float> levels(table.begin(), table.end());
   const Scene scene = make_scene(SceneConfig{}, SEED);
   std::set<float> at_centre;
   kernels::PointCloud cloud;
-  for (std::uint64_t s = 0; s < 12; ++s) {
+  for (std::uint64_t s = 0; s < 10; ++s) {
     Random rng(s);
     render_scene(scene, options, rng, cloud);
     for (float z : cloud.z()) {
       if (!std::isnan(z)) { ASSERT_EQ(levels.count(z), 1U) << z << " is not a Kinect depth level"; }
     }
-    const std::size_t centre = 60 * 160 + 80;
+    const std::size_t centre = 36 * 96 + 48;
     if (!std::isnan(cloud.z()[centre])) { at_centre.insert(cloud.z()[centre]); }
   }
   // The noise spreads one pixel's depth over a few levels, one step (> 1 mm at >= 0.7 m) apart.
@@ -206,16 +206,23 @@ TEST(SyntheticScene, PlacementKeepsObjectsApartOrTouchingAndOnTheTable) {
 
 TEST(SyntheticScene, TenObjectFrameRendersFastAndReusesTheCloud) {
   const Scene scene = make_scene(SceneConfig{10, false, {}, 5, true}, 3);
+#if defined(__SANITIZE_ADDRESS__)
+  const RenderOptions options = half_resolution();  // the timing means nothing under ASan: keep it short
+#else
+  const RenderOptions options;
+#endif
   kernels::PointCloud cloud;
   Random rng(1);
-  render_scene(scene, RenderOptions{}, rng, cloud);
+  render_scene(scene, options, rng, cloud);
   const float* before = cloud.x().data();
   const auto start = std::chrono::steady_clock::now();
-  render_scene(scene, RenderOptions{}, rng, cloud);
+  render_scene(scene, options, rng, cloud);
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   EXPECT_EQ(before, cloud.x().data());  // same buffers: the warm cloud is refilled in place
-  std::printf("[ info ] 640x480 frame with %zu objects rendered in %.1f ms\n", scene.objects.size(), ms);
-  EXPECT_LT(ms, 5000.0);  // generous for sanitizer builds; release is far below 1 s
+  EXPECT_EQ(scene.objects.size(), 10U);
+  std::printf("[ info ] %ux%u frame with %zu objects rendered in %.1f ms\n", cloud.width(), cloud.height(),
+              scene.objects.size(), ms);
+  EXPECT_LT(ms, 2000.0);  // release: tens of ms; the bound leaves room for loaded CI machines
 }
 
 }  // namespace
