@@ -83,8 +83,14 @@ TEST(PclCrossCheck, PclReadsWhatWeWrite) {
     const fs::path p = dir / (std::string(od::to_string(e)) + ".pcd");
     ASSERT_TRUE(od::write_pcd(cloud, p, e));
     pcl::PCLPointCloud2 pc;
-    ASSERT_EQ(pcl::io::loadPCDFile(p.string(), pc), 0) << p;
+    Eigen::Vector4f origin;
+    Eigen::Quaternionf orientation;
+    ASSERT_EQ(pcl::io::loadPCDFile(p.string(), pc, origin, orientation), 0) << p;
     expect_agrees(pc, cloud, p.string());
+    const ok::Viewpoint& vp = cloud.info.viewpoint;
+    EXPECT_EQ(origin.head<3>(), Eigen::Vector3f(vp.origin[0], vp.origin[1], vp.origin[2])) << p;
+    EXPECT_EQ(orientation.coeffs(), Eigen::Vector4f(vp.orientation[1], vp.orientation[2], vp.orientation[3],
+                                                    vp.orientation[0])) << p;  // Eigen stores x y z w
     pcl::PointCloud<pcl::PointXYZRGBA> typed;
     ASSERT_EQ(pcl::io::loadPCDFile(p.string(), typed), 0) << p;
     EXPECT_EQ(typed.points[5].rgba, cloud.rgb()[5]) << p;
@@ -96,6 +102,8 @@ TEST(PclCrossCheck, WeReadWhatPclWrites) {
   pcl::PointCloud<pcl::PointXYZRGBA> typed(16, 8);
   const ok::PointCloud ref = orthoflow::test::make_cloud(16, 8, true, 21);
   od::to_aos<pcl::PointXYZRGBA>(ref, std::span<pcl::PointXYZRGBA>(typed.points.data(), typed.points.size()));
+  typed.sensor_origin_ = Eigen::Vector4f(0.25F, -2.0F, 1.5F, 0.0F);
+  typed.sensor_orientation_ = Eigen::Quaternionf(0.5F, -0.5F, 0.5F, -0.5F);  // w x y z
   const fs::path dir = fs::temp_directory_path() / "orthoflow_pcl_xcheck_pcl";
   fs::create_directories(dir);
   pcl::PCDWriter writer;
@@ -111,6 +119,8 @@ TEST(PclCrossCheck, WeReadWhatPclWrites) {
       ASSERT_EQ(bits(ours->x()[i]), bits(ref.x()[i])) << p << " point " << i;
       ASSERT_EQ(ours->rgb()[i], ref.rgb()[i]) << p << " point " << i;
     }
+    const ok::Viewpoint expected{{0.25F, -2.0F, 1.5F}, {0.5F, -0.5F, 0.5F, -0.5F}};
+    EXPECT_EQ(ours->info.viewpoint, expected) << p;
   }
   auto ascii = od::read_pcd(a);
   ASSERT_TRUE(ascii) << ascii.error().to_string();

@@ -60,6 +60,7 @@ inline void expect_same_cloud(const kernels::PointCloud& a, const kernels::Point
                       (!a.has(kernels::Field::RGB) || a.rgb()[i] == b.rgb()[i]) &&
                       (!a.has(kernels::Field::LABEL) || a.label()[i] == b.label()[i]) &&
                       (!a.has(kernels::Field::NORMALS) || (bits(a.normal_x()[i]) == bits(b.normal_x()[i]) &&
+                                                           bits(a.normal_y()[i]) == bits(b.normal_y()[i]) &&
                                                            bits(a.normal_z()[i]) == bits(b.normal_z()[i])));
     mismatches += same ? 0U : 1U;
   }
