@@ -107,6 +107,13 @@ struct Engine::Impl {
 
   ~Impl() {
     arena.execute([this] { g->wait_for_all(); });
+    // Flow-graph nodes unregister from their graph when destroyed: tear them down before it.
+    dispatch.reset();
+    for (auto& rt : runtimes) {
+      rt->sequencer.reset();
+      rt->fn.reset();
+    }
+    g.reset();
   }
 
   void build_flow() {
