@@ -1,7 +1,9 @@
 // The object-view dataset generator (object_dataset.hpp).
 #include "drivers/object_dataset.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <utility>
 #include <cstdio>
 #include <system_error>
 
@@ -40,6 +42,31 @@ Result<void, DatasetError> validate(const DatasetConfig& c) {
   }
   if (what.empty()) { return {}; }
   return err(DatasetError{DatasetError::Code::BAD_CONFIG, "dataset config: " + what});
+}
+
+/// The pixels of @p in that can see the object of @p scene, as intrinsics of that window (same
+/// rays as the full image): the projection of the box [c - R, c + R] around its bounding sphere,
+/// whose extreme x/z and y/z lie at corners because x/z is monotonic in x and z for z > 0.
+DepthIntrinsics object_window(const Scene& scene, const DepthIntrinsics& in) {
+  const ObjectModel& m = scene.objects.front().model;
+  const Vec3 c = table_frame(scene.table).point(0.0, 0.0, m.height / 2);
+  const double r = std::hypot(m.footprint_radius, m.height / 2) + 0.01;
+  if (c[2] - r <= 0.05) { return in; }  // too close to bound cheaply: render everything
+  auto span = [&](double centre, double f, double principal, std::uint32_t size) {
+    double lo = 1e300, hi = -1e300;
+    for (double a : {centre - r, centre + r}) {
+      for (double z : {c[2] - r, c[2] + r}) {
+        lo = std::min(lo, f * a / z + principal);
+        hi = std::max(hi, f * a / z + principal);
+      }
+    }
+    const double first = std::clamp(std::floor(lo), 0.0, static_cast<double>(size));
+    const double last = std::clamp(std::ceil(hi) + 1.0, 0.0, static_cast<double>(size));
+    return std::pair<std::uint32_t, std::uint32_t>{static_cast<std::uint32_t>(first), static_cast<std::uint32_t>(last)};
+  };
+  const auto [u0, u1] = span(c[0], in.fx, in.cx, in.width);
+  const auto [v0, v1] = span(c[1], in.fy, in.cy, in.height);
+  return DepthIntrinsics{in.fx, in.fy, in.cx - u0, in.cy - v0, u1 - u0, v1 - v0};
 }
 
 std::size_t render_view(const DatasetConfig& config, const ObjectModel& model, std::uint32_t v,
@@ -92,7 +119,13 @@ std::size_t render_object_view(const ObjectModel& model, const ViewSpec& view, c
   Scene scene;
   scene.table = TableSpec{view.distance_m, view.elevation_rad, TABLE_SIZE_M, TABLE_SIZE_M, 0.0};
   scene.objects.push_back(PlacedObject{model, 0.0, 0.0, view.azimuth_rad});
-  render_scene(scene, options, rng, frame);
+  RenderOptions windowed = options;
+  windowed.intrinsics = object_window(scene, options.intrinsics);
+  if (windowed.intrinsics.width == 0 || windowed.intrinsics.height == 0) {
+    frame.resize(0);
+  } else {
+    render_scene(scene, windowed, rng, frame);
+  }
   std::size_t n = 0;
   for (std::uint32_t l : frame.label()) { n += l == OBJECT_LABEL_BASE; }
   out.remove_field(kernels::Field::LABEL);

@@ -61,7 +61,9 @@ struct DatasetSummary {
 };
 
 /// @brief Renders the segmented view of @p model from @p view into @p out (unorganized x, y, z, rgb),
-/// using @p frame as scratch for the full 640x480 frame. @return the number of points.
+/// using @p frame as scratch. Only the image window around the object's bounding sphere is ray cast
+/// (the same pixels and rays as the full image, so the points are those of a full frame; the noise
+/// draws differ). @return the number of points.
 /// @note Deterministic in @p rng's state; not thread-safe on shared arguments.
 std::size_t render_object_view(const ObjectModel& model, const ViewSpec& view, const RenderOptions& options,
                                Random& rng, kernels::PointCloud& frame, kernels::PointCloud& out);

@@ -93,6 +93,34 @@ TEST(ObjectDataset, SameSeedSameBytes) {
   EXPECT_NE(encode_pcd(a, PcdEncoding::BINARY), encode_pcd(b, PcdEncoding::BINARY));
 }
 
+TEST(ObjectDataset, WindowedViewHasExactlyTheObjectPointsOfTheFullFrame) {
+  RenderOptions exact;  // no noise: the full frame and the window must agree bit for bit
+  exact.depth.sigma_raw = 0.0;
+  for (Category cat : {Category::TEAPOT, Category::FORK, Category::VASE}) {
+    const ObjectModel model = make_object_model(cat, 2, 4);
+    for (const ViewSpec& view : {ViewSpec{0.4, 0.3, 0.6}, ViewSpec{1.2, 4.0, 1.4}}) {
+      kernels::PointCloud frame, windowed, full;
+      Random r1(1), r2(1);
+      const std::size_t n = render_object_view(model, view, exact, r1, frame, windowed);
+      Scene scene;
+      scene.table = TableSpec{view.distance_m, view.elevation_rad, 3.0, 3.0, 0.0};
+      scene.objects.push_back(PlacedObject{model, 0.0, 0.0, view.azimuth_rad});
+      render_scene(scene, exact, r2, full);
+      std::size_t k = 0;
+      for (std::size_t i = 0; i < full.size(); ++i) {
+        if (full.label()[i] != OBJECT_LABEL_BASE) { continue; }
+        ASSERT_LT(k, n);
+        ASSERT_EQ(full.x()[i], windowed.x()[k]);
+        ASSERT_EQ(full.z()[i], windowed.z()[k]);
+        ++k;
+      }
+      EXPECT_EQ(k, n) << category_name(cat);
+      EXPECT_GT(n, 50U);
+      EXPECT_LT(frame.size(), view.distance_m > 1.0 ? full.size() / 4 : full.size());  // a part of the image
+    }
+  }
+}
+
 TEST(ObjectDataset, InstancesVaryWithinACategory) {
   const ObjectModel a = make_object_model(Category::BOTTLE, 0, 1);
   const ObjectModel b = make_object_model(Category::BOTTLE, 1, 1);
