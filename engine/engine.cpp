@@ -221,7 +221,13 @@ struct Engine::Impl {
       forward_tombstone(rt, m);
     } else {
       Router router(this, &rt, &m);
+      // Concurrency gauge: shows per-object work really runs in parallel (telemetry, tests).
+      const std::uint32_t running = rt.stats->running.fetch_add(1, std::memory_order_relaxed) + 1;
+      std::uint32_t seen = rt.stats->max_running.load(std::memory_order_relaxed);
+      while (running > seen && !rt.stats->max_running.compare_exchange_weak(seen, running)) {
+      }
       rt.node->process(m, router);
+      rt.stats->running.fetch_sub(1, std::memory_order_relaxed);
       const std::int64_t end = now_ns();
       rt.stats->processed.fetch_add(1, std::memory_order_relaxed);
       rt.stats->service.record(end - start);

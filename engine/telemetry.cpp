@@ -63,6 +63,7 @@ std::string to_json(const GraphStats& stats) {
                            {"dropped", n.dropped.load()},
                            {"skipped", n.skipped.load()},
                            {"deadline_misses", n.deadline_misses.load()},
+                           {"max_concurrency", n.max_running.load()},
                            {"latency", histogram_json(n.service)}};
     if (n.sink) node["frame_age"] = histogram_json(n.age);
     nodes.push_back(std::move(node));

@@ -21,6 +21,8 @@ struct NodeStats {
   std::atomic<std::uint64_t> dropped{0};     ///< stale messages skipped by the latest-wins policy
   std::atomic<std::uint64_t> skipped{0};     ///< tombstones passed through without processing
   std::atomic<std::uint64_t> deadline_misses{0};  ///< process() took longer than the node deadline
+  std::atomic<std::uint32_t> running{0};          ///< process() calls in progress right now
+  std::atomic<std::uint32_t> max_running{0};      ///< most process() calls ever seen at once
 };
 
 /// @brief Whole-graph counters plus one NodeStats per node (stable addresses: a deque).

@@ -80,6 +80,28 @@ TEST(Engine, FanOutProcessesObjectsAndJoinsPerFrame) {
   EXPECT_EQ(engine.stats().nodes[2].skipped.load(), 50u);
 }
 
+TEST(Engine, ObjectsOfOneFrameRunInParallel) {
+  // Frames of 8 objects of 2 ms each on a 2-thread arena: the per-object node must be seen running
+  // twice at once. Needs the second thread to join, so retry a few times on a loaded machine.
+  std::uint32_t max_running = 0;
+  for (int attempt = 0; attempt < 8 && max_running < 2; ++attempt) {
+    auto graph = must_build(graph_text("  pool: {blocks: 2}\n",
+                                       "  - {name: src, kind: ticker, params: {frames: 4}}\n"
+                                       "  - {name: split, kind: fanout, params: {objects: 8}}\n"
+                                       "  - {name: work, kind: busy, params: {type: object, spin_us: 2000}}\n"
+                                       "  - {name: join, kind: join}\n  - {name: sink, kind: count}\n",
+                                       "  - src.out -> split.in\n  - split.out -> work.in\n"
+                                       "  - work.out -> join.in\n  - join.out -> sink.in\n"));
+    ASSERT_TRUE(graph);
+    Engine engine(*graph, {2});
+    engine.run({});
+    EXPECT_EQ(sink_of(engine).received.load(), 4u);
+    max_running = engine.stats().nodes[2].max_running.load();
+    EXPECT_EQ(engine.stats().nodes[4].max_running.load(), 1u);  // the stateful sink never overlaps
+  }
+  EXPECT_GE(max_running, 2u);
+}
+
 TEST(Engine, SequencerRestoresFrameOrderAfterParallelStages) {
   // Frames with many objects finish later than empty ones, so the join emits out of order.
   const std::string nodes = "  - {name: src, kind: ticker, params: {frames: 200}}\n"
