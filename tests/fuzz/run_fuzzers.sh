@@ -1,30 +1,46 @@
 #!/usr/bin/env bash
-# usage: run_fuzzers.sh SECONDS [FUZZ_BUILD_DIR]
-# Runs every libFuzzer binary of an already built fuzz tree (default: build/fuzz, the `fuzz` preset)
+# usage: run_fuzzers.sh SECONDS [FUZZ_BUILD_DIR | FUZZER_BINARY]...
+# Runs libFuzzer binaries that are already built (default: every fuzz_*_reader under build/fuzz, the
+# `fuzz` preset; a directory argument means every fuzzer under it, a file argument that one fuzzer)
 # for SECONDS each, on a fresh temporary corpus seeded with the committed seeds and the small PCD files
 # of the shared data. Builds nothing. Exits non-zero on any crash, leak, timeout, OOM or sanitizer report.
-# Set FUZZERS="pcd" (or "ply") to run only some; KEEP_CORPUS=DIR keeps the grown corpora in DIR/<kind>.
+# FUZZERS="pcd" (or "ply") restricts directory arguments to some kinds; KEEP_CORPUS=DIR keeps the grown
+# corpora in DIR/<kind>.
 set -euo pipefail
 if [ $# -lt 1 ]; then
-  echo "usage: $0 SECONDS [FUZZ_BUILD_DIR]" >&2
+  echo "usage: $0 SECONDS [FUZZ_BUILD_DIR | FUZZER_BINARY]..." >&2
   exit 2
 fi
 seconds=$1
+shift
 here=$(cd "$(dirname "$0")" && pwd)
-build=${2:-$here/../../build/fuzz}
-shared="${ORTHOFLOW_SHARED_DIR:-/work/shared}"
-status=0
-found=0
-for kind in ${FUZZERS:-pcd ply}; do
-  fuzzer=$(find "$build" -type f -perm -u+x -name "fuzz_${kind}_reader" | head -1)
-  if [ -z "$fuzzer" ]; then
-    echo "fuzz: fuzz_${kind}_reader not found under $build (build the fuzz preset first)" >&2
-    status=1
-    continue
+[ $# -gt 0 ] || set -- "$here/../../build/fuzz"
+shared="${ORTHOFLOW_SHARED_DIR:-$here/../../../shared}"  # the shared data beside the checkout
+fuzzers=()
+for arg in "$@"; do
+  if [ -d "$arg" ]; then
+    for kind in ${FUZZERS:-pcd ply}; do
+      found=$(find "$arg" -type f -perm -u+x -name "fuzz_${kind}_reader" | head -1)
+      if [ -z "$found" ]; then
+        echo "fuzz: fuzz_${kind}_reader not found under $arg (build the fuzz preset first)" >&2
+        exit 1
+      fi
+      fuzzers+=("$found")
+    done
+  elif [ -x "$arg" ]; then
+    fuzzers+=("$arg")
+  else
+    echo "fuzz: $arg is neither a build directory nor a fuzzer binary" >&2
+    exit 1
   fi
-  found=$((found + 1))
+done
+status=0
+for fuzzer in "${fuzzers[@]}"; do
+  kind=$(basename "$fuzzer")
+  kind=${kind#fuzz_}
+  kind=${kind%_reader}
   corpus=$(mktemp -d)
-  cp "$here/corpus/$kind/"* "$corpus/"
+  cp "$here/corpus/$kind/"* "$corpus/" 2>/dev/null || true  # a new kind may have no seeds yet
   if [ "$kind" = pcd ] && [ -d "$shared" ]; then
     # Small shared files only: big organized frames make each execution slow.
     find "$shared" -name '*.pcd' -size -40k -exec cp {} "$corpus/" \; 2>/dev/null || true
@@ -47,5 +63,4 @@ for kind in ${FUZZERS:-pcd ply}; do
   fi
   rm -rf "$corpus"
 done
-[ "$found" -gt 0 ] || status=1
 exit $status
