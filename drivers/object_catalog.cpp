@@ -44,7 +44,7 @@ void cutlery(Builder& b, Random& r, Category c) {
   } else if (c == Category::KNIFE) {
     b.box({head_x, 0, t / 3}, {0.05, 0.012, t / 3});
   } else {
-    b.ellipsoid({head_x + 0.01, 0, t / 2}, {0.03, r.uniform(0.016, 0.022), t / 2 + 0.002});
+    b.ellipsoid({head_x + 0.01, 0, t / 2}, {0.03, r.uniform(0.016, 0.022), t / 2 + 0.002}, 0.0);  // cut at the table
   }
 }
 
