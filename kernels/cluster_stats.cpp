@@ -1,0 +1,86 @@
+#include "kernels/cluster_stats.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <limits>
+
+#include "memory_pool/assert.hpp"
+
+namespace orthoflow::kernels {
+
+namespace {
+
+/// Centroid, covariance and PCA axes from the accumulated moments (population covariance).
+void finish_moments(const ClusterMoments& m, ClusterStats& s) {
+  const double n = static_cast<double>(s.points);
+  const Eigen::Vector3d mean_rel = Eigen::Vector3d(m.sum[0], m.sum[1], m.sum[2]) / n;
+  Eigen::Matrix3d outer;
+  outer << m.outer[0], m.outer[1], m.outer[2], m.outer[1], m.outer[3], m.outer[4], m.outer[2], m.outer[4], m.outer[5];
+  const Eigen::Matrix3d cov = outer / n - mean_rel * mean_rel.transpose();
+  for (std::size_t a = 0; a < 3; ++a) {
+    s.centroid[a] = static_cast<float>(mean_rel[static_cast<Eigen::Index>(a)] + m.ref[a]);
+  }
+  s.covariance = {static_cast<float>(cov(0, 0)), static_cast<float>(cov(0, 1)), static_cast<float>(cov(0, 2)),
+                  static_cast<float>(cov(1, 1)), static_cast<float>(cov(1, 2)), static_cast<float>(cov(2, 2))};
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+  solver.computeDirect(cov);  // ascending eigenvalues
+  Eigen::Matrix3d axes;
+  axes.row(0) = solver.eigenvectors().col(2).transpose();
+  axes.row(1) = solver.eigenvectors().col(1).transpose();
+  axes.row(2) = axes.row(0).cross(axes.row(1));
+  for (Eigen::Index r = 0; r < 3; ++r) {
+    for (Eigen::Index c = 0; c < 3; ++c) { s.obb_axes[static_cast<std::size_t>(3 * r + c)] = static_cast<float>(axes(r, c)); }
+  }
+}
+
+}  // namespace
+
+std::size_t cluster_stats(PointsView points, std::span<const std::int32_t> labels, std::span<ClusterMoments> moments,
+                          std::span<ClusterStats> out) noexcept {
+  OF_ASSERT(moments.size() >= out.size() && labels.size() >= points.size(), "cluster_stats: spans too small");
+  const float inf = std::numeric_limits<float>::infinity();
+  for (std::size_t c = 0; c < out.size(); ++c) {
+    out[c] = ClusterStats{};
+    out[c].bbox_min = out[c].obb_min = {inf, inf, inf};
+    out[c].bbox_max = out[c].obb_max = {-inf, -inf, -inf};
+    moments[c] = ClusterMoments{};
+  }
+  // Pass 1: counts, boxes, reference points. Pass 2: moments around the reference.
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (labels[i] < 0) { continue; }
+    const auto c = static_cast<std::size_t>(labels[i]);
+    ClusterStats& s = out[c];
+    const std::array<float, 3> p{points.x[i], points.y[i], points.z[i]};
+    if (s.points++ == 0) { moments[c].ref = {p[0], p[1], p[2]}; }
+    for (std::size_t a = 0; a < 3; ++a) {
+      s.bbox_min[a] = std::min(s.bbox_min[a], p[a]);
+      s.bbox_max[a] = std::max(s.bbox_max[a], p[a]);
+    }
+    ClusterMoments& m = moments[c];
+    const double q[3] = {p[0] - m.ref[0], p[1] - m.ref[1], p[2] - m.ref[2]};
+    for (std::size_t a = 0; a < 3; ++a) { m.sum[a] += q[a]; }
+    m.outer[0] += q[0] * q[0];
+    m.outer[1] += q[0] * q[1];
+    m.outer[2] += q[0] * q[2];
+    m.outer[3] += q[1] * q[1];
+    m.outer[4] += q[1] * q[2];
+    m.outer[5] += q[2] * q[2];
+  }
+  for (std::size_t c = 0; c < out.size(); ++c) {
+    if (out[c].points == 0) { out[c] = ClusterStats{}; } else { finish_moments(moments[c], out[c]); }
+  }
+  // Pass 3: extents in the PCA frame around the centroid.
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (labels[i] < 0) { continue; }
+    ClusterStats& s = out[static_cast<std::size_t>(labels[i])];
+    const float q[3] = {points.x[i] - s.centroid[0], points.y[i] - s.centroid[1], points.z[i] - s.centroid[2]};
+    for (std::size_t r = 0; r < 3; ++r) {
+      const float t = s.obb_axes[3 * r] * q[0] + s.obb_axes[3 * r + 1] * q[1] + s.obb_axes[3 * r + 2] * q[2];
+      s.obb_min[r] = std::min(s.obb_min[r], t);
+      s.obb_max[r] = std::max(s.obb_max[r], t);
+    }
+  }
+  return out.size();
+}
+
+}  // namespace orthoflow::kernels

@@ -1,0 +1,39 @@
+#pragma once
+/// @file
+/// @brief Polygonal prism (specs/PIPELINE.md section 4): points above the support polygon.
+#include <cstddef>
+#include <cstdint>
+#include <span>
+
+#include "kernels/convex_hull.hpp"
+#include "kernels/plane_distance.hpp"
+#include "kernels/point_cloud.hpp"
+
+namespace orthoflow::kernels {
+
+/// @brief The prism: plane, its basis, the hull vertices (u, v) counter-clockwise, height range.
+struct Prism {
+  Plane plane;
+  PlaneBasis basis;
+  std::span<const double> hull_u;  ///< counter-clockwise convex polygon (convex_hull_2d order)
+  std::span<const double> hull_v;
+  float h_min = 0.005F;  ///< signed height range, metres, along the plane normal (positive toward the sensor)
+  float h_max = 0.5F;
+};
+
+/// @brief mask[i] = 1 when point i has signed height normal . p + d in [h_min, h_max] and its
+/// projection lies inside (or on) the hull polygon; 0 otherwise (NaN points, hulls of < 3 vertices).
+/// @p heights receives the signed heights (SIMD plane_signed_distance).
+/// @pre mask.size() and heights.size() >= points.size(). @return the number of points kept.
+/// @note Allocation-free, thread-safe. Tolerance against the twin: the plane_distance.hpp one for
+/// points whose height is within 1e-6 x (|p| + |d|) of h_min or h_max.
+std::size_t polygonal_prism(PointsView points, const Prism& prism, std::span<float> heights,
+                            std::span<std::uint8_t> mask) noexcept;
+/// @brief Scalar reference twin of polygonal_prism().
+std::size_t polygonal_prism_scalar(PointsView points, const Prism& prism, std::span<float> heights,
+                                   std::span<std::uint8_t> mask) noexcept;
+
+/// @brief Whether (u, v) lies inside or on the convex counter-clockwise polygon (O(log n) fan search).
+bool inside_convex_polygon(std::span<const double> hu, std::span<const double> hv, double u, double v) noexcept;
+
+}  // namespace orthoflow::kernels
