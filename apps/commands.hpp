@@ -15,6 +15,8 @@ inline constexpr int EXIT_USAGE = 106;          ///< CLI11's own code for bad ar
 
 /// @brief `graph check|dot|run FILE`: validate, draw (Graphviz) and run dataflow graph files.
 void add_graph_command(CLI::App& app);
+/// @brief `describe FILE.pcd`: GOOD descriptor, object frame, bbox, projection order; --json, --png.
+void add_describe_command(CLI::App& app);
 /// @brief `synth` and `synth-dataset`: synthetic Kinect tabletop frames and the object-view dataset.
 void add_synth_command(CLI::App& app);
 /// @brief `info FILE [--json]`: fields, point count, layout, finite points, bounding box of a .pcd/.ply file.

@@ -7,6 +7,7 @@ int main(int argc, char** argv) {
   CLI::App app{"orthoflow: real-time open-ended 3D object perception"};
   app.require_subcommand(1);
   orthoflow::apps::add_graph_command(app);
+  orthoflow::apps::add_describe_command(app);
   orthoflow::apps::add_synth_command(app);
   orthoflow::apps::add_info_command(app);
   app.set_version_flag("--version", ORTHOFLOW_VERSION);
