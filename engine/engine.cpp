@@ -8,6 +8,8 @@
 #include <oneapi/tbb/task_arena.h>
 
 #include <chrono>
+#include <condition_variable>
+#include <mutex>
 #include <thread>
 #include <vector>
 
@@ -77,7 +79,13 @@ struct Engine::Impl {
   std::uint64_t max_frames = 0;
   std::uint64_t next_frame = 0;
   bool source_ended = false;  // touched only by the serial admission node
-  std::int64_t next_tick_ns = 0;
+  std::atomic<std::int64_t> next_tick_ns{0};
+  // Pacing without blocking an arena thread (with threads = 1 a sleeping task would stall the
+  // whole graph): early tokens are parked here and a plain std::thread hands them back on time.
+  std::mutex park_mutex;
+  std::condition_variable park_cv;
+  std::vector<std::uint32_t> parked;  // capacity max_in_flight, reserved at start-up
+  bool pacer_exit = false;
   StopReason reason = StopReason::SOURCE_END;
   bool ran = false;
 
@@ -155,21 +163,20 @@ struct Engine::Impl {
     if (max_frames > 0 && next_frame >= max_frames && reason == StopReason::SOURCE_END) {
       reason = StopReason::FRAME_LIMIT;
     }
-    while (reason == StopReason::SOURCE_END && graph.spec.period_ns > 0 && now_ns() < next_tick_ns &&
-           !should_stop()) {
-      // Short slices so that a stop request is seen within ~2 ms.
-      std::this_thread::sleep_for(
-          std::chrono::microseconds(std::min<std::int64_t>(2000, (next_tick_ns - now_ns()) / 1000 + 1)));
-    }
     if (reason == StopReason::SOURCE_END && should_stop()) reason = StopReason::STOP_REQUESTED;
     if (reason != StopReason::SOURCE_END || source_ended) return;  // token retired
+    if (graph.spec.period_ns > 0 && now_ns() < next_tick_ns.load(std::memory_order_relaxed)) {
+      park(token);  // too early: the pacer thread gives it back at the next tick
+      return;
+    }
     Message m;
     const std::int64_t start = now_ns();
     if (graph.nodes[graph.source]->produce(m) == SourceStatus::END) {
       source_ended = true;
       return;
     }
-    next_tick_ns = std::max(next_tick_ns + graph.spec.period_ns, now_ns());
+    next_tick_ns.store(std::max(next_tick_ns.load(std::memory_order_relaxed) + graph.spec.period_ns, now_ns()),
+                       std::memory_order_relaxed);
     NodeStats& source_stats = *runtimes[graph.source]->stats;
     source_stats.processed.fetch_add(1, std::memory_order_relaxed);
     source_stats.service.record(now_ns() - start);
@@ -185,6 +192,35 @@ struct Engine::Impl {
     for (std::size_t port = 0; port < source.out.size(); ++port) send(source, port, m);
     m.payload.reset();
     done(m.slot);
+  }
+
+  void park(std::uint32_t token) noexcept {
+    g->reserve_wait();  // keeps wait_for_all() from returning while the token is parked
+    {
+      const std::lock_guard<std::mutex> lock(park_mutex);
+      parked.push_back(token);  // never reallocates: at most max_in_flight tokens exist
+    }
+    park_cv.notify_one();
+  }
+
+  void pace() {
+    std::unique_lock<std::mutex> lock(park_mutex);
+    while (true) {
+      park_cv.wait(lock, [this] { return pacer_exit || !parked.empty(); });
+      if (parked.empty()) return;
+      Message token;
+      token.slot = parked.back();
+      parked.pop_back();
+      lock.unlock();
+      // Sleep in short slices so a stop request is seen within ~2 ms.
+      while (now_ns() < next_tick_ns.load(std::memory_order_relaxed) && !should_stop()) {
+        const std::int64_t left_us = (next_tick_ns.load(std::memory_order_relaxed) - now_ns()) / 1000 + 1;
+        std::this_thread::sleep_for(std::chrono::microseconds(std::min<std::int64_t>(2000, left_us)));
+      }
+      dispatch->try_put(token);
+      g->release_wait();
+      lock.lock();
+    }
   }
 
   void send(NodeRuntime& from, std::size_t port, const Message& message) noexcept {
@@ -265,7 +301,10 @@ StopReason Engine::run(const RunOptions& options) {
   impl_->external_stop = options.stop;
   impl_->max_frames = options.max_frames;
   const std::int64_t start = now_ns();
-  impl_->next_tick_ns = start;
+  impl_->next_tick_ns.store(start);
+  impl_->parked.reserve(impl_->slot_count);
+  std::thread pacer;
+  if (impl_->graph.spec.period_ns > 0) pacer = std::thread([this] { impl_->pace(); });
   impl_->arena.execute([this] {
     for (std::size_t i = 0; i < impl_->slot_count; ++i) {
       Message token;
@@ -274,6 +313,14 @@ StopReason Engine::run(const RunOptions& options) {
     }
     impl_->g->wait_for_all();
   });
+  if (pacer.joinable()) {
+    {
+      const std::lock_guard<std::mutex> lock(impl_->park_mutex);
+      impl_->pacer_exit = true;
+    }
+    impl_->park_cv.notify_one();
+    pacer.join();
+  }
   impl_->stats.elapsed_ns.store(now_ns() - start);
   return impl_->reason;
 }

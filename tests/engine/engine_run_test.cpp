@@ -2,7 +2,9 @@
 // deadlines, pool exhaustion at the source, and shutdown by request and by signal.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <csignal>
 #include <thread>
 
@@ -82,8 +84,11 @@ TEST(Engine, FanOutProcessesObjectsAndJoinsPerFrame) {
 
 TEST(Engine, ObjectsOfOneFrameRunInParallel) {
   // Frames of 8 objects of 2 ms each on a 2-thread arena: the per-object node must be seen running
-  // twice at once. Needs the second thread to join, so retry a few times on a loaded machine.
+  // twice at once. That needs the host to actually give us two CPUs; on an oversubscribed CI box it
+  // may not, so each attempt also measures process CPU time / wall time and the test is skipped
+  // (not passed) only if no attempt ever got 1.5 CPUs' worth.
   std::uint32_t max_running = 0;
+  double best_cpus = 0.0;
   for (int attempt = 0; attempt < 8 && max_running < 2; ++attempt) {
     auto graph = must_build(graph_text("  pool: {blocks: 2}\n",
                                        "  - {name: src, kind: ticker, params: {frames: 4}}\n"
@@ -94,10 +99,18 @@ TEST(Engine, ObjectsOfOneFrameRunInParallel) {
                                        "  - work.out -> join.in\n  - join.out -> sink.in\n"));
     ASSERT_TRUE(graph);
     Engine engine(*graph, {2});
+    const std::clock_t cpu_start = std::clock();
+    const auto wall_start = std::chrono::steady_clock::now();
     engine.run({});
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+    const double cpu = static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC;
+    best_cpus = std::max(best_cpus, cpu / wall);
     EXPECT_EQ(sink_of(engine).received.load(), 4u);
     max_running = engine.stats().nodes[2].max_running.load();
     EXPECT_EQ(engine.stats().nodes[4].max_running.load(), 1u);  // the stateful sink never overlaps
+  }
+  if (max_running < 2 && best_cpus < 1.5) {
+    GTEST_SKIP() << "host never gave this process 1.5 CPUs (best " << best_cpus << "): cannot observe parallelism";
   }
   EXPECT_GE(max_running, 2u);
 }
