@@ -90,11 +90,12 @@ std::optional<GoodError> validate(PointsView points, const GoodConfig& cfg, cons
   return std::nullopt;
 }
 
-template <class StatsFn, class BinFn>
+template <class FrameFn, class StatsFn, class BinFn>
 Result<GoodResult, GoodError> run_good(PointsView points, const GoodConfig& cfg, GoodScratch& scratch,
-                                       std::span<float> out, StatsFn&& stats_fn, BinFn&& bin_fn) noexcept {
+                                       std::span<float> out, FrameFn&& frame_fn, StatsFn&& stats_fn,
+                                       BinFn&& bin_fn) noexcept {
   if (const auto bad = validate(points, cfg, scratch, out)) { return err(*bad); }
-  const auto frame_result = compute_pca_frame(points);
+  const auto frame_result = frame_fn(points);
   if (!frame_result) { return err(GoodError::NO_FINITE_POINTS); }
   const PcaFrame& f = frame_result.value();
   GoodResult r;
@@ -117,9 +118,10 @@ Result<GoodResult, GoodError> run_good(PointsView points, const GoodConfig& cfg,
   p.half = static_cast<float>(side / 2.0);
   p.width = static_cast<float>(side / static_cast<double>(cfg.bins));
   const std::size_t len = 3 * cfg.bins * cfg.bins;
-  const std::span<std::uint32_t> counts = scratch.buffer().subspan(0, len);
+  const std::span<std::uint32_t> counts = scratch.buffer().subspan(0, len + 3);  // + 3 drop slots
   std::fill(counts.begin(), counts.end(), 0U);
-  bin_fn(points, p, counts, r.kept);
+  bin_fn(points, p, counts);
+  for (std::size_t v = 0; v < 3; ++v) { r.kept[v] = points.size() - counts[len + v]; }
   const detail::GoodOrderOut o = detail::good_normalise_and_order(counts, r.kept, cfg.bins, out.subspan(0, len));
   r.length = len;
   r.frame = frame_matrix(p.t);
@@ -164,16 +166,17 @@ Result<GoodResult, GoodError> compute_good_scalar(PointsView points, const GoodC
     detail::good_stats_scalar(pts, t, thr, 0, pts.size(), s);
     return s;
   };
-  const auto bins = [](PointsView pts, const detail::GoodBinParams& p, std::span<std::uint32_t> c,
-                       std::array<std::size_t, 3>& kept) { detail::good_bin_range_scalar(pts, p, 0, pts.size(), c, kept); };
-  return run_good(points, cfg, scratch, descriptor_out, stats, bins);
+  const auto bins = [](PointsView pts, const detail::GoodBinParams& p, std::span<std::uint32_t> c) {
+    detail::good_bin_range_scalar(pts, p, 0, pts.size(), c);
+  };
+  return run_good(points, cfg, scratch, descriptor_out, compute_pca_frame_scalar, stats, bins);
 }
 
 Result<GoodResult, GoodError> compute_good(PointsView points, const GoodConfig& cfg, GoodScratch& scratch,
                                            std::span<float> descriptor_out) noexcept {
   static auto stats = xsimd::dispatch<SimdArchs>(detail::GoodStatsKernel{});
   static auto bins = xsimd::dispatch<SimdArchs>(detail::GoodBinKernel{});
-  return run_good(points, cfg, scratch, descriptor_out, stats, bins);
+  return run_good(points, cfg, scratch, descriptor_out, compute_pca_frame, stats, bins);
 }
 
 }  // namespace orthoflow::kernels

@@ -84,13 +84,13 @@ enum class GoodError : std::uint8_t {
 class GoodScratch {
  public:
   /// @brief Room for up to @p max_bins bins per side.
-  explicit GoodScratch(std::size_t max_bins = 15) : max_bins_(max_bins), counts_(3 * max_bins * max_bins) {}
+  explicit GoodScratch(std::size_t max_bins = 15) : max_bins_(max_bins), counts_(3 * max_bins * max_bins + 3) {}
   [[nodiscard]] std::size_t max_bins() const noexcept { return max_bins_; }
   /// @brief Raw counts of @p view (row-major n x n) from the last compute_good() call with n bins.
   [[nodiscard]] std::span<const std::uint32_t> counts(GoodView view, std::size_t bins) const noexcept {
     return std::span<const std::uint32_t>(counts_).subspan(static_cast<std::size_t>(view) * bins * bins, bins * bins);
   }
-  /// @brief The whole buffer (3 n^2 counts, canonical order); for compute_good() only.
+  /// @brief The whole buffer (3 n^2 counts in canonical order, then 3 drop counters); for compute_good() only.
   [[nodiscard]] std::span<std::uint32_t> buffer() noexcept { return counts_; }
 
  private:

@@ -1,5 +1,7 @@
 #include "kernels/pca_frame.hpp"
 
+#include "kernels/detail/pca_moments_kernel.hpp"
+
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
@@ -7,44 +9,6 @@
 namespace orthoflow::kernels {
 
 namespace {
-
-struct Moments {
-  std::array<double, 3> origin{};  // the first finite point: the sums below are about it
-  std::array<double, 3> sum{};
-  std::array<double, 6> sq{};  // xx xy xz yy yz zz
-  std::size_t count = 0;
-};
-
-// One pass in double about the first finite point: with the shift, sum(d d^T)/m - mean(d) mean(d)^T has
-// no catastrophic cancellation for objects metres away from the origin (mug_handle_far is 11 m away).
-Moments accumulate(PointsView points) noexcept {
-  Moments m;
-  bool have_origin = false;
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    const double x = points.x[i];
-    const double y = points.y[i];
-    const double z = points.z[i];
-    if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) { continue; }
-    if (!have_origin) {
-      m.origin = {x, y, z};
-      have_origin = true;
-    }
-    const double dx = x - m.origin[0];
-    const double dy = y - m.origin[1];
-    const double dz = z - m.origin[2];
-    m.sum[0] += dx;
-    m.sum[1] += dy;
-    m.sum[2] += dz;
-    m.sq[0] += dx * dx;
-    m.sq[1] += dx * dy;
-    m.sq[2] += dx * dz;
-    m.sq[3] += dy * dy;
-    m.sq[4] += dy * dz;
-    m.sq[5] += dz * dz;
-    ++m.count;
-  }
-  return m;
-}
 
 std::uint32_t shape_flags(const PcaFrame& f) noexcept {
   std::uint32_t flags = 0;
@@ -70,9 +34,38 @@ const char* to_string(PcaError error) noexcept {
   return "unknown PcaError";
 }
 
+PcaMoments pca_moments_scalar(PointsView points) noexcept {
+  PcaMoments m;
+  const std::size_t first = detail::first_finite(points);
+  if (first == points.size()) { return m; }
+  // Sums about the first finite point: sum(d d^T)/m - mean(d) mean(d)^T then has no catastrophic
+  // cancellation for objects metres away from the origin (mug_handle_far is 11 m away).
+  m.origin = {points.x[first], points.y[first], points.z[first]};
+  detail::add_moments_scalar(points, first, points.size(), m);
+  return m;
+}
+
+PcaMoments pca_moments(PointsView points) noexcept {
+  static auto dispatched = xsimd::dispatch<SimdArchs>(detail::PcaMomentsKernel{});
+  PcaMoments m;
+  const std::size_t first = detail::first_finite(points);
+  if (first == points.size()) { return m; }
+  m.origin = {points.x[first], points.y[first], points.z[first]};
+  return dispatched(points, m);
+}
+
 Result<PcaFrame, PcaError> compute_pca_frame(PointsView points) noexcept {
   if (points.empty()) { return err(PcaError::EMPTY_CLOUD); }
-  const Moments m = accumulate(points);
+  return pca_frame_from_moments(pca_moments(points), points.size());
+}
+
+Result<PcaFrame, PcaError> compute_pca_frame_scalar(PointsView points) noexcept {
+  if (points.empty()) { return err(PcaError::EMPTY_CLOUD); }
+  return pca_frame_from_moments(pca_moments_scalar(points), points.size());
+}
+
+Result<PcaFrame, PcaError> pca_frame_from_moments(const PcaMoments& m, std::size_t total_points) noexcept {
+  if (total_points == 0) { return err(PcaError::EMPTY_CLOUD); }
   if (m.count == 0) { return err(PcaError::NO_FINITE_POINTS); }
   const double inv = 1.0 / static_cast<double>(m.count);
   const Eigen::Vector3d mean(m.sum[0] * inv, m.sum[1] * inv, m.sum[2] * inv);
@@ -96,7 +89,7 @@ Result<PcaFrame, PcaError> compute_pca_frame(PointsView points) noexcept {
     f.axes[2][a] = v3[a];
   }
   f.flags = shape_flags(f);
-  if (m.count != points.size()) { f.flags |= NAN_IGNORED; }
+  if (m.count != total_points) { f.flags |= NAN_IGNORED; }
   return f;
 }
 

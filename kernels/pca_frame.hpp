@@ -42,6 +42,21 @@ struct PcaFrame {
   std::uint32_t flags = 0;  ///< FrameFlag bits
 };
 
+/// @brief Sums over the finite points about @p origin (the first finite point): the covariance input.
+struct PcaMoments {
+  std::array<double, 3> origin{};
+  std::array<double, 3> sum{};  ///< sum of d = p - origin
+  std::array<double, 6> sq{};   ///< sum of d d^T: xx xy xz yy yz zz
+  std::size_t count = 0;        ///< finite points
+};
+
+/// @brief Moments in double (SIMD over double lanes, dispatched at run time).
+/// @pre x, y and z have equal lengths. @note No allocation; thread-safe; deterministic on one machine.
+/// Tolerance against pca_moments_scalar(): summation order differs by lane, so sums agree to ~1e-15 relative.
+[[nodiscard]] PcaMoments pca_moments(PointsView points) noexcept;
+/// @brief Scalar reference twin of pca_moments(), in point order.
+[[nodiscard]] PcaMoments pca_moments_scalar(PointsView points) noexcept;
+
 /// @brief Why no frame could be computed.
 enum class PcaError : std::uint8_t {
   EMPTY_CLOUD,       ///< the cloud has no points
@@ -56,5 +71,9 @@ enum class PcaError : std::uint8_t {
 /// @pre x, y and z have equal lengths.
 /// @note No allocation; thread-safe; deterministic (same input, same output, bit for bit).
 [[nodiscard]] Result<PcaFrame, PcaError> compute_pca_frame(PointsView points) noexcept;
+/// @brief compute_pca_frame() with pca_moments_scalar().
+[[nodiscard]] Result<PcaFrame, PcaError> compute_pca_frame_scalar(PointsView points) noexcept;
+/// @brief The frame from moments of a cloud of @p total_points points (finite or not).
+[[nodiscard]] Result<PcaFrame, PcaError> pca_frame_from_moments(const PcaMoments& m, std::size_t total_points) noexcept;
 
 }  // namespace orthoflow::kernels

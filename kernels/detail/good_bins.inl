@@ -86,24 +86,41 @@ GoodStats GoodStatsKernel::operator()(Arch /*arch*/, PointsView points, const Go
 
 template <class Arch>
 void GoodBinKernel::operator()(Arch /*arch*/, PointsView points, const GoodBinParams& p,
-                               std::span<std::uint32_t> counts, std::array<std::size_t, 3>& kept) const noexcept {
+                               std::span<std::uint32_t> counts) const noexcept {
   using batch = xsimd::batch<float, Arch>;
   constexpr std::size_t LANES = batch::size;
   const std::size_t n = points.size();
-  const batch half(p.half), width(p.width), lo(-1.0F), hi(static_cast<float>(p.bins)), none(-1.0F);
-  alignas(64) std::int32_t k[3][LANES];
+  const float nf = static_cast<float>(p.bins);
+  const float nn = nf * nf;  // slots stay below 3 * 256^2 + 3 < 2^24: exact in float
+  const batch half(p.half), width(p.width), lo(-1.0F), hi(nf), nb(nf);
+  // Row and column axis of each canonical view, and its offset (good_slot()).
+  constexpr std::size_t ROW[3] = {1, 0, 0};
+  constexpr std::size_t COL[3] = {2, 2, 1};
+  alignas(64) std::int32_t slot[3][LANES];
   std::size_t i = 0;
   for (; i + LANES <= n; i += LANES) {
     const auto q = good_simd::transform<batch>(p.t, points.x.data() + i, points.y.data() + i, points.z.data() + i);
     const batch qs[3] = {q.x, q.y, q.z};
+    batch k[3];
+    xsimd::batch_bool<float, Arch> ok[3];
     for (std::size_t a = 0; a < 3; ++a) {
       const batch f = (qs[a] + half) / width;  // the division of good_bin_scalar(), exact IEEE in both
-      const batch kf = xsimd::select((f > lo) && (f < hi), xsimd::trunc(f), none);
-      xsimd::to_int(kf).store_unaligned(k[a]);
+      ok[a] = (f > lo) && (f < hi);
+      k[a] = xsimd::trunc(f);  // (-1, 0) -> -0 -> bin 0, as the reference
     }
-    for (std::size_t l = 0; l < LANES; ++l) { good_add_bins(k[0][l], k[1][l], k[2][l], p.bins, counts, kept); }
+    for (std::size_t v = 0; v < 3; ++v) {
+      const float base = static_cast<float>(v) * nn;
+      const batch cell = batch(base) + k[ROW[v]] * nb + k[COL[v]];
+      const batch s = xsimd::select(ok[ROW[v]] && ok[COL[v]], cell, batch(3.0F * nn + static_cast<float>(v)));
+      xsimd::to_int(s).store_unaligned(slot[v]);
+    }
+    for (std::size_t l = 0; l < LANES; ++l) {
+      ++counts[static_cast<std::size_t>(slot[0][l])];
+      ++counts[static_cast<std::size_t>(slot[1][l])];
+      ++counts[static_cast<std::size_t>(slot[2][l])];
+    }
   }
-  good_bin_range_scalar(points, p, i, n, counts, kept);
+  good_bin_range_scalar(points, p, i, n, counts);
 }
 
 }  // namespace orthoflow::kernels::detail
@@ -113,5 +130,5 @@ template orthoflow::kernels::detail::GoodStats orthoflow::kernels::detail::GoodS
     OF_SIMD_ARCH, orthoflow::kernels::PointsView, const orthoflow::kernels::detail::GoodTransform&, float) const noexcept;
 template void orthoflow::kernels::detail::GoodBinKernel::operator()<OF_SIMD_ARCH>(
     OF_SIMD_ARCH, orthoflow::kernels::PointsView, const orthoflow::kernels::detail::GoodBinParams&,
-    std::span<std::uint32_t>, std::array<std::size_t, 3>&) const noexcept;
+    std::span<std::uint32_t>) const noexcept;
 #endif

@@ -41,10 +41,10 @@ struct GoodStatsKernel {
 };
 
 struct GoodBinKernel {
-  /// Adds to counts (3 n^2, canonical view order, zeroed by the caller) and kept; returns nothing.
+  /// Adds to counts (3 n^2 + 3: the views in canonical order, then one slot per view counting the
+  /// points it dropped), zeroed by the caller.
   template <class Arch>
-  void operator()(Arch arch, PointsView points, const GoodBinParams& p, std::span<std::uint32_t> counts,
-                  std::array<std::size_t, 3>& kept) const noexcept;
+  void operator()(Arch arch, PointsView points, const GoodBinParams& p, std::span<std::uint32_t> counts) const noexcept;
 };
 
 inline std::array<float, 3> good_transform_point(const GoodTransform& t, float x, float y, float z) noexcept {
@@ -84,30 +84,25 @@ inline int good_bin_scalar(float a, const GoodBinParams& p) noexcept {
   return static_cast<int>(f);
 }
 
+/// Slot of one view's cell (row, col), or the view's drop slot 3 n^2 + view when either is -1.
+inline std::size_t good_slot(int row, int col, std::size_t view, std::size_t n) noexcept {
+  if (row < 0 || col < 0) { return 3 * n * n + view; }
+  return view * n * n + static_cast<std::size_t>(row) * n + static_cast<std::size_t>(col);
+}
+
 /// Adds one point's three bins (canonical views: YoZ = (y, z), XoZ = (x, z), XoY = (x, y)).
-inline void good_add_bins(int kx, int ky, int kz, std::size_t n, std::span<std::uint32_t> counts,
-                          std::array<std::size_t, 3>& kept) noexcept {
-  const std::size_t nn = n * n;
-  if (ky >= 0 && kz >= 0) {
-    ++counts[static_cast<std::size_t>(ky) * n + static_cast<std::size_t>(kz)];
-    ++kept[0];
-  }
-  if (kx >= 0 && kz >= 0) {
-    ++counts[nn + static_cast<std::size_t>(kx) * n + static_cast<std::size_t>(kz)];
-    ++kept[1];
-  }
-  if (kx >= 0 && ky >= 0) {
-    ++counts[2 * nn + static_cast<std::size_t>(kx) * n + static_cast<std::size_t>(ky)];
-    ++kept[2];
-  }
+inline void good_add_bins(int kx, int ky, int kz, std::size_t n, std::span<std::uint32_t> counts) noexcept {
+  ++counts[good_slot(ky, kz, 0, n)];
+  ++counts[good_slot(kx, kz, 1, n)];
+  ++counts[good_slot(kx, ky, 2, n)];
 }
 
 /// Pass 2 rule for points [begin, end).
 inline void good_bin_range_scalar(PointsView points, const GoodBinParams& p, std::size_t begin, std::size_t end,
-                                  std::span<std::uint32_t> counts, std::array<std::size_t, 3>& kept) noexcept {
+                                  std::span<std::uint32_t> counts) noexcept {
   for (std::size_t i = begin; i < end; ++i) {
     const std::array<float, 3> q = good_transform_point(p.t, points.x[i], points.y[i], points.z[i]);
-    good_add_bins(good_bin_scalar(q[0], p), good_bin_scalar(q[1], p), good_bin_scalar(q[2], p), p.bins, counts, kept);
+    good_add_bins(good_bin_scalar(q[0], p), good_bin_scalar(q[1], p), good_bin_scalar(q[2], p), p.bins, counts);
   }
 }
 

@@ -3,6 +3,7 @@
 #include <limits>
 
 #include "kernels/detail/good_kernel.hpp"
+#include "kernels/detail/pca_moments_kernel.hpp"
 #include "tests/kernels/good_test_util.hpp"
 
 namespace {
@@ -49,9 +50,8 @@ TEST_P(GoodSimd, StatsAndBinsEqualScalarOnEveryArch) {
   od::GoodStats ref{{inf, inf, inf}, {-inf, -inf, -inf}, {0, 0}, {0, 0}};
   od::good_stats_scalar(c.view(), t, 0.05F * GetParam().scale, 0, c.x.size(), ref);
   od::GoodBinParams p{t, 0.6F * GetParam().scale, 0.12F * GetParam().scale, 10};
-  std::vector<std::uint32_t> ref_counts(300, 0U);
-  std::array<std::size_t, 3> ref_kept{};
-  od::good_bin_range_scalar(c.view(), p, 0, c.x.size(), ref_counts, ref_kept);
+  std::vector<std::uint32_t> ref_counts(303, 0U);
+  od::good_bin_range_scalar(c.view(), p, 0, c.x.size(), ref_counts);
   ok::for_each_available_arch([&](auto arch) {
     const od::GoodStats s = od::GoodStatsKernel{}(arch, c.view(), t, 0.05F * GetParam().scale);
     const std::string name = decltype(arch)::name();
@@ -66,15 +66,11 @@ TEST_P(GoodSimd, StatsAndBinsEqualScalarOnEveryArch) {
       EXPECT_LE(std::abs(static_cast<long>(s.pos[a]) - static_cast<long>(ref.pos[a])), 1) << name;
       EXPECT_LE(std::abs(static_cast<long>(s.neg[a]) - static_cast<long>(ref.neg[a])), 1) << name;
     }
-    std::vector<std::uint32_t> counts(300, 0U);
-    std::array<std::size_t, 3> kept{};
-    od::GoodBinKernel{}(arch, c.view(), p, counts, kept);
-    long moved = 0;
+    std::vector<std::uint32_t> counts(303, 0U);
+    od::GoodBinKernel{}(arch, c.view(), p, counts);
+    long moved = 0;  // over the cells and the three drop slots
     for (std::size_t i = 0; i < counts.size(); ++i) { moved += std::abs(static_cast<long>(counts[i]) - static_cast<long>(ref_counts[i])); }
-    EXPECT_LE(moved, 4) << name;
-    for (std::size_t v = 0; v < 3; ++v) {
-      EXPECT_LE(std::abs(static_cast<long>(kept[v]) - static_cast<long>(ref_kept[v])), 1) << name;
-    }
+    EXPECT_LE(moved, 6) << name;
     if (!name.starts_with("avx") && !name.starts_with("fma")) {  // no FMA in the SSE2 unit: exact
       EXPECT_EQ(counts, ref_counts) << name;
       EXPECT_EQ(s.min, ref.min) << name;
@@ -88,16 +84,32 @@ INSTANTIATE_TEST_SUITE_P(Sizes, GoodSimd,
                                            SimdCase{15, 1.0F}, SimdCase{16, 1.0F}, SimdCase{17, 1.0F},
                                            SimdCase{33, 1.0F}, SimdCase{1000, 0.1F}, SimdCase{5003, 1e30F}));
 
+TEST(PcaMoments, EveryArchWithinToleranceOfScalar) {
+  for (const std::size_t n : {1U, 3U, 4U, 5U, 8U, 9U, 17U, 1000U}) {
+    const Cloud c = random_cloud(n, static_cast<std::uint32_t>(n), 1.0F, 0.2F);
+    const ok::PcaMoments ref = ok::pca_moments_scalar(c.view());
+    const std::size_t first = od::first_finite(c.view());
+    if (first == n) { continue; }
+    ok::for_each_available_arch([&](auto arch) {
+      ok::PcaMoments m;
+      m.origin = ref.origin;
+      m = od::PcaMomentsKernel{}(arch, c.view(), m);
+      EXPECT_EQ(m.count, ref.count);
+      for (std::size_t a = 0; a < 3; ++a) { EXPECT_NEAR(m.sum[a], ref.sum[a], 1e-12 * (1.0 + std::abs(ref.sum[a]))); }
+      for (std::size_t a = 0; a < 6; ++a) { EXPECT_NEAR(m.sq[a], ref.sq[a], 1e-12 * (1.0 + std::abs(ref.sq[a]))); }
+    });
+  }
+}
+
 TEST(GoodSimd, AllNaNCountsNothing) {
   const float nan = std::numeric_limits<float>::quiet_NaN();
   const Cloud c{std::vector<float>(37, nan), std::vector<float>(37, 0.0F), std::vector<float>(37, 1.0F)};
   ok::for_each_available_arch([&](auto arch) {
     const od::GoodStats s = od::GoodStatsKernel{}(arch, c.view(), some_transform(), 0.0F);
     EXPECT_EQ(s.pos[0] + s.neg[0] + s.pos[1] + s.neg[1], 0U);
-    std::vector<std::uint32_t> counts(75, 0U);
-    std::array<std::size_t, 3> kept{};
-    od::GoodBinKernel{}(arch, c.view(), od::GoodBinParams{some_transform(), 1.0F, 0.4F, 5}, counts, kept);
-    EXPECT_EQ(kept, (std::array<std::size_t, 3>{0, 0, 0}));
+    std::vector<std::uint32_t> counts(78, 0U);
+    od::GoodBinKernel{}(arch, c.view(), od::GoodBinParams{some_transform(), 1.0F, 0.4F, 5}, counts);
+    EXPECT_EQ(counts[75] + counts[76] + counts[77], 3U * 37U);  // every point dropped by every view
   });
 }
 
@@ -113,7 +125,7 @@ TEST(GoodSimd, DispatchedDescriptorEqualsScalarTwin) {
         const auto rb = ok::compute_good_scalar(c.view(), cfg, scratch, b);
         ASSERT_TRUE(ra.has_value() && rb.has_value());
         EXPECT_LE(l1(a, b), 1e-3) << name;  // a point may move across a bin edge (good.hpp @note)
-        EXPECT_EQ(ra->frame, rb->frame) << name;
+        for (std::size_t k = 0; k < 16; ++k) { EXPECT_NEAR(ra->frame[k], rb->frame[k], 1e-5) << name; }
         EXPECT_EQ(ra->order, rb->order) << name;
         EXPECT_EQ(ra->kept, rb->kept) << name;
       }
