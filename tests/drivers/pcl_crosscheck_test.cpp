@@ -94,6 +94,9 @@ TEST(PclCrossCheck, PclReadsWhatWeWrite) {
     pcl::PointCloud<pcl::PointXYZRGBA> typed;
     ASSERT_EQ(pcl::io::loadPCDFile(p.string(), typed), 0) << p;
     EXPECT_EQ(typed.points[5].rgba, cloud.rgb()[5]) << p;
+    pcl::PointCloud<pcl::PointXYZRGB> rgb_typed;  // PCL maps our `rgba U 4` onto PointXYZRGB's rgb too
+    ASSERT_EQ(pcl::io::loadPCDFile(p.string(), rgb_typed), 0) << p;
+    EXPECT_EQ(rgb_typed.points[7].rgba, cloud.rgb()[7]) << p;
   }
   fs::remove_all(dir);
 }
@@ -118,6 +121,13 @@ TEST(PclCrossCheck, WeReadWhatPclWrites) {
     for (std::size_t i = 0; i < ref.size(); ++i) {
       ASSERT_EQ(bits(ours->x()[i]), bits(ref.x()[i])) << p << " point " << i;
       ASSERT_EQ(ours->rgb()[i], ref.rgb()[i]) << p << " point " << i;
+    }
+    ok::PointCloud adapted;  // the AoS adapter over PCL's own point struct gives the same cloud
+    od::from_aos<pcl::PointXYZRGBA>(std::span<const pcl::PointXYZRGBA>(typed.points.data(), typed.points.size()),
+                                    adapted);
+    for (std::size_t i = 0; i < ref.size(); ++i) {
+      ASSERT_EQ(bits(adapted.z()[i]), bits(ours->z()[i])) << "point " << i;
+      ASSERT_EQ(adapted.rgb()[i], ours->rgb()[i]) << "point " << i;
     }
     const ok::Viewpoint expected{{0.25F, -2.0F, 1.5F}, {0.5F, -0.5F, 0.5F, -0.5F}};
     EXPECT_EQ(ours->info.viewpoint, expected) << p;
