@@ -21,6 +21,8 @@ void add_describe_command(CLI::App& app);
 void add_synth_command(CLI::App& app);
 /// @brief `info FILE [--json]`: fields, point count, layout, finite points, bounding box of a .pcd/.ply file.
 void add_info_command(CLI::App& app);
+/// @brief `segment FILE.pcd`: tabletop plane, objects and per-stage timings; --json, --repeat, PCL-named parameters.
+void add_segment_command(CLI::App& app);
 
 
 }  // namespace orthoflow::apps

@@ -1,0 +1,121 @@
+// `orthoflow segment FILE.pcd`: the tabletop chain (kernels/segmentation_chain.hpp) on one frame:
+// the table plane, its inlier count, the objects and the per-stage timings (median over --repeat runs).
+// The flags mean what the PCL parameters of specs/BASELINES.md mean: --leaf is VoxelGrid's leaf,
+// --plane-tau/--plane-iters SACSegmentation's distance threshold and max iterations, --cluster-tol and
+// --min-cluster EuclideanClusterExtraction's tolerance and minimum size.
+#include <algorithm>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "apps/commands.hpp"
+#include "drivers/pcd_io.hpp"
+#include "kernels/segmentation_chain.hpp"
+
+namespace orthoflow::apps {
+namespace {
+
+struct SegmentOptions {
+  std::string file;
+  bool json = false;
+  int repeat = 1;
+  kernels::SegmentationParams params{};
+};
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+nlohmann::json triple(const std::array<float, 3>& a) { return {a[0], a[1], a[2]}; }
+
+/// Median of every stage over the runs.
+nlohmann::json median_timings(const std::vector<kernels::SegmentationTimings>& runs) {
+  auto stage = [&](double kernels::SegmentationTimings::*field) {
+    std::vector<double> v;
+    for (const auto& t : runs) { v.push_back(t.*field); }
+    return median(v);
+  };
+  using T = kernels::SegmentationTimings;
+  return {{"filter", stage(&T::filter)}, {"voxel", stage(&T::voxel)},     {"plane", stage(&T::plane)},
+          {"prism", stage(&T::prism)},   {"cluster", stage(&T::cluster)}, {"total", stage(&T::total)}};
+}
+
+nlohmann::json to_json(const kernels::SegmentationResult& seg, const nlohmann::json& timings) {
+  nlohmann::json objects = nlohmann::json::array();
+  for (const kernels::ClusterStats& s : seg.objects) {
+    objects.push_back({{"points", s.points}, {"centroid", triple(s.centroid)}, {"bbox_min", triple(s.bbox_min)},
+                       {"bbox_max", triple(s.bbox_max)}});
+  }
+  return {{"plane", {{"normal", triple(seg.plane.plane.normal)}, {"d", seg.plane.plane.d}}},
+          {"inliers", seg.plane.inliers},
+          {"objects", objects},
+          {"timings_ms", timings}};
+}
+
+void print_text(const nlohmann::json& j) {
+  const auto& n = j["plane"]["normal"];
+  std::printf("plane: normal (%.5f, %.5f, %.5f) d %.5f, %zu inliers\n", n[0].get<double>(), n[1].get<double>(),
+              n[2].get<double>(), j["plane"]["d"].get<double>(), j["inliers"].get<std::size_t>());
+  std::printf("objects: %zu\n", j["objects"].size());
+  for (std::size_t k = 0; k < j["objects"].size(); ++k) {
+    const auto& o = j["objects"][k];
+    std::printf("  %zu: %zu points, centroid (%.4f, %.4f, %.4f), bbox (%.4f, %.4f, %.4f)..(%.4f, %.4f, %.4f)\n", k,
+                o["points"].get<std::size_t>(), o["centroid"][0].get<double>(), o["centroid"][1].get<double>(),
+                o["centroid"][2].get<double>(), o["bbox_min"][0].get<double>(), o["bbox_min"][1].get<double>(),
+                o["bbox_min"][2].get<double>(), o["bbox_max"][0].get<double>(), o["bbox_max"][1].get<double>(),
+                o["bbox_max"][2].get<double>());
+  }
+  const auto& t = j["timings_ms"];
+  std::printf("timings (ms, median): filter %.3f voxel %.3f plane %.3f prism %.3f cluster %.3f total %.3f\n",
+              t["filter"].get<double>(), t["voxel"].get<double>(), t["plane"].get<double>(), t["prism"].get<double>(),
+              t["cluster"].get<double>(), t["total"].get<double>());
+}
+
+void run_segment(const SegmentOptions& opt) {
+  auto cloud_result = drivers::read_pcd(opt.file);
+  if (!cloud_result) {
+    std::cerr << "orthoflow segment: " << cloud_result.error().to_string() << '\n';
+    throw CLI::RuntimeError(EXIT_BAD_INPUT);
+  }
+  kernels::SegmentationChain chain(cloud_result->size(), opt.params);
+  std::vector<kernels::SegmentationTimings> runs;
+  nlohmann::json out;
+  for (int r = 0; r < opt.repeat; ++r) {
+    auto seg_result = chain.run(cloud_result->view());
+    if (!seg_result) {
+      std::cerr << "orthoflow segment: " << seg_result.error().to_string() << '\n';
+      throw CLI::RuntimeError(EXIT_FAILURE_GENERIC);
+    }
+    runs.push_back(seg_result->timings);
+    if (r + 1 == opt.repeat) { out = to_json(*seg_result, median_timings(runs)); }
+  }
+  if (opt.json) {
+    std::cout << out.dump() << '\n';
+  } else {
+    print_text(out);
+  }
+}
+
+}  // namespace
+
+void add_segment_command(CLI::App& app) {
+  auto opt = std::make_shared<SegmentOptions>();
+  CLI::App* cmd = app.add_subcommand("segment", "Tabletop segmentation of one PCD frame: plane, objects, timings");
+  cmd->add_option("FILE", opt->file, "Input .pcd file")->required()->check(CLI::ExistingFile);
+  cmd->add_flag("--json", opt->json, "Print one JSON object (plane, inliers, objects, timings_ms)");
+  cmd->add_option("--repeat", opt->repeat, "Runs; timings are the median")->check(CLI::Range(1, 100000));
+  cmd->add_option("--leaf", opt->params.leaf, "Voxel leaf in metres (0: no voxel grid)")->check(CLI::Range(0.0, 1e6));
+  cmd->add_option("--plane-tau", opt->params.ransac.tau, "RANSAC inlier distance, metres")->check(CLI::Range(0.0, 1e6));
+  cmd->add_option("--plane-iters", opt->params.ransac.max_iterations, "RANSAC iterations")->check(CLI::Range(1, 100000000));
+  cmd->add_option("--cluster-tol", opt->params.cluster.tolerance, "Cluster distance tolerance, metres")
+      ->check(CLI::Range(1e-6, 1e6));
+  cmd->add_option("--min-cluster", opt->params.cluster.min_size, "Minimum points per object");
+  cmd->callback([opt] { run_segment(*opt); });
+}
+
+}  // namespace orthoflow::apps

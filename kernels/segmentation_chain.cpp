@@ -1,0 +1,116 @@
+#include "kernels/segmentation_chain.hpp"
+
+#include <algorithm>
+#include <chrono>
+
+#include "kernels/polygonal_prism.hpp"
+
+namespace orthoflow::kernels {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double ms_since(Clock::time_point& start) {
+  const auto now = Clock::now();
+  const double ms = std::chrono::duration<double, std::milli>(now - start).count();
+  start = now;
+  return ms;
+}
+
+}  // namespace
+
+SegmentationChain::SegmentationChain(std::size_t max_points, const SegmentationParams& params)
+    : params_(params), max_points_(max_points), mask_(max_points), kx_(max_points), ky_(max_points), kz_(max_points),
+      vx_(max_points), vy_(max_points), vz_(max_points), inliers_(max_points), hull_scratch_(max_points),
+      hull_idx_(max_points + 1), pu_(max_points), pv_(max_points), hull_u_(max_points + 1), hull_v_(max_points + 1),
+      heights_(max_points), labels_(max_points),
+      // every cluster has at least max(1, min_size) points, which bounds the cluster count
+      moments_(max_points / std::max<std::size_t>(1, params.cluster.min_size) + 1), stats_(moments_.size()),
+      voxel_scratch_(max_points), cluster_scratch_(max_points) {}
+
+Result<std::size_t, SegmentationError> SegmentationChain::filter_and_voxel(CloudView cloud, SegmentationTimings& t) {
+  auto start = Clock::now();
+  const std::size_t kept = crop_box_mask(cloud.points, params_.roi, mask_);
+  const PointsSpan kept_span{std::span(kx_).first(kept), std::span(ky_).first(kept), std::span(kz_).first(kept)};
+  compact_masked(cloud.points, mask_, kept_span, {});
+  t.filter = ms_since(start);
+  if (params_.leaf == 0.0F) {
+    plane_points_ = kept_span;
+    return kept;
+  }
+  auto voxel_result = voxel_grid(kept_span, params_.leaf, voxel_scratch_, PointsSpan{vx_, vy_, vz_});
+  if (!voxel_result) { return err(SegmentationError{voxel_result.error().to_string()}); }
+  const std::size_t n = *voxel_result;
+  plane_points_ = PointsView{std::span(vx_).first(n), std::span(vy_).first(n), std::span(vz_).first(n)};
+  t.voxel = ms_since(start);
+  return n;
+}
+
+Result<std::size_t, SegmentationError> SegmentationChain::hull_of_inliers(std::size_t inliers) {
+  const PlaneBasis basis = make_plane_basis(plane_.plane);
+  const auto idx = std::span<const std::uint32_t>(inliers_).first(inliers);
+  project_to_plane(plane_points_, idx, basis, pu_, pv_);
+  const std::size_t h = convex_hull_2d(std::span<const double>(pu_).first(inliers),
+                                       std::span<const double>(pv_).first(inliers), hull_scratch_, hull_idx_);
+  if (h < 3) { return err(SegmentationError{"segmentation: the plane inliers have a degenerate hull"}); }
+  for (std::size_t k = 0; k < h; ++k) {
+    hull_u_[k] = pu_[hull_idx_[k]];
+    hull_v_[k] = pv_[hull_idx_[k]];
+  }
+  return h;
+}
+
+Result<std::size_t, SegmentationError> SegmentationChain::objects(CloudView cloud, bool organized,
+                                                                  SegmentationTimings& t) {
+  auto start = Clock::now();
+  auto hull_result = hull_of_inliers(plane_.inliers);
+  if (!hull_result) { return hull_result; }
+  const std::size_t h = *hull_result;
+  const Prism prism{plane_.plane, make_plane_basis(plane_.plane), std::span<const double>(hull_u_).first(h),
+                    std::span<const double>(hull_v_).first(h), params_.h_min, params_.h_max};
+  // The prism runs on the full-resolution pixels (organized) or on the plane's input points.
+  const PointsView target = organized ? cloud.points : plane_points_;
+  polygonal_prism(target, prism, heights_, mask_);
+  if (organized) {  // the ROI applies to the pixels too
+    for (std::size_t i = 0; i < target.size(); ++i) {
+      const bool in_roi = target.x[i] >= params_.roi.min[0] && target.x[i] <= params_.roi.max[0] &&
+                          target.y[i] >= params_.roi.min[1] && target.y[i] <= params_.roi.max[1] &&
+                          target.z[i] >= params_.roi.min[2] && target.z[i] <= params_.roi.max[2];
+      mask_[i] = in_roi ? mask_[i] : std::uint8_t{0};
+    }
+  }
+  t.prism = ms_since(start);
+  const auto mask = std::span<const std::uint8_t>(mask_).first(target.size());
+  auto labels = std::span(labels_).first(target.size());
+  auto clusters_result = organized ? euclidean_cluster_organized({target, cloud.width, cloud.height}, mask,
+                                                                 params_.cluster, cluster_scratch_, labels)
+                                   : euclidean_cluster(target, mask, params_.cluster, cluster_scratch_, labels);
+  if (!clusters_result) { return err(SegmentationError{clusters_result.error().to_string()}); }
+  const std::size_t clusters = std::min(*clusters_result, stats_.size());
+  cluster_stats(target, labels, moments_, std::span(stats_).first(clusters));
+  t.cluster = ms_since(start);
+  return clusters;
+}
+
+Result<SegmentationResult, SegmentationError> SegmentationChain::run(CloudView cloud) {
+  if (cloud.points.size() > max_points_) { return err(SegmentationError{"segmentation: cloud larger than max_points"}); }
+  const auto start = Clock::now();
+  SegmentationTimings t;
+  auto voxel_result = filter_and_voxel(cloud, t);
+  if (!voxel_result) { return err(voxel_result.error()); }
+  auto plane_start = Clock::now();
+  auto plane_result = ransac_plane(plane_points_, params_.ransac, inliers_);
+  if (!plane_result) { return err(SegmentationError{plane_result.error().to_string()}); }
+  plane_ = *plane_result;
+  t.plane = ms_since(plane_start);
+  const bool organized = params_.use_organized && cloud.organized();
+  auto objects_result = objects(cloud, organized, t);
+  if (!objects_result) { return err(objects_result.error()); }
+  t.total = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+  const std::size_t n = organized ? cloud.points.size() : plane_points_.size();
+  return SegmentationResult{plane_, std::span<const ClusterStats>(stats_).first(*objects_result),
+                            std::span<const std::int32_t>(labels_).first(n), organized, t};
+}
+
+}  // namespace orthoflow::kernels

@@ -1,0 +1,60 @@
+// The whole tabletop chain on the real mOSD Kinect frames: plane found, objects against the
+// per-pixel ground truth (tests/kernels/seg_quality.hpp states the overlap rule), determinism.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <string>
+
+#include "drivers/pcd_io.hpp"
+#include "kernels/segmentation_chain.hpp"
+#include "seg_quality.hpp"
+
+namespace ok = orthoflow::kernels;
+
+namespace {
+
+struct Frame {
+  const char* name;
+  std::size_t gt_objects;
+  std::size_t min_matched;  // what the chain must detect at least (IoU >= 0.5)
+};
+
+class SegChainFrames : public ::testing::TestWithParam<Frame> {};
+
+TEST_P(SegChainFrames, FindsTableAndObjects) {
+  const Frame f = GetParam();
+  auto cloud_result = orthoflow::drivers::read_pcd(std::string(ORTHOFLOW_SHARED_DIR) + "/data/scenes/" + f.name);
+  ASSERT_TRUE(cloud_result) << cloud_result.error().to_string();
+  const ok::PointCloud& cloud = *cloud_result;
+  ok::SegmentationChain chain(cloud.size(), ok::SegmentationParams{});
+  auto seg_result = chain.run(cloud.view());
+  ASSERT_TRUE(seg_result) << seg_result.error().to_string();
+  const ok::SegmentationResult& seg = *seg_result;
+  // The table faces the sensor: its normal points up toward -y/-z in the sensor frame, d > 0.
+  EXPECT_GT(seg.plane.inliers, 1000U);
+  EXPECT_LT(seg.plane.plane.normal[1], -0.5F);
+  EXPECT_GT(seg.plane.plane.d, 0.3F);
+  const auto q = orthoflow::testing::evaluate(cloud.label(), seg.labels);
+  std::printf("%s: plane n=(%.3f %.3f %.3f) d=%.3f inliers=%zu; gt %zu clusters %zu matched %zu precision %.2f "
+              "recall %.2f over %zu under %zu; total %.2f ms\n",
+              f.name, double(seg.plane.plane.normal[0]), double(seg.plane.plane.normal[1]),
+              double(seg.plane.plane.normal[2]), double(seg.plane.plane.d), seg.plane.inliers, q.gt_objects,
+              q.clusters, q.matched, q.precision(), q.recall(), q.over, q.under, seg.timings.total);
+  std::printf("  ms: filter %.2f voxel %.2f plane %.2f prism %.2f cluster %.2f\n", seg.timings.filter,
+              seg.timings.voxel, seg.timings.plane, seg.timings.prism, seg.timings.cluster);
+  EXPECT_EQ(q.gt_objects, f.gt_objects);
+  EXPECT_GE(q.matched, f.min_matched);
+  EXPECT_EQ(seg.objects.size(), q.clusters);
+  // Deterministic: a second run gives the same labels.
+  const std::vector<std::int32_t> first(seg.labels.begin(), seg.labels.end());
+  auto again = chain.run(cloud.view());
+  ASSERT_TRUE(again);
+  EXPECT_TRUE(std::equal(first.begin(), first.end(), again->labels.begin()));
+}
+
+INSTANTIATE_TEST_SUITE_P(Mosd, SegChainFrames,
+                         ::testing::Values(Frame{"test31.pcd", 3, 2}, Frame{"test44.pcd", 5, 2},
+                                           Frame{"test55.pcd", 14, 8}),
+                         [](const auto& p) { return std::string(p.param.name).substr(0, 6); });
+
+}  // namespace

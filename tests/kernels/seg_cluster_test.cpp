@@ -1,0 +1,183 @@
+// Euclidean clustering against an O(n^2) union-find reference, the organized variant on a synthetic
+// range image, every error code, and per-cluster statistics on known shapes.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <random>
+#include <vector>
+
+#include "kernels/cluster_stats.hpp"
+#include "kernels/euclidean_cluster.hpp"
+
+namespace ok = orthoflow::kernels;
+
+namespace {
+
+struct Cloud {
+  std::vector<float> x, y, z;
+  ok::PointsView view() const { return {x, y, z}; }
+  void add(float a, float b, float c) { x.push_back(a), y.push_back(b), z.push_back(c); }
+};
+
+/// Brute force: components of the graph "within tol", sizes filtered, ids by lowest index.
+std::vector<std::int32_t> reference(const Cloud& c, const ok::ClusterParams& p) {
+  const std::size_t n = c.x.size();
+  std::vector<std::size_t> parent(n);
+  std::iota(parent.begin(), parent.end(), 0U);
+  auto find = [&](std::size_t i) { while (parent[i] != i) { i = parent[i]; } return i; };
+  auto ok_pt = [&](std::size_t i) { return std::isfinite(c.x[i]) && std::isfinite(c.y[i]) && std::isfinite(c.z[i]); };
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t j = i + 1; j < n && ok_pt(i); ++j) {
+      const float dx = c.x[i] - c.x[j], dy = c.y[i] - c.y[j], dz = c.z[i] - c.z[j];
+      if (ok_pt(j) && dx * dx + dy * dy + dz * dz <= p.tolerance * p.tolerance) {
+        const std::size_t a = find(i), b = find(j);
+        parent[std::max(a, b)] = std::min(a, b);
+      }
+    }
+  }
+  std::vector<std::size_t> size(n, 0);
+  for (std::size_t i = 0; i < n; ++i) { size[find(i)] += ok_pt(i) ? 1U : 0U; }
+  std::vector<std::int32_t> label(n, -1), id(n, -2);
+  std::int32_t next = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!ok_pt(i)) { continue; }
+    const std::size_t r = find(i);
+    if (id[r] == -2) { id[r] = (size[r] >= p.min_size && size[r] <= p.max_size) ? next++ : -1; }
+    label[i] = id[r];
+  }
+  return label;
+}
+
+Cloud blobs(std::size_t per_blob, std::size_t blobs_n, float spread, std::uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<float> g(0.0F, spread);
+  std::uniform_real_distribution<float> centre(-1.0F, 1.0F);
+  Cloud c;
+  for (std::size_t b = 0; b < blobs_n; ++b) {
+    const float cx = centre(rng), cy = centre(rng), cz = centre(rng);
+    for (std::size_t i = 0; i < per_blob; ++i) { c.add(cx + g(rng), cy + g(rng), cz + g(rng)); }
+  }
+  // Interleave blobs so that ids do not follow blob order trivially.
+  std::shuffle(c.x.begin(), c.x.end(), std::mt19937(seed)), std::shuffle(c.y.begin(), c.y.end(), std::mt19937(seed)),
+      std::shuffle(c.z.begin(), c.z.end(), std::mt19937(seed));
+  return c;
+}
+
+void expect_reference(const Cloud& c, const ok::ClusterParams& p) {
+  ok::ClusterScratch scratch(c.x.size());
+  std::vector<std::int32_t> labels(c.x.size());
+  auto r = ok::euclidean_cluster(c.view(), {}, p, scratch, labels);
+  ASSERT_TRUE(r) << r.error().to_string();
+  const auto ref = reference(c, p);
+  EXPECT_EQ(labels, ref);
+  EXPECT_EQ(*r, static_cast<std::size_t>(*std::max_element(ref.begin(), ref.end()) + 1));
+}
+
+TEST(SegCluster, GridMatchesBruteForce) {
+  ok::ClusterParams p;
+  p.min_size = 5;
+  for (const std::size_t n : {1U, 7U, 40U, 300U}) { expect_reference(blobs(n, 6, 0.03F, std::uint32_t(n)), p); }
+  p.tolerance = 0.005F;
+  p.min_size = 1;
+  p.max_size = 50;
+  expect_reference(blobs(200, 4, 0.02F, 5), p);
+}
+
+TEST(SegCluster, AdversarialInputs) {
+  ok::ClusterParams p;
+  p.min_size = 1;
+  expect_reference(Cloud{}, p);
+  Cloud nan_cloud;
+  for (int i = 0; i < 20; ++i) { nan_cloud.add(std::numeric_limits<float>::quiet_NaN(), 0, 0); }
+  expect_reference(nan_cloud, p);
+  Cloud dup;
+  for (int i = 0; i < 33; ++i) { dup.add(0.5F, 0.5F, 0.5F); }
+  expect_reference(dup, p);
+  Cloud huge;
+  for (int i = 0; i < 17; ++i) { huge.add(1e6F + 0.01F * float(i), -1e6F, 3e5F); }  // a chain 1 cm apart
+  expect_reference(huge, p);
+}
+
+TEST(SegCluster, OrganizedSeparatesByDepthAndMask) {
+  // 40 x 30 range image: left half a wall at 1 m, right half one at 1.2 m, one masked-out column.
+  const std::uint32_t w = 40, h = 30;
+  Cloud c;
+  for (std::uint32_t v = 0; v < h; ++v) {
+    for (std::uint32_t u = 0; u < w; ++u) {
+      const float z = u < 20 ? 1.0F : 1.2F;
+      c.add((float(u) - 20.0F) * 0.002F * z, (float(v) - 15.0F) * 0.002F * z, z);
+    }
+  }
+  std::vector<std::uint8_t> mask(c.x.size(), 1);
+  for (std::uint32_t v = 0; v < h; ++v) { mask[v * w + 30] = 0; }  // one pixel gap: bridged by radius 2
+  ok::ClusterScratch scratch(c.x.size());
+  std::vector<std::int32_t> labels(c.x.size());
+  ok::ClusterParams p;
+  p.min_size = 10;
+  auto r = ok::euclidean_cluster_organized({c.view(), w, h}, mask, p, scratch, labels);
+  ASSERT_TRUE(r);
+  EXPECT_EQ(*r, 2U);
+  EXPECT_EQ(labels[0], 0);
+  EXPECT_EQ(labels[25], 1);
+  EXPECT_EQ(labels[39], 1);
+  EXPECT_EQ(labels[30], -1);
+  p.pixel_radius = 1;  // now the masked column splits the right wall
+  ASSERT_EQ(*ok::euclidean_cluster_organized({c.view(), w, h}, mask, p, scratch, labels), 3U);
+}
+
+TEST(SegCluster, EveryErrorCode) {
+  using Code = ok::ClusterError::Code;
+  Cloud c = blobs(10, 1, 0.01F, 1);
+  ok::ClusterScratch scratch(c.x.size());
+  std::vector<std::int32_t> labels(c.x.size());
+  ok::ClusterParams p;
+  p.tolerance = 0.0F;
+  EXPECT_EQ(ok::euclidean_cluster(c.view(), {}, p, scratch, labels).error().code, Code::BAD_PARAMS);
+  p = {};
+  p.min_size = 10, p.max_size = 5;
+  EXPECT_EQ(ok::euclidean_cluster(c.view(), {}, p, scratch, labels).error().code, Code::BAD_PARAMS);
+  p = {};
+  p.pixel_radius = 0;
+  EXPECT_EQ(ok::euclidean_cluster_organized({c.view(), 5, 2}, {}, p, scratch, labels).error().code, Code::BAD_PARAMS);
+  ok::ClusterScratch small(3);
+  EXPECT_EQ(ok::euclidean_cluster(c.view(), {}, {}, small, labels).error().code, Code::SCRATCH_TOO_SMALL);
+  Cloud far;
+  far.add(-3e38F, -3e38F, -3e38F), far.add(3e38F, 3e38F, 3e38F);
+  ok::ClusterScratch s2(2);
+  auto overflow = ok::euclidean_cluster(far.view(), {}, {}, s2, labels);
+  ASSERT_FALSE(overflow);
+  EXPECT_EQ(overflow.error().code, Code::GRID_OVERFLOW);
+  EXPECT_FALSE(overflow.error().to_string().empty());
+}
+
+TEST(SegClusterStats, BoxAlongAxesAndRotated) {
+  // A 0.4 x 0.2 x 0.1 grid of points rotated 30 degrees about z, centred at (1, 2, 3).
+  Cloud c;
+  const float ca = std::cos(0.5235988F), sa = std::sin(0.5235988F);
+  for (int i = 0; i <= 20; ++i) {
+    for (int j = 0; j <= 10; ++j) {
+      for (int k = 0; k <= 5; ++k) {
+        const float a = -0.2F + 0.02F * float(i), b = -0.1F + 0.02F * float(j), e = -0.05F + 0.02F * float(k);
+        c.add(1.0F + ca * a - sa * b, 2.0F + sa * a + ca * b, 3.0F + e);
+      }
+    }
+  }
+  std::vector<std::int32_t> labels(c.x.size(), 0);
+  labels[0] = -1;  // one unlabelled point is ignored
+  std::vector<ok::ClusterMoments> moments(2);
+  std::vector<ok::ClusterStats> stats(2);
+  ok::cluster_stats(c.view(), labels, moments, stats);
+  EXPECT_EQ(stats[0].points, c.x.size() - 1);
+  EXPECT_EQ(stats[1].points, 0U);
+  EXPECT_NEAR(stats[0].centroid[2], 3.0F, 1e-3F);
+  const float obb_len = stats[0].obb_max[0] - stats[0].obb_min[0];
+  EXPECT_NEAR(obb_len, 0.4F, 1e-3F);
+  EXPECT_NEAR(stats[0].obb_max[1] - stats[0].obb_min[1], 0.2F, 1e-3F);
+  EXPECT_NEAR(std::fabs(stats[0].obb_axes[0]), ca, 1e-3F);  // first axis along the long side
+  EXPECT_GT(stats[0].bbox_max[0] - stats[0].bbox_min[0], 0.4F * ca);
+  EXPECT_GT(stats[0].covariance[0], 0.0F);
+}
+
+}  // namespace
