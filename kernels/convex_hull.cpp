@@ -63,11 +63,17 @@ std::size_t octagon_filter(std::span<const double> u, std::span<const double> v,
   std::size_t m = 0;
   for (std::uint32_t i = 0; i < u.size(); ++i) {
     if (!std::isfinite(u[i]) || !std::isfinite(v[i])) { continue; }
-    bool inside = true;  // strictly left of every octagon edge (counter-clockwise) means interior
+    // Strictly left of every proper octagon edge (counter-clockwise) means interior; with no proper
+    // edge (all points equal) nothing is interior.
+    bool inside = true;
+    bool any_edge = false;
     for (std::size_t e = 0; e < 8 && inside; ++e) {
       const std::uint32_t a = ext[e], b = ext[(e + 1) % 8];
-      inside = a != b ? cross(u, v, a, b, i) > 0.0 : true;
+      if (a == b) { continue; }
+      any_edge = true;
+      inside = cross(u, v, a, b, i) > 0.0;
     }
+    inside = inside && any_edge;
     if (!inside) { keep[m++] = i; }
   }
   return m;
