@@ -97,7 +97,9 @@ Scene make_scene(const SceneConfig& config, std::uint64_t seed) {
   // About as wide as the view at the table centre (58 degrees horizontal field of view), so the
   // side edges show at the far end and the near and far edges show whole; at least 0.9 m so that
   // ten objects usually fit.
-  scene.table.width_m = std::max(scene.table.distance_m * rng.uniform(0.95, 1.1), rng.uniform(0.9, 1.0));
+  // Two draws in one call would be unsequenced (GCC and clang order arguments differently): one per statement.
+  const double view_width = scene.table.distance_m * rng.uniform(0.95, 1.1);
+  scene.table.width_m = std::max(view_width, rng.uniform(0.9, 1.0));
   scene.table.depth_m = rng.uniform(0.6, 0.8);
   scene.table.floor_drop_m = config.floor ? rng.uniform(0.65, 0.78) : 0.0;
   std::array<ObjectModel, MAX_SCENE_OBJECTS> models{};

@@ -12,6 +12,7 @@
 #include "drivers/object_catalog.hpp"
 #include "drivers/shape_primitives.hpp"
 #include "drivers/synthetic_random.hpp"
+#include "drivers/synthetic_scene.hpp"
 
 namespace orthoflow::drivers {
 namespace {
@@ -108,6 +109,24 @@ TEST(SyntheticRandom, RangesAndMomentsHold) {
   for (std::uint64_t c : counts) { EXPECT_NEAR(static_cast<double>(c) / N, 1.0 / 3.0, 0.01); }
   EXPECT_EQ(Random(5).below(1), 0U);
   EXPECT_LT(Random(5).below(UINT64_MAX), UINT64_MAX);
+}
+
+TEST(SyntheticRandom, SceneTablesFollowTheDrawOrderOnEveryCompiler) {
+  // Reference values from an independent replica of make_scene's documented draws (distance, tilt,
+  // width from two draws, depth, floor drop; left to right). Two draws in one function call would
+  // be unsequenced and GCC would take them in the other order (seed 7: width 1.1523).
+  const std::uint64_t seeds[] = {7, 42};
+  const double expected[2][5] = {
+      {1.0502882410898446, 0.6695525780472927, 1.1300514565510897, 0.7981720557666137, 0.7634606120368672},
+      {0.741931485529941, 0.7220323708212084, 0.9924692945325387, 0.7983607828564205, 0.7500661298564515}};
+  for (std::size_t i = 0; i < 2; ++i) {
+    const TableSpec t = make_scene(SceneConfig{}, seeds[i]).table;
+    EXPECT_EQ(t.distance_m, expected[i][0]) << "seed " << seeds[i];
+    EXPECT_EQ(t.tilt_rad, expected[i][1]) << "seed " << seeds[i];
+    EXPECT_EQ(t.width_m, expected[i][2]) << "seed " << seeds[i];
+    EXPECT_EQ(t.depth_m, expected[i][3]) << "seed " << seeds[i];
+    EXPECT_EQ(t.floor_drop_m, expected[i][4]) << "seed " << seeds[i];
+  }
 }
 
 // ---- Ray-primitive intersections --------------------------------------------------------------------
