@@ -77,16 +77,17 @@ Result<PcaFrame, PcaError> pca_frame_from_moments(const PcaMoments& m, std::size
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(cov, Eigen::ComputeEigenvectors);
   PcaFrame f;
   f.finite = m.count;
-  for (int a = 0; a < 3; ++a) { f.centroid[a] = m.origin[a] + mean[a]; }
+  for (std::size_t a = 0; a < 3; ++a) { f.centroid[a] = m.origin[a] + mean[static_cast<Eigen::Index>(a)]; }
   // Eigen sorts ascending: column 2 is the largest.
   const Eigen::Vector3d v1 = solver.eigenvectors().col(2);
   const Eigen::Vector3d v2 = solver.eigenvectors().col(1);
   const Eigen::Vector3d v3 = v1.cross(v2);
-  for (int a = 0; a < 3; ++a) {
-    f.eigenvalues[a] = std::max(solver.eigenvalues()[2 - a], 0.0);
-    f.axes[0][a] = v1[a];
-    f.axes[1][a] = v2[a];
-    f.axes[2][a] = v3[a];
+  for (std::size_t a = 0; a < 3; ++a) {
+    const auto e = static_cast<Eigen::Index>(a);
+    f.eigenvalues[a] = std::max(solver.eigenvalues()[2 - e], 0.0);
+    f.axes[0][a] = v1[e];
+    f.axes[1][a] = v2[e];
+    f.axes[2][a] = v3[e];
   }
   f.flags = shape_flags(f);
   if (m.count != total_points) { f.flags |= NAN_IGNORED; }
