@@ -112,9 +112,9 @@ Result<Grid, ClusterError> build_grid(PointsView p, std::span<const std::uint8_t
   g.ny = static_cast<std::uint64_t>(ext[1]);
   for (std::size_t k = 0; k < m; ++k) {
     const std::uint32_t i = s.order[k];
-    const auto ix = static_cast<std::uint64_t>(std::floor((p.x[i] - g.lo[0]) * g.inv)) + 1U;
-    const auto iy = static_cast<std::uint64_t>(std::floor((p.y[i] - g.lo[1]) * g.inv)) + 1U;
-    const auto iz = static_cast<std::uint64_t>(std::floor((p.z[i] - g.lo[2]) * g.inv)) + 1U;
+    const auto ix = static_cast<std::uint64_t>((p.x[i] - g.lo[0]) * g.inv) + 1U;  // >= 0: cast floors
+    const auto iy = static_cast<std::uint64_t>((p.y[i] - g.lo[1]) * g.inv) + 1U;  // >= 0: cast floors
+    const auto iz = static_cast<std::uint64_t>((p.z[i] - g.lo[2]) * g.inv) + 1U;  // >= 0: cast floors
     s.keys[k] = ix + g.nx * (iy + g.ny * iz);
   }
   const auto max_key = static_cast<std::uint64_t>(ext[0] * ext[1] * ext[2]);

@@ -36,6 +36,7 @@ struct PclResult {
   PclCloud::Ptr objects{new PclCloud};  // prism output, what the clusters index
   pcl::ModelCoefficients plane;
   std::size_t inliers = 0;
+  std::size_t cropped = 0;  // points after NaN removal + crop box
   std::vector<pcl::PointIndices> clusters;
   PclTimings t;
 };
@@ -66,6 +67,7 @@ inline PclResult run_pcl_chain(const PclCloud::ConstPtr& input, float leaf = 0.0
   crop.setMax(Eigen::Vector4f(1, 1, 2.0F, 1));
   crop.setInputCloud(finite);
   crop.filter(*cropped);
+  r.cropped = cropped->size();
   const auto t1 = Clock::now();
   pcl::VoxelGrid<PclPoint> vg;
   vg.setLeafSize(leaf, leaf, leaf);
