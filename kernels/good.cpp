@@ -90,6 +90,17 @@ std::optional<GoodError> validate(PointsView points, const GoodConfig& cfg, cons
   return std::nullopt;
 }
 
+std::array<int, 3> choose_signs(PointsView points, const GoodConfig& cfg, const PcaFrame& f, const GoodStats& s,
+                                std::uint32_t& flags) noexcept {
+  if (cfg.mode == GoodMode::INVARIANT) {
+    const int sx = invariant_sign(points, f, s, 0, flags);
+    const int sy = invariant_sign(points, f, s, 1, flags);
+    return {sx, sy, sx * sy};  // Z = X x Y = (Sx v1) x (Sy v2) = Sx Sy v3
+  }
+  const int sign = reference_sign(s, 0, points.size()) * reference_sign(s, 1, points.size());
+  return {sign, sign, 1};  // s multiplies x and y only; z is never flipped
+}
+
 template <class FrameFn, class StatsFn, class BinFn>
 Result<GoodResult, GoodError> run_good(PointsView points, const GoodConfig& cfg, GoodScratch& scratch,
                                        std::span<float> out, FrameFn&& frame_fn, StatsFn&& stats_fn,
@@ -101,14 +112,7 @@ Result<GoodResult, GoodError> run_good(PointsView points, const GoodConfig& cfg,
   GoodResult r;
   r.flags = f.flags;
   const GoodStats s = stats_fn(points, make_transform(f, {1, 1, 1}), cfg.effective_threshold());
-  if (cfg.mode == GoodMode::INVARIANT) {
-    const int sx = invariant_sign(points, f, s, 0, r.flags);
-    const int sy = invariant_sign(points, f, s, 1, r.flags);
-    r.signs = {sx, sy, sx * sy};  // Z = X x Y = (Sx v1) x (Sy v2) = Sx Sy v3
-  } else {
-    const int sign = reference_sign(s, 0, points.size()) * reference_sign(s, 1, points.size());
-    r.signs = {sign, sign, 1};  // s multiplies x and y only; z is never flipped
-  }
+  r.signs = choose_signs(points, cfg, f, s, r.flags);
   detail::GoodBinParams p;
   p.t = make_transform(f, r.signs);
   p.bins = cfg.bins;

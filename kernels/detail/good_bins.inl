@@ -27,6 +27,20 @@ Q<B> transform(const GoodTransform& t, const float* px, const float* py, const f
   return q;
 }
 
+// Lane-wise extremes -> scalar extremes (order-free, so the result equals the scalar pass).
+template <class B>
+void reduce_extremes(const B (&lo)[3], const B (&hi)[3], GoodStats& s) noexcept {
+  alignas(64) float buf[B::size];
+  for (std::size_t a = 0; a < 3; ++a) {
+    s.min[a] = std::numeric_limits<float>::infinity();
+    s.max[a] = -std::numeric_limits<float>::infinity();
+    lo[a].store_unaligned(buf);
+    for (const float v : buf) { s.min[a] = std::min(s.min[a], v); }
+    hi[a].store_unaligned(buf);
+    for (const float v : buf) { s.max[a] = std::max(s.max[a], v); }
+  }
+}
+
 }  // namespace good_simd
 
 template <class Arch>
@@ -71,15 +85,7 @@ GoodStats GoodStatsKernel::operator()(Arch /*arch*/, PointsView points, const Go
     }
   }
   flush();
-  alignas(64) float buf[LANES];
-  for (std::size_t a = 0; a < 3; ++a) {
-    s.min[a] = inf;
-    s.max[a] = -inf;
-    lo[a].store_unaligned(buf);
-    for (std::size_t l = 0; l < LANES; ++l) { s.min[a] = std::min(s.min[a], buf[l]); }
-    hi[a].store_unaligned(buf);
-    for (std::size_t l = 0; l < LANES; ++l) { s.max[a] = std::max(s.max[a], buf[l]); }
-  }
+  good_simd::reduce_extremes(lo, hi, s);
   good_stats_scalar(points, t, threshold, i, n, s);
   return s;
 }
