@@ -20,7 +20,6 @@ std::string ClusterError::to_string() const {
 
 namespace {
 
-constexpr std::uint32_t NONE = std::numeric_limits<std::uint32_t>::max();
 
 /// Union-find over scratch.parent: the root is the component's lowest index (deterministic).
 struct Forest {
