@@ -20,7 +20,6 @@ std::string ClusterError::to_string() const {
 
 namespace {
 
-
 /// Union-find over scratch.parent: the root is the component's lowest index (deterministic).
 struct Forest {
   std::uint32_t* parent;
