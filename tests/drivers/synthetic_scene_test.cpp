@@ -204,7 +204,7 @@ TEST(SyntheticScene, PlacementKeepsObjectsApartOrTouchingAndOnTheTable) {
   }
 }
 
-TEST(SyntheticScene, TenObjectFrameRendersFastAndReusesTheCloud) {
+TEST(SyntheticScene, TenObjectFrameReusesTheCloud) {
   const Scene scene = make_scene(SceneConfig{10, false, {}, 5, true}, 6);  // a seed where all ten fit
 #if defined(__SANITIZE_ADDRESS__)
   const RenderOptions options = half_resolution();  // the timing means nothing under ASan: keep it short
@@ -222,7 +222,7 @@ TEST(SyntheticScene, TenObjectFrameRendersFastAndReusesTheCloud) {
   EXPECT_EQ(scene.objects.size(), 10U);
   std::printf("[ info ] %ux%u frame with %zu objects rendered in %.1f ms\n", cloud.width(), cloud.height(),
               scene.objects.size(), ms);
-  EXPECT_LT(ms, 2000.0);  // release: tens of ms; the bound leaves room for loaded CI machines
+  // Speed is measured in bench/drivers/synthetic_bench.cpp, never asserted here.
 }
 
 }  // namespace
