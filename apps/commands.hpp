@@ -11,7 +11,7 @@ namespace orthoflow::apps {
 inline constexpr int EXIT_OK = 0;
 inline constexpr int EXIT_FAILURE_GENERIC = 1;  ///< the operation failed (message on stderr)
 inline constexpr int EXIT_BAD_INPUT = 2;        ///< unreadable or malformed input file
-inline constexpr int EXIT_USAGE = 106;          ///< CLI11's own code for bad arguments (ValidationError)
+inline constexpr int EXIT_USAGE = 106;          ///< bad arguments (the code CLI11 uses for RequiredError; its own validators exit 105)
 
 /// @brief `graph check|dot|run FILE`: validate, draw (Graphviz) and run dataflow graph files.
 void add_graph_command(CLI::App& app);
