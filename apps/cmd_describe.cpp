@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "apps/commands.hpp"
+#include "apps/json_numbers.hpp"
 #include "drivers/pcd_io.hpp"
 #include "kernels/good.hpp"
 
@@ -34,19 +35,6 @@ struct Described {
   kernels::GoodResult result;
 };
 
-/// The shortest decimal that reads back as the same float (0.1F prints as 0.1, not 0.100000001).
-template <class Floats>
-nlohmann::json floats_json(const Floats& values) {
-  nlohmann::json out = nlohmann::json::array();
-  for (const float v : values) {
-    std::array<char, 32> text{};
-    const auto written = std::to_chars(text.data(), text.data() + text.size(), v);
-    double shortest = 0.0;
-    std::from_chars(text.data(), written.ptr, shortest);
-    out.push_back(shortest);
-  }
-  return out;
-}
 
 nlohmann::json flags_json(std::uint32_t flags) {
   static const std::array<std::pair<std::uint32_t, const char*>, 7> NAMES{{

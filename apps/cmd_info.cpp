@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "apps/commands.hpp"
+#include "apps/json_numbers.hpp"
 #include "drivers/file_bytes.hpp"
 #include "drivers/pcd_io.hpp"
 #include "drivers/ply_header.hpp"
@@ -75,19 +76,6 @@ FileSummary summarize_ply(std::span<const char> bytes, const std::string& name) 
   return s;
 }
 
-/// The double whose shortest text is the float's shortest text, so 0.1F prints as 0.1, not 0.100000001.
-template <std::size_t N>
-nlohmann::json floats_json(const std::array<float, N>& values) {
-  nlohmann::json out = nlohmann::json::array();
-  for (const float v : values) {
-    std::array<char, 32> text{};
-    const auto written = std::to_chars(text.data(), text.data() + text.size(), v);
-    double shortest = 0.0;
-    std::from_chars(text.data(), written.ptr, shortest);
-    out.push_back(shortest);
-  }
-  return out;
-}
 
 /// JSON numbers cannot be inf; an empty box (no finite point) is reported as null.
 nlohmann::json box_json(const kernels::CloudStats& stats) {

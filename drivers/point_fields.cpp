@@ -48,18 +48,6 @@ void decode_u32(const char* base, std::size_t stride, ScalarType type, std::span
   }
 }
 
-std::span<float> float_target(kernels::PointCloud& cloud, FieldTarget t) noexcept {
-  switch (t) {
-    case FieldTarget::X: return cloud.x();
-    case FieldTarget::Y: return cloud.y();
-    case FieldTarget::Z: return cloud.z();
-    case FieldTarget::NORMAL_X: return cloud.normal_x();
-    case FieldTarget::NORMAL_Y: return cloud.normal_y();
-    case FieldTarget::NORMAL_Z: return cloud.normal_z();
-    default: return {};
-  }
-}
-
 }  // namespace
 
 std::span<const float> float_buffer(const kernels::PointCloud& cloud, FieldTarget t) noexcept {
@@ -74,6 +62,15 @@ std::span<const float> float_buffer(const kernels::PointCloud& cloud, FieldTarge
   }
 }
 
+namespace {
+
+/// The writable buffer behind float_buffer(): the same selection, on a cloud the caller may change.
+std::span<float> float_target(kernels::PointCloud& cloud, FieldTarget t) noexcept {
+  const std::span<const float> view = float_buffer(cloud, t);
+  return {const_cast<float*>(view.data()), view.size()};  // NOLINT: the cloud itself is not const
+}
+
+}  // namespace
 
 std::uint32_t scalar_size(ScalarType type) noexcept {
   switch (type) {
