@@ -1,0 +1,53 @@
+#include "learning/learner.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+namespace orthoflow::learning {
+
+std::string_view Label::view() const noexcept {
+  // The last byte is always zero (from() writes at most LABEL_MAX_BYTES), so strnlen stays in bounds.
+  return std::string_view(text.data(), ::strnlen(text.data(), text.size()));
+}
+
+Label Label::from(std::string_view s) noexcept {
+  Label label;
+  const std::size_t n = std::min(s.size(), LABEL_MAX_BYTES);
+  std::copy_n(s.data(), n, label.text.data());
+  return label;
+}
+
+const char* to_string(LearnError error) noexcept {
+  switch (error) {
+    case LearnError::EMPTY_LABEL: return "empty label: a category needs a name";
+    case LearnError::LABEL_TOO_LONG: return "label longer than 63 bytes";
+    case LearnError::NO_VIEWS: return "no view to learn from (empty descriptor batch)";
+    case LearnError::WRONG_LENGTH: return "descriptor length differs from the learner's descriptor_length";
+    case LearnError::NOT_FINITE: return "descriptor holds a NaN or infinite value";
+    case LearnError::NEGATIVE_VALUE: return "histogram descriptor holds a negative value";
+    case LearnError::UNKNOWN_LABEL: return "no category has this label";
+    case LearnError::DUPLICATE_ID: return "two restored categories share an id or a label";
+  }
+  return "unknown learn error";
+}
+
+Result<void, LearnError> validate_label(std::string_view label) noexcept {
+  if (label.empty()) { return err(LearnError::EMPTY_LABEL); }
+  if (label.size() > LABEL_MAX_BYTES) { return err(LearnError::LABEL_TOO_LONG); }
+  // An embedded zero would silently cut the label short in Label::view().
+  if (label.find('\0') != std::string_view::npos) { return err(LearnError::EMPTY_LABEL); }
+  return {};
+}
+
+Result<void, LearnError> validate_batch(DescriptorBatch views, std::size_t length, bool histograms) noexcept {
+  if (views.values.empty()) { return err(LearnError::NO_VIEWS); }
+  if (views.length != length || views.values.size() % length != 0) { return err(LearnError::WRONG_LENGTH); }
+  for (const float v : views.values) {
+    if (!std::isfinite(v)) { return err(LearnError::NOT_FINITE); }
+    if (histograms && v < 0.0F) { return err(LearnError::NEGATIVE_VALUE); }
+  }
+  return {};
+}
+
+}  // namespace orthoflow::learning
