@@ -9,6 +9,8 @@ find_package(yaml-cpp REQUIRED)
 find_package(nlohmann_json 3.10 REQUIRED)
 find_package(CLI11 REQUIRED)
 find_package(leveldb CONFIG REQUIRED)
+# Debian 12's leveldb config links "snappy" by name, which needs libsnappy-dev; libleveldb.so already NEEDs libsnappy.so.1.
+set_target_properties(leveldb::leveldb PROPERTIES INTERFACE_LINK_LIBRARIES Threads::Threads)
 find_package(PkgConfig REQUIRED)
 pkg_check_modules(LZF REQUIRED IMPORTED_TARGET liblzf)
 pkg_check_modules(CAIRO REQUIRED IMPORTED_TARGET cairo)

@@ -1,5 +1,7 @@
 #include "learning/learner.hpp"
 
+#include "learning/detail/learner_common.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -46,6 +48,23 @@ Result<void, LearnError> validate_batch(DescriptorBatch views, std::size_t lengt
   for (const float v : views.values) {
     if (!std::isfinite(v)) { return err(LearnError::NOT_FINITE); }
     if (histograms && v < 0.0F) { return err(LearnError::NEGATIVE_VALUE); }
+  }
+  return {};
+}
+
+Result<void, LearnError> validate_restored(std::span<const RestoredCategory> categories, std::size_t length,
+                                           bool histograms) noexcept {
+  for (std::size_t k = 0; k < categories.size(); ++k) {
+    const RestoredCategory& c = categories[k];
+    if (auto r = validate_label(c.label); !r) { return r; }
+    const bool has_model = !c.accumulators.empty();
+    if (!has_model || !c.views.values.empty()) {
+      if (auto r = validate_batch(c.views, length, histograms); !r) { return r; }
+    }
+    if (has_model && c.accumulators.size() != length) { return err(LearnError::WRONG_LENGTH); }
+    for (std::size_t j = 0; j < k; ++j) {
+      if (categories[j].id == c.id || categories[j].label == c.label) { return err(LearnError::DUPLICATE_ID); }
+    }
   }
   return {};
 }

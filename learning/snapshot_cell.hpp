@@ -95,10 +95,11 @@ class SnapshotCell {
       }
     }
     retired_.resize(kept);
+    retired_count_.store(kept, std::memory_order_relaxed);
   }
 
-  /// @brief Retired snapshots still pinned by a reader (writer side only).
-  [[nodiscard]] std::size_t retired_pending() const noexcept { return retired_.size(); }
+  /// @brief Retired snapshots still pinned by a reader after the last publish(). @note Thread-safe.
+  [[nodiscard]] std::size_t retired_pending() const noexcept { return retired_count_.load(std::memory_order_relaxed); }
 
  private:
   struct alignas(64) Slot {
@@ -126,6 +127,7 @@ class SnapshotCell {
   mutable std::array<Slot, SNAPSHOT_READER_SLOTS> slots_{};
   std::atomic<const T*> current_;
   std::vector<const T*> retired_;  // writer only
+  std::atomic<std::size_t> retired_count_{0};
 };
 
 }  // namespace orthoflow::learning

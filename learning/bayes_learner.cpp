@@ -1,0 +1,171 @@
+#include "learning/bayes_learner.hpp"
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+
+#include "learning/detail/learner_common.hpp"
+#include "learning/snapshot_cell.hpp"
+
+namespace orthoflow::learning {
+
+/// One category model: N_k, the unscaled bin sums s_k (a_k = count_scale * s_k) and log P(x_i | C_k).
+struct BayesCategory {
+  CategoryId id = NO_CATEGORY;
+  Label label;
+  std::uint64_t seen = 0;
+  std::vector<double> sums;
+  std::vector<float> log_p;
+};
+
+struct BayesSnapshot {
+  std::vector<std::shared_ptr<const BayesCategory>> categories;  // by id
+  std::uint64_t total = 0;                                        // N = sum of N_k
+  std::uint64_t generation = 0;
+  CategoryId next_id = 0;
+};
+
+struct BayesLearner::Cell : SnapshotCell<BayesSnapshot> {
+  using SnapshotCell::SnapshotCell;
+};
+
+void accumulate_views(DescriptorBatch views, std::span<double> sums) noexcept {
+  for (std::size_t v = 0; v < views.count(); ++v) {
+    const std::span<const float> x = views.view(v);
+    for (std::size_t i = 0; i < sums.size(); ++i) { sums[i] += static_cast<double>(x[i]); }
+  }
+}
+
+namespace {
+
+using CategoryPtr = std::shared_ptr<const BayesCategory>;
+
+// Laplace-smoothed bin probabilities (thesis eq. update_p): P(x_i | C_k) = (a_ki + 1) / sum_j (a_kj + 1),
+// with a_ki = count_scale * sums_i; stored as logarithms for the log-likelihood sum.
+CategoryPtr make_category(CategoryId id, const Label& label, std::uint64_t seen, std::vector<double> sums,
+                          float count_scale) {
+  auto c = std::make_shared<BayesCategory>();
+  c->id = id;
+  c->label = label;
+  c->seen = seen;
+  c->sums = std::move(sums);
+  const double scale = static_cast<double>(count_scale);
+  double denominator = 0.0;
+  for (const double s : c->sums) { denominator += scale * s + 1.0; }
+  c->log_p.resize(c->sums.size());
+  for (std::size_t i = 0; i < c->sums.size(); ++i) {
+    c->log_p[i] = static_cast<float>(std::log((scale * c->sums[i] + 1.0) / denominator));
+  }
+  return c;
+}
+
+std::unique_ptr<BayesSnapshot> finish(std::vector<CategoryPtr> categories, std::uint64_t generation, CategoryId next_id) {
+  auto s = std::make_unique<BayesSnapshot>();
+  s->categories = std::move(categories);
+  s->generation = generation;
+  s->next_id = next_id;
+  for (const CategoryPtr& c : s->categories) { s->total += c->seen; }
+  return s;
+}
+
+}  // namespace
+
+BayesLearner::BayesLearner(const BayesConfig& cfg) : cfg_(cfg) {
+  OF_ENFORCE(cfg.descriptor_length > 0, "BayesConfig::descriptor_length must be positive");
+  OF_ENFORCE(cfg.count_scale > 0.0F && std::isfinite(cfg.count_scale), "BayesConfig::count_scale must be > 0");
+  cell_ = std::make_unique<Cell>(finish({}, 0, 0));
+}
+
+BayesLearner::~BayesLearner() = default;
+
+Result<CategoryId, LearnError> BayesLearner::teach(std::string_view label, DescriptorBatch views) {
+  if (auto r = validate_label(label); !r) { return err(r.error()); }
+  if (auto r = validate_batch(views, cfg_.descriptor_length, true); !r) { return err(r.error()); }
+  const std::lock_guard lock(writer_);
+  const BayesSnapshot& cur = cell_->writer_view();
+  std::vector<CategoryPtr> next = cur.categories;
+  CategoryId next_id = cur.next_id;
+  auto it = std::find_if(next.begin(), next.end(), [&](const CategoryPtr& c) { return c->label.view() == label; });
+  const bool fresh = it == next.end();
+  // Thesis "Category Initialization and Update": N_k <- N_k + views, a_ki <- a_ki + x'_i.
+  std::vector<double> sums = fresh ? std::vector<double>(cfg_.descriptor_length, 0.0) : (*it)->sums;
+  accumulate_views(views, sums);
+  const CategoryId id = fresh ? next_id++ : (*it)->id;
+  const std::uint64_t seen = (fresh ? 0 : (*it)->seen) + views.count();
+  CategoryPtr updated = make_category(id, Label::from(label), seen, std::move(sums), cfg_.count_scale);
+  if (fresh) {
+    next.push_back(std::move(updated));
+  } else {
+    *it = std::move(updated);
+  }
+  cell_->publish(finish(std::move(next), cur.generation + 1, next_id));
+  return id;
+}
+
+Prediction BayesLearner::ask(std::span<const float> descriptor, AskScratch& scratch) const noexcept {
+  const auto snap = cell_->read(scratch.slot_hint);
+  RankedScores ranked(true);
+  if (descriptor.size() != cfg_.descriptor_length) { return RankedScores::wrong_length(snap->generation); }
+  const auto n = static_cast<Eigen::Index>(descriptor.size());
+  const Eigen::Map<const Eigen::VectorXf> x(descriptor.data(), n);
+  const double log_total = std::log(static_cast<double>(snap->total));
+  for (const CategoryPtr& c : snap->categories) {
+    // log P(C_k) + sum_i y_i log P(x_i | C_k) with y_i = count_scale * x_i (thesis, log-likelihood rule).
+    const float dot = x.dot(Eigen::Map<const Eigen::VectorXf>(c->log_p.data(), n));
+    const double score = std::log(static_cast<double>(c->seen)) - log_total +
+                         static_cast<double>(cfg_.count_scale) * static_cast<double>(dot);
+    ranked.offer(static_cast<float>(score), c->id, c->label);
+  }
+  return ranked.prediction(snap->generation);
+}
+
+Result<void, LearnError> BayesLearner::forget(std::string_view label) {
+  const std::lock_guard lock(writer_);
+  const BayesSnapshot& cur = cell_->writer_view();
+  std::vector<CategoryPtr> next = cur.categories;
+  const auto it = std::find_if(next.begin(), next.end(), [&](const CategoryPtr& c) { return c->label.view() == label; });
+  if (it == next.end()) { return err(LearnError::UNKNOWN_LABEL); }
+  next.erase(it);
+  cell_->publish(finish(std::move(next), cur.generation + 1, cur.next_id));
+  return {};
+}
+
+Result<void, LearnError> BayesLearner::restore(std::span<const RestoredCategory> categories, CategoryId next_id) {
+  if (auto r = validate_restored(categories, cfg_.descriptor_length, true); !r) { return err(r.error()); }
+  std::vector<CategoryPtr> next;
+  for (const RestoredCategory& rc : categories) {
+    std::vector<double> sums(rc.accumulators.begin(), rc.accumulators.end());
+    std::uint64_t seen = rc.seen;
+    if (sums.empty()) {
+      sums.assign(cfg_.descriptor_length, 0.0);
+      accumulate_views(rc.views, sums);
+      seen = rc.views.count();
+    }
+    next.push_back(make_category(rc.id, Label::from(rc.label), std::max<std::uint64_t>(seen, 1), std::move(sums),
+                                 cfg_.count_scale));
+    next_id = std::max(next_id, rc.id + 1);
+  }
+  std::sort(next.begin(), next.end(), [](const CategoryPtr& a, const CategoryPtr& b) { return a->id < b->id; });
+  const std::lock_guard lock(writer_);
+  cell_->publish(finish(std::move(next), cell_->writer_view().generation + 1, next_id));
+  return {};
+}
+
+LearnerStats BayesLearner::stats() const noexcept {
+  std::size_t hint = 0;
+  const auto snap = cell_->read(hint);
+  return LearnerStats{snap->categories.size(), static_cast<std::size_t>(snap->total),
+                      snap->categories.size() * cfg_.descriptor_length, snap->generation, cell_->retired_pending()};
+}
+
+std::vector<CategorySummary> BayesLearner::categories() const {
+  std::size_t hint = 0;
+  const auto snap = cell_->read(hint);
+  std::vector<CategorySummary> out;
+  for (const CategoryPtr& c : snap->categories) {
+    out.push_back(CategorySummary{c->id, c->label, static_cast<std::size_t>(c->seen), 0.0F});
+  }
+  return out;
+}
+
+}  // namespace orthoflow::learning

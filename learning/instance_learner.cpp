@@ -1,0 +1,215 @@
+#include "learning/instance_learner.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "kernels/distance.hpp"
+#include "learning/detail/learner_common.hpp"
+#include "learning/snapshot_cell.hpp"
+
+namespace orthoflow::learning {
+
+/// One category: its views as a dims x count structure-of-arrays matrix (stride = count) and the sum of
+/// its pairwise distances, kept so that ICD is updated in O(new views x count) per teach.
+struct InstanceCategory {
+  CategoryId id = NO_CATEGORY;
+  Label label;
+  std::size_t count = 0;
+  std::vector<float> soa;
+  double pair_sum = 0.0;  // sum over unordered pairs {U, V}, U != V, of D(U, V)
+};
+
+struct InstanceSnapshot {
+  std::vector<std::shared_ptr<const InstanceCategory>> categories;  // by id
+  std::vector<float> icd;                                           // ICD in use, parallel to categories
+  float mean_icd = 0.0F;                                            // mean of icd (approach II)
+  std::size_t views = 0;
+  std::uint64_t generation = 0;
+  CategoryId next_id = 0;
+};
+
+struct InstanceLearner::Cell : SnapshotCell<InstanceSnapshot> {
+  using SnapshotCell::SnapshotCell;
+};
+
+namespace {
+
+using CategoryPtr = std::shared_ptr<const InstanceCategory>;
+
+// A new category holding @p base's views followed by @p views; every new view adds its distances to all
+// earlier views to pair_sum (thesis: ICD_n <- ICD(C_n) after C_n <- C_{n-1} U {O_n}).
+CategoryPtr extend(const InstanceCategory& base, DescriptorBatch views, std::size_t dims) {
+  auto c = std::make_shared<InstanceCategory>();
+  c->id = base.id;
+  c->label = base.label;
+  c->count = base.count + views.count();
+  c->pair_sum = base.pair_sum;
+  c->soa.assign(dims * c->count, 0.0F);
+  for (std::size_t d = 0; d < dims; ++d) {
+    std::copy_n(base.soa.begin() + static_cast<std::ptrdiff_t>(d * base.count), base.count,
+                c->soa.begin() + static_cast<std::ptrdiff_t>(d * c->count));
+  }
+  std::vector<float> dist(c->count);
+  for (std::size_t v = 0; v < views.count(); ++v) {
+    const std::span<const float> q = views.view(v);
+    const std::size_t col = base.count + v;
+    for (std::size_t d = 0; d < dims; ++d) { c->soa[d * c->count + col] = q[d]; }
+    const kernels::DescriptorMatrixView earlier{c->soa, dims, col, c->count};
+    kernels::distances(q, earlier, kernels::Metric::L2, dist);
+    for (std::size_t j = 0; j < col; ++j) { c->pair_sum += static_cast<double>(dist[j]); }
+  }
+  return c;
+}
+
+// ICD of every category (rules in instance_learner.hpp), their mean, and the view total.
+std::unique_ptr<InstanceSnapshot> finish(std::vector<CategoryPtr> categories, std::uint64_t generation,
+                                         CategoryId next_id, const InstanceConfig& cfg) {
+  auto s = std::make_unique<InstanceSnapshot>();
+  s->categories = std::move(categories);
+  s->generation = generation;
+  s->next_id = next_id;
+  double defined_sum = 0.0;
+  std::size_t defined = 0;
+  for (const CategoryPtr& c : s->categories) {
+    s->views += c->count;
+    if (c->count >= 2) {
+      const double n = static_cast<double>(c->count);
+      defined_sum += std::max(2.0 * c->pair_sum / (n * (n - 1.0)), static_cast<double>(cfg.min_icd));
+      ++defined;
+    }
+  }
+  const double fallback = defined > 0 ? defined_sum / static_cast<double>(defined) : static_cast<double>(cfg.default_icd);
+  double all_sum = 0.0;
+  for (const CategoryPtr& c : s->categories) {
+    const double n = static_cast<double>(c->count);
+    const double icd = c->count >= 2 ? std::max(2.0 * c->pair_sum / (n * (n - 1.0)), static_cast<double>(cfg.min_icd))
+                                     : fallback;
+    s->icd.push_back(static_cast<float>(icd));
+    all_sum += icd;
+  }
+  s->mean_icd = s->categories.empty() ? cfg.default_icd : static_cast<float>(all_sum / static_cast<double>(s->categories.size()));
+  return s;
+}
+
+// Min (approach I) or mean (approach II) of the L2 distances from @p query to the views of @p c, walked
+// in chunks of the scratch size (thesis eq. OCD, approaches I and II). NaN distances propagate.
+float ocd(std::span<const float> query, const InstanceCategory& c, bool mean, std::span<float> buffer) noexcept {
+  const std::size_t dims = query.size();
+  float min_d = std::numeric_limits<float>::infinity();
+  double sum = 0.0;
+  bool saw_nan = false;
+  for (std::size_t j0 = 0; j0 < c.count; j0 += buffer.size()) {
+    const std::size_t n = std::min(buffer.size(), c.count - j0);
+    const kernels::DescriptorMatrixView chunk{std::span<const float>(c.soa).subspan(j0), dims, n, c.count};
+    kernels::distances(query, chunk, kernels::Metric::L2, buffer.first(n));
+    for (std::size_t j = 0; j < n; ++j) {
+      saw_nan = saw_nan || std::isnan(buffer[j]);
+      min_d = std::min(min_d, buffer[j]);
+      sum += static_cast<double>(buffer[j]);
+    }
+  }
+  if (saw_nan) { return std::numeric_limits<float>::quiet_NaN(); }
+  return mean ? static_cast<float>(sum / static_cast<double>(c.count)) : min_d;
+}
+
+}  // namespace
+
+InstanceLearner::InstanceLearner(const InstanceConfig& cfg) : cfg_(cfg) {
+  OF_ENFORCE(cfg.descriptor_length > 0, "InstanceConfig::descriptor_length must be positive");
+  OF_ENFORCE(cfg.default_icd > 0.0F && std::isfinite(cfg.default_icd), "InstanceConfig::default_icd must be > 0");
+  OF_ENFORCE(cfg.min_icd > 0.0F && std::isfinite(cfg.min_icd), "InstanceConfig::min_icd must be > 0");
+  OF_ENFORCE(!std::isnan(cfg.classification_threshold), "InstanceConfig::classification_threshold is NaN");
+  cell_ = std::make_unique<Cell>(finish({}, 0, 0, cfg_));
+}
+
+InstanceLearner::~InstanceLearner() = default;
+
+Result<CategoryId, LearnError> InstanceLearner::teach(std::string_view label, DescriptorBatch views) {
+  if (auto r = validate_label(label); !r) { return err(r.error()); }
+  if (auto r = validate_batch(views, cfg_.descriptor_length, false); !r) { return err(r.error()); }
+  const std::lock_guard lock(writer_);
+  const InstanceSnapshot& cur = cell_->writer_view();
+  std::vector<CategoryPtr> next = cur.categories;
+  CategoryId next_id = cur.next_id;
+  auto it = std::find_if(next.begin(), next.end(), [&](const CategoryPtr& c) { return c->label.view() == label; });
+  InstanceCategory fresh;
+  if (it == next.end()) {
+    fresh.id = next_id++;
+    fresh.label = Label::from(label);
+  }
+  const CategoryPtr grown = extend(it == next.end() ? fresh : **it, views, cfg_.descriptor_length);
+  if (it == next.end()) {
+    next.push_back(grown);
+  } else {
+    *it = grown;
+  }
+  cell_->publish(finish(std::move(next), cur.generation + 1, next_id, cfg_));
+  return grown->id;
+}
+
+Prediction InstanceLearner::ask(std::span<const float> descriptor, AskScratch& scratch) const noexcept {
+  const auto snap = cell_->read(scratch.slot_hint);
+  RankedScores ranked(false);
+  if (descriptor.size() != cfg_.descriptor_length) { return ranked.wrong_length(snap->generation); }
+  const bool mean = cfg_.normalise && cfg_.approach == NocdApproach::MEAN_DISTANCE;
+  for (std::size_t k = 0; k < snap->categories.size(); ++k) {
+    const InstanceCategory& c = *snap->categories[k];
+    const float o = ocd(descriptor, c, mean, scratch.distances());
+    float score = o;
+    if (cfg_.normalise) {
+      score = cfg_.approach == NocdApproach::MIN_DISTANCE ? o / snap->icd[k] : 2.0F * o / (snap->icd[k] + snap->mean_icd);
+    }
+    ranked.offer(score, c.id, c.label);
+  }
+  Prediction p = ranked.prediction(snap->generation);
+  p.unknown = p.category == NO_CATEGORY || !(p.score <= cfg_.classification_threshold);
+  if (p.unknown) { p.category = NO_CATEGORY; }
+  return p;
+}
+
+Result<void, LearnError> InstanceLearner::forget(std::string_view label) {
+  const std::lock_guard lock(writer_);
+  const InstanceSnapshot& cur = cell_->writer_view();
+  std::vector<CategoryPtr> next = cur.categories;
+  const auto it = std::find_if(next.begin(), next.end(), [&](const CategoryPtr& c) { return c->label.view() == label; });
+  if (it == next.end()) { return err(LearnError::UNKNOWN_LABEL); }
+  next.erase(it);
+  cell_->publish(finish(std::move(next), cur.generation + 1, cur.next_id, cfg_));
+  return {};
+}
+
+Result<void, LearnError> InstanceLearner::restore(std::span<const RestoredCategory> categories, CategoryId next_id) {
+  if (auto r = validate_restored(categories, cfg_.descriptor_length, false); !r) { return err(r.error()); }
+  std::vector<CategoryPtr> next;
+  for (const RestoredCategory& rc : categories) {
+    InstanceCategory base;
+    base.id = rc.id;
+    base.label = Label::from(rc.label);
+    next.push_back(extend(base, rc.views, cfg_.descriptor_length));
+    next_id = std::max(next_id, rc.id + 1);
+  }
+  std::sort(next.begin(), next.end(), [](const CategoryPtr& a, const CategoryPtr& b) { return a->id < b->id; });
+  const std::lock_guard lock(writer_);
+  cell_->publish(finish(std::move(next), cell_->writer_view().generation + 1, next_id, cfg_));
+  return {};
+}
+
+LearnerStats InstanceLearner::stats() const noexcept {
+  std::size_t hint = 0;
+  const auto snap = cell_->read(hint);
+  return LearnerStats{snap->categories.size(), snap->views, snap->views * cfg_.descriptor_length, snap->generation,
+                      cell_->retired_pending()};
+}
+
+std::vector<CategorySummary> InstanceLearner::categories() const {
+  std::size_t hint = 0;
+  const auto snap = cell_->read(hint);
+  std::vector<CategorySummary> out;
+  for (std::size_t k = 0; k < snap->categories.size(); ++k) {
+    const InstanceCategory& c = *snap->categories[k];
+    out.push_back(CategorySummary{c.id, c.label, c.count, snap->icd[k]});
+  }
+  return out;
+}
+
+}  // namespace orthoflow::learning
