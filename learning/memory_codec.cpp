@@ -1,0 +1,210 @@
+#include "learning/detail/memory_codec.hpp"
+
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+namespace orthoflow::learning {
+namespace {
+
+// Values are written with memcpy of native numbers; the format is little-endian (docs/LEARNING.md).
+static_assert(std::endian::native == std::endian::little, "the memory format is little-endian");
+
+constexpr std::uint32_t VIEW_MAGIC = 0x3156464FU;  // "OFV1"
+// Largest descriptor a record may declare (GOOD_MAX_BINS): a corrupt length never triggers a huge allocation.
+constexpr std::size_t MAX_VALUES = 3 * kernels::GOOD_MAX_BINS * kernels::GOOD_MAX_BINS;
+
+class Writer {
+ public:
+  template <class T>
+  Writer& put(const T& v) {
+    const auto* p = reinterpret_cast<const char*>(&v);
+    out_.append(p, sizeof(T));
+    return *this;
+  }
+  template <class T>
+  Writer& put_all(std::span<const T> values) {
+    out_.append(reinterpret_cast<const char*>(values.data()), values.size_bytes());
+    return *this;
+  }
+  std::string take() { return std::move(out_); }
+
+ private:
+  std::string out_;
+};
+
+class Reader {
+ public:
+  explicit Reader(std::string_view bytes) : bytes_(bytes) {}
+  template <class T>
+  bool get(T& v) noexcept {
+    if (bytes_.size() < sizeof(T)) { return false; }
+    std::memcpy(&v, bytes_.data(), sizeof(T));
+    bytes_.remove_prefix(sizeof(T));
+    return true;
+  }
+  template <class T>
+  bool get_all(std::span<T> values) noexcept {
+    if (bytes_.size() < values.size_bytes()) { return false; }
+    std::memcpy(values.data(), bytes_.data(), values.size_bytes());
+    bytes_.remove_prefix(values.size_bytes());
+    return true;
+  }
+  [[nodiscard]] std::size_t left() const noexcept { return bytes_.size(); }
+  [[nodiscard]] std::string_view rest() const noexcept { return bytes_; }
+
+ private:
+  std::string_view bytes_;
+};
+
+void put_be(std::string& key, std::uint64_t v, int bytes) {
+  for (int b = bytes - 1; b >= 0; --b) { key.push_back(static_cast<char>((v >> (8 * b)) & 0xFFU)); }
+}
+
+}  // namespace
+
+std::string category_key(char kind, CategoryId id) {
+  std::string key(1, kind);
+  put_be(key, id, 4);
+  return key;
+}
+
+std::string view_key(CategoryId id, std::uint64_t seq) {
+  std::string key = category_key(KIND_VIEW, id);
+  put_be(key, seq, 8);
+  return key;
+}
+
+std::optional<CategoryId> key_category(std::string_view key) noexcept {
+  if (key.size() < 5) { return std::nullopt; }
+  CategoryId id = 0;
+  for (std::size_t i = 1; i < 5; ++i) { id = (id << 8U) | static_cast<unsigned char>(key[i]); }
+  return id;
+}
+
+std::string StoreParams::describe() const {
+  std::ostringstream s;
+  s << "bins=" << bins << " mode=" << (mode == kernels::GoodMode::INVARIANT ? "invariant" : "reference")
+    << " threshold=" << threshold;
+  return s.str();
+}
+
+StoreParams params_of(const kernels::GoodConfig& cfg) noexcept {
+  return StoreParams{cfg.bins, cfg.mode, cfg.effective_threshold()};
+}
+
+std::string encode_schema(const StoreParams& p) {
+  const nlohmann::json j{{"schema", MEMORY_SCHEMA_VERSION},
+                         {"bins", p.bins},
+                         {"mode", p.mode == kernels::GoodMode::INVARIANT ? "invariant" : "reference"},
+                         {"threshold", p.threshold}};
+  return j.dump();
+}
+
+std::optional<StoreParams> decode_schema(std::string_view json, std::uint32_t& version, std::string& why) {
+  const nlohmann::json j = nlohmann::json::parse(json, nullptr, false);
+  if (j.is_discarded() || !j.is_object()) {
+    why = "not a JSON object";
+    return std::nullopt;
+  }
+  const auto schema = j.find("schema");
+  const auto bins = j.find("bins");
+  const auto mode = j.find("mode");
+  const auto threshold = j.find("threshold");
+  if (schema == j.end() || !schema->is_number_unsigned() || bins == j.end() || !bins->is_number_unsigned() ||
+      mode == j.end() || !mode->is_string() || threshold == j.end() || !threshold->is_number()) {
+    why = "needs unsigned \"schema\" and \"bins\", string \"mode\", number \"threshold\"";
+    return std::nullopt;
+  }
+  const std::string m = mode->get<std::string>();
+  if (m != "invariant" && m != "reference") {
+    why = "mode must be \"invariant\" or \"reference\", not \"" + m + "\"";
+    return std::nullopt;
+  }
+  version = schema->get<std::uint32_t>();
+  return StoreParams{bins->get<std::size_t>(), m == "invariant" ? kernels::GoodMode::INVARIANT : kernels::GoodMode::REFERENCE,
+                     threshold->get<float>()};
+}
+
+std::string encode_category(const CategoryRecord& c) {
+  Writer w;
+  w.put(c.next_seq).put(c.views);
+  std::string out = w.take();
+  return out + c.label;
+}
+
+std::optional<CategoryRecord> decode_category(std::string_view bytes) {
+  Reader r(bytes);
+  CategoryRecord c;
+  if (!r.get(c.next_seq) || !r.get(c.views) || r.left() == 0 || r.left() > LABEL_MAX_BYTES) { return std::nullopt; }
+  c.label = std::string(r.rest());
+  return c;
+}
+
+std::string encode_model(const ModelRecord& m) {
+  Writer w;
+  w.put(m.seen).put(static_cast<std::uint32_t>(m.sums.size())).put_all(std::span<const double>(m.sums));
+  return w.take();
+}
+
+std::optional<ModelRecord> decode_model(std::string_view bytes) {
+  Reader r(bytes);
+  ModelRecord m;
+  std::uint32_t n = 0;
+  if (!r.get(m.seen) || !r.get(n) || n > MAX_VALUES || r.left() != n * sizeof(double)) { return std::nullopt; }
+  m.sums.resize(n);
+  if (!r.get_all(std::span<double>(m.sums))) { return std::nullopt; }
+  return m;
+}
+
+std::string encode_view(const ViewRecord& v, const StoreParams& p) {
+  Writer w;
+  w.put(VIEW_MAGIC).put(static_cast<std::uint32_t>(p.bins)).put(static_cast<std::uint8_t>(p.mode)).put(p.threshold);
+  w.put_all(std::span<const float>(v.frame)).put_all(std::span<const float>(v.bbox));
+  w.put(v.track_id).put(v.stamp_ns).put(static_cast<std::uint32_t>(v.descriptor.size()));
+  w.put_all(std::span<const float>(v.descriptor));
+  return w.take();
+}
+
+std::optional<ViewRecord> decode_view(std::string_view bytes, const StoreParams& expected, std::string& why) {
+  Reader r(bytes);
+  std::uint32_t magic = 0, bins = 0, n = 0;
+  std::uint8_t mode = 0;
+  float threshold = 0.0F;
+  ViewRecord v;
+  if (!r.get(magic) || magic != VIEW_MAGIC) {
+    why = "view record does not start with OFV1";
+    return std::nullopt;
+  }
+  if (!r.get(bins) || !r.get(mode) || !r.get(threshold) || !r.get_all(std::span<float>(v.frame)) ||
+      !r.get_all(std::span<float>(v.bbox)) || !r.get(v.track_id) || !r.get(v.stamp_ns) || !r.get(n)) {
+    why = "view record truncated in its header";
+    return std::nullopt;
+  }
+  const StoreParams got{bins, static_cast<kernels::GoodMode>(mode), threshold};
+  if (!(got == expected) || n != 3 * expected.bins * expected.bins || r.left() != n * sizeof(float)) {
+    why = "view record has " + got.describe() + " and " + std::to_string(n) + " values, store has " +
+          expected.describe();
+    return std::nullopt;
+  }
+  v.descriptor.resize(n);
+  (void)r.get_all(std::span<float>(v.descriptor));
+  return v;
+}
+
+std::string encode_u32(std::uint32_t v) {
+  Writer w;
+  w.put(v);
+  return w.take();
+}
+
+std::optional<std::uint32_t> decode_u32(std::string_view bytes) noexcept {
+  Reader r(bytes);
+  std::uint32_t v = 0;
+  if (!r.get(v) || r.left() != 0) { return std::nullopt; }
+  return v;
+}
+
+}  // namespace orthoflow::learning

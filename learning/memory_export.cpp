@@ -1,0 +1,132 @@
+// Export and import of the perceptual memory as JSON lines (format in docs/LEARNING.md): line 1 is the
+// header with the schema version and the representation parameters, then one line per view.
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "learning/detail/memory_state.hpp"
+#include "learning/perceptual_memory.hpp"
+
+namespace orthoflow::learning {
+namespace {
+
+using Code = MemoryError::Code;
+using nlohmann::json;
+
+json view_line(const std::string& label, const ViewRecord& v) {
+  return json{{"label", label},         {"descriptor", v.descriptor}, {"frame", v.frame},
+              {"bbox", v.bbox},         {"track_id", v.track_id},     {"stamp_ns", v.stamp_ns}};
+}
+
+// Copies exactly @p n finite numbers of array @p j into @p out.
+bool read_floats(const json& j, std::size_t n, std::span<float> out) {
+  if (!j.is_array() || j.size() != n || out.size() != n) { return false; }
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!j[i].is_number()) { return false; }
+    out[i] = j[i].get<float>();
+  }
+  return true;
+}
+
+// One view line; @p why says what is wrong when it returns false.
+bool parse_view(const std::string& line, std::size_t length, std::string& label, ViewRecord& v, std::string& why) {
+  const json j = json::parse(line, nullptr, false);
+  if (j.is_discarded() || !j.is_object()) {
+    why = "not a JSON object";
+    return false;
+  }
+  const auto l = j.find("label");
+  const auto d = j.find("descriptor");
+  const auto f = j.find("frame");
+  const auto b = j.find("bbox");
+  const auto t = j.find("track_id");
+  const auto s = j.find("stamp_ns");
+  if (l == j.end() || !l->is_string() || d == j.end() || f == j.end() || b == j.end() || t == j.end() ||
+      !t->is_number_unsigned() || s == j.end() || !s->is_number_integer()) {
+    why = "needs \"label\", \"descriptor\", \"frame\", \"bbox\", \"track_id\" and \"stamp_ns\"";
+    return false;
+  }
+  label = l->get<std::string>();
+  v.descriptor.resize(length);
+  if (!read_floats(*d, length, v.descriptor) || !read_floats(*f, 16, v.frame) || !read_floats(*b, 3, v.bbox)) {
+    why = "descriptor must hold " + std::to_string(length) + " numbers, frame 16, bbox 3";
+    return false;
+  }
+  v.track_id = t->get<std::uint64_t>();
+  v.stamp_ns = s->get<std::int64_t>();
+  if (auto r = validate_label(label); !r) {
+    why = to_string(r.error());
+    return false;
+  }
+  if (auto r = validate_batch(DescriptorBatch{v.descriptor, length}, length, true); !r) {
+    why = to_string(r.error());
+    return false;
+  }
+  return true;
+}
+
+struct ImportGroup {
+  std::string label;
+  std::vector<ViewRecord> views;
+};
+
+}  // namespace
+
+Result<std::size_t, MemoryError> PerceptualMemory::export_to(const std::filesystem::path& file) const {
+  const State& s = *state_;
+  std::ofstream out(file, std::ios::binary | std::ios::trunc);
+  if (!out) { return err(memory_error(Code::FILE_FAILED, file, "cannot open for writing")); }
+  json header = json::parse(encode_schema(s.params));
+  header["format"] = "orthoflow-memory";
+  header["categories"] = s.index.size();
+  header["views"] = stats().views;
+  out << header.dump() << '\n';
+  std::size_t written = 0;
+  for (const IndexedCategory& c : s.index) {
+    auto views_result = State::read_views(*state_, c.id);
+    if (!views_result) { return err(views_result.error()); }
+    for (const ViewRecord& v : *views_result) {
+      out << view_line(c.record.label, v).dump() << '\n';
+      ++written;
+    }
+  }
+  out.flush();
+  if (!out) { return err(memory_error(Code::FILE_FAILED, file, "write failed")); }
+  return written;
+}
+
+Result<std::size_t, MemoryError> PerceptualMemory::import_from(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) { return err(memory_error(Code::FILE_FAILED, file, "cannot open for reading")); }
+  std::string line;
+  std::uint32_t version = 0;
+  std::string why;
+  const auto params = std::getline(in, line) ? decode_schema(line, version, why) : std::nullopt;
+  if (!params || version != MEMORY_SCHEMA_VERSION || !(*params == state_->params)) {
+    const std::string reason = !params ? (why.empty() ? "empty file" : why)
+                               : version != MEMORY_SCHEMA_VERSION ? "schema version " + std::to_string(version)
+                                                                  : "file has " + params->describe() + ", store has " +
+                                                                        state_->params.describe();
+    return err(memory_error(Code::BAD_IMPORT, file, "line 1: " + reason));
+  }
+  // Everything is parsed and checked before the first teach, so a bad line imports nothing.
+  std::vector<ImportGroup> groups;
+  std::size_t count = 0;
+  for (std::size_t number = 2; std::getline(in, line); ++number) {
+    if (line.empty()) { continue; }
+    std::string label;
+    ViewRecord v;
+    if (!parse_view(line, state_->learner->descriptor_length(), label, v, why)) {
+      return err(memory_error(Code::BAD_IMPORT, file, "line " + std::to_string(number) + ": " + why));
+    }
+    auto g = std::find_if(groups.begin(), groups.end(), [&](const ImportGroup& e) { return e.label == label; });
+    if (g == groups.end()) { g = groups.insert(groups.end(), ImportGroup{label, {}}); }
+    g->views.push_back(std::move(v));
+    ++count;
+  }
+  for (const ImportGroup& g : groups) {
+    if (auto r = teach(g.label, g.views); !r) { return err(r.error()); }
+  }
+  return count;
+}
+
+}  // namespace orthoflow::learning
