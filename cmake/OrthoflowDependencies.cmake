@@ -8,6 +8,7 @@ find_package(TBB CONFIG REQUIRED)
 find_package(yaml-cpp REQUIRED)
 find_package(nlohmann_json 3.10 REQUIRED)
 find_package(CLI11 REQUIRED)
+find_package(iceoryx_posh CONFIG REQUIRED)  # pulls iceoryx_hoofs; C++ standard set per target
 find_package(leveldb CONFIG REQUIRED)
 # Debian 12's leveldb config links "snappy" by name, which needs libsnappy-dev; libleveldb.so already NEEDs libsnappy.so.1.
 set_target_properties(leveldb::leveldb PROPERTIES INTERFACE_LINK_LIBRARIES Threads::Threads)

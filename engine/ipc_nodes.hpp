@@ -1,0 +1,25 @@
+#pragma once
+/// @file
+/// @brief Graph node kinds that cross process boundaries through iceoryx:
+/// - `ipc_publish` (sink): publishes each input block's payload [0, payload_bytes) on `topic`
+///   (one copy, block -> chunk; sources that can write in place use IpcPublisher::loan()).
+/// - `ipc_subscribe` (source): hands each received chunk downstream without copying: the frame's
+///   pool block holds a FrameRef (ipc_frame_ref.hpp) to the chunk, which the node keeps until the
+///   block is released by every reader.
+/// Both register the process with RouDi when the graph is built (an error if none runs).
+#include <string>
+
+#include "engine/ipc_pubsub.hpp"
+#include "engine/registry.hpp"
+
+namespace orthoflow::engine {
+
+/// @brief Payload type of a port type name: "frame" (FrameHeader) or "objects" (ObjectListPayload).
+/// @return an error message for any other name.
+[[nodiscard]] Result<IpcPayloadType, std::string> ipc_payload_type(const std::string& port_type);
+
+/// @brief Registers `ipc_publish` and `ipc_subscribe` (parameters in docs/IPC.md).
+/// @pre Neither kind registered yet. Start-up only.
+void add_ipc_nodes(NodeRegistry& registry);
+
+}  // namespace orthoflow::engine
