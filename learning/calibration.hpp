@@ -31,7 +31,8 @@ enum class CalibrationError : std::uint8_t {
 
 /// @brief Leave-one-out CT for @p cfg (approach, normalisation, ICD rules) over @p categories.
 /// @pre every category's views have cfg.descriptor_length values. @note Allocates (start-up/offline
-/// tool, not the frame path); deterministic; O(V^2 L) for V views of length L.
+/// tool, not the frame path): O(V^2) floats for the distance table and O(V^2 L) time for V views of
+/// length L (2 000 views: 16 MB). Deterministic.
 [[nodiscard]] Result<Calibration, CalibrationError> calibrate_threshold(std::span<const RestoredCategory> categories,
                                                                         const InstanceConfig& cfg);
 
