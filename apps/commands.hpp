@@ -24,5 +24,7 @@ void add_info_command(CLI::App& app);
 /// @brief `segment FILE.pcd`: tabletop plane, objects and per-stage timings; --json, --repeat, PCL-named parameters.
 void add_segment_command(CLI::App& app);
 
+/// @brief `ipc config|doctor|echo|send|run`: operate the iceoryx transport (exit codes 20-22 in docs/IPC.md).
+void add_ipc_command(CLI::App& app);
 
 }  // namespace orthoflow::apps

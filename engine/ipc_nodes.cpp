@@ -40,7 +40,7 @@ class Liveness {
 };
 
 /// Sink: copies each payload once into a loaned chunk and publishes it.
-class IpcPublishNode final : public Node {
+class IpcPublishNode final : public IpcNode {
  public:
   IpcPublishNode(std::unique_ptr<IpcPublisher> publisher, const std::string& type)
       : publisher_(std::move(publisher)), inputs_{{"in", type, true}} {}
@@ -51,19 +51,21 @@ class IpcPublishNode final : public Node {
     if (!liveness_.alive()) return;
     if (in.skipped || !in.payload) return;
     const auto bytes = resolve_frame_bytes(in.payload.bytes());
-    if (!publisher_->publish_copy(bytes)) errors_.fetch_add(1, std::memory_order_relaxed);
+    // Failures (pool exhausted, bad header) are counted in the publisher's counters; no I/O here.
+    auto published = publisher_->publish_copy(bytes);
+    static_cast<void>(published);
   }
-  [[nodiscard]] const IpcPublisher& publisher() const noexcept { return *publisher_; }
+  const std::string& topic() const noexcept override { return publisher_->topic(); }
+  const IpcCounters& ipc_counters() const noexcept override { return publisher_->counters(); }
 
  private:
   std::unique_ptr<IpcPublisher> publisher_;
   std::vector<PortSpec> inputs_;
   Liveness liveness_;
-  std::atomic<std::uint64_t> errors_{0};
 };
 
 /// Source: one frame per received chunk; the frame's block holds a FrameRef to the chunk.
-class IpcSubscribeNode final : public Node {
+class IpcSubscribeNode final : public IpcNode {
  public:
   struct Settings {
     std::int64_t frames = 0;    // END after this many frames (0 = endless)
@@ -82,6 +84,8 @@ class IpcSubscribeNode final : public Node {
   bool stateful() const noexcept override { return true; }
   void process(const Message& /*in*/, Emitter& /*out*/) noexcept override {}
   SourceStatus produce(Message& out) noexcept override;
+  const std::string& topic() const noexcept override { return subscriber_->topic(); }
+  const IpcCounters& ipc_counters() const noexcept override { return subscriber_->counters(); }
 
  private:
   struct Held {

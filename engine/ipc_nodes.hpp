@@ -14,6 +14,16 @@
 
 namespace orthoflow::engine {
 
+/// @brief What every IPC node kind exposes for telemetry: its topic and its counters.
+class IpcNode : public Node {
+ public:
+  /// @brief `service/instance/event`.
+  [[nodiscard]] virtual const std::string& topic() const noexcept = 0;
+  /// @brief Samples, drops (sequence gaps and latest-wins replacements), rejected, loan failures.
+  /// Readable from any thread while the graph runs.
+  [[nodiscard]] virtual const IpcCounters& ipc_counters() const noexcept = 0;
+};
+
 /// @brief Payload type of a port type name: "frame" (FrameHeader) or "objects" (ObjectListPayload).
 /// @return an error message for any other name.
 [[nodiscard]] Result<IpcPayloadType, std::string> ipc_payload_type(const std::string& port_type);

@@ -133,6 +133,7 @@ Result<void, IpcError> IpcPublisher::publish(std::span<std::byte> loaned) noexce
   auto checked = check_payload_header(loaned, config_.type, topic_);
   if (!checked) {
     impl_->publisher.release(loaned.data());
+    counters_.rejected.fetch_add(1, std::memory_order_relaxed);
     return err(checked.error());
   }
   impl_->publisher.publish(loaned.data());
@@ -144,7 +145,10 @@ void IpcPublisher::release(std::span<std::byte> loaned) noexcept { impl_->publis
 
 Result<void, IpcError> IpcPublisher::publish_copy(std::span<const std::byte> payload) noexcept {
   auto checked = check_payload_header(payload, config_.type, topic_);
-  if (!checked) return err(checked.error());
+  if (!checked) {
+    counters_.rejected.fetch_add(1, std::memory_order_relaxed);
+    return err(checked.error());
+  }
   auto chunk = loan(static_cast<std::size_t>(*checked));
   if (!chunk) return err(chunk.error());
   std::memcpy(chunk->data(), payload.data(), chunk->size());

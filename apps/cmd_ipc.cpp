@@ -1,0 +1,248 @@
+// `orthoflow ipc ...`: operate the iceoryx transport (docs/IPC.md). Exit codes beyond commands.hpp:
+// 20 RouDi unreachable, 21 RouDi's pools do not fit the topics, 22 RouDi lost while running.
+#include <csignal>
+#include <cstring>
+#include <unistd.h>
+#include <iostream>
+#include <map>
+#include <thread>
+
+#include "apps/commands.hpp"
+#include "engine/engine.hpp"
+#include "engine/frame_payload.hpp"
+#include "engine/generic_nodes.hpp"
+#include "engine/ipc_nodes.hpp"
+#include "engine/object_list_payload.hpp"
+
+namespace orthoflow::apps {
+
+namespace {
+
+constexpr int EXIT_NO_ROUDI = 20;
+constexpr int EXIT_POOLS = 21;
+constexpr int EXIT_ROUDI_LOST = 22;
+
+std::atomic<bool> stop_flag{false};
+extern "C" void on_signal(int /*sig*/) { stop_flag.store(true); }
+
+[[noreturn]] void fail(int code, const std::string& message) {
+  std::cerr << "orthoflow ipc: " << message << "\n";
+  throw CLI::RuntimeError(code);
+}
+
+int exit_code_of(const engine::IpcError& error) {
+  switch (error.code) {
+    case engine::IpcError::Code::ROUDI_UNREACHABLE: return EXIT_NO_ROUDI;
+    case engine::IpcError::Code::ROUDI_LOST: return EXIT_ROUDI_LOST;
+    case engine::IpcError::Code::NO_FITTING_POOL: return EXIT_POOLS;
+    default: return EXIT_FAILURE_GENERIC;
+  }
+}
+
+template <class T>
+T value_or_fail(Result<T, engine::IpcError>&& result) {
+  if (!result) fail(exit_code_of(result.error()), to_string(result.error()));
+  return std::move(*result);
+}
+
+void start_runtime(const char* role) {
+  auto init = engine::init_ipc_runtime(std::string("orthoflow_") + role + "_" + std::to_string(::getpid()));
+  if (!init) fail(exit_code_of(init.error()), to_string(init.error()));
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);  // RouDi SIGTERMs its apps when it shuts down
+}
+
+engine::NodeRegistry make_ipc_registry() {
+  engine::NodeRegistry registry;
+  engine::add_generic_nodes(registry);
+  engine::add_ipc_nodes(registry);
+  return registry;
+}
+
+/// One demand per IPC node of a graph file: payload bytes and chunks it can hold at once.
+struct Demand {
+  std::string topic;
+  std::uint64_t bytes = 0;
+  std::uint64_t chunks = 0;
+};
+
+std::vector<Demand> demands_of(const std::string& file) {
+  auto spec = engine::load_graph_file(file);
+  if (!spec) fail(EXIT_BAD_INPUT, engine::to_string(spec.error()));
+  std::vector<Demand> demands;
+  for (const auto& node : spec->nodes) {
+    auto get = [&](const char* key, std::int64_t fallback) { return node.params.integer(key, fallback, 0, INT64_MAX); };
+    std::string topic;
+    for (const auto& e : node.params.entries()) topic = e.key == "topic" ? e.value : topic;
+    if (node.kind == "ipc_publish") {
+      // 8 chunks loaned at once at most (iceoryx), plus the publisher's history.
+      const auto bytes = get("max_bytes", static_cast<std::int64_t>(spec->block_bytes));
+      const auto history = get("history", 0);
+      if (!bytes || !history) fail(EXIT_BAD_INPUT, file + ": bad ipc_publish parameter");
+      demands.push_back({topic, static_cast<std::uint64_t>(*bytes), 8 + static_cast<std::uint64_t>(*history)});
+    } else if (node.kind == "ipc_subscribe") {
+      // One chunk per pool block (FrameRef) plus the queue.
+      const auto depth = get("depth", 1);
+      if (!depth) fail(EXIT_BAD_INPUT, file + ": bad ipc_subscribe parameter");
+      demands.push_back({topic, 0, spec->blocks + static_cast<std::uint64_t>(*depth)});
+    }
+  }
+  return demands;
+}
+
+void run_config(const std::vector<std::string>& files) {
+  std::uint64_t held = 0;
+  std::map<std::uint64_t, std::uint64_t> pools;  // payload bytes (64-byte multiple + alignment slack) -> count
+  std::vector<Demand> publishers;
+  for (const auto& file : files) {
+    for (auto& d : demands_of(file)) {
+      if (d.bytes > 0) publishers.push_back(d);
+      else held += d.chunks;  // subscribers hold chunks of every publisher they listen to
+    }
+  }
+  for (const auto& p : publishers) {
+    // Slack for the 64-byte payload alignment inside the chunk (iox::mepoo::ChunkSettings).
+    const std::uint64_t size = (p.bytes + 63) / 64 * 64 + 64;
+    pools[size] += p.chunks + (held > 0 ? held : 16);
+  }
+  std::cout << "# RouDi pools for " << files.size() << " graph file(s); start: iox-roudi -c THIS_FILE\n"
+            << "[general]\nversion = 1\n\n[[segment]]\n\n";
+  std::cout << "[[segment.mempool]]\nsize = 1024\ncount = 64\n";
+  for (const auto& [size, count] : pools) std::cout << "\n[[segment.mempool]]\nsize = " << size << "\ncount = " << count << "\n";
+}
+
+void run_doctor(const std::string& config, const std::vector<std::string>& files) {
+  if (auto probe = engine::probe_roudi(); !probe) fail(EXIT_NO_ROUDI, to_string(probe.error()));
+  std::cout << "RouDi: reachable on " << engine::ROUDI_SOCKET_PATH << "\n";
+  start_runtime("doctor");
+  auto pools = value_or_fail(config.empty() ? engine::query_roudi_pools(std::chrono::milliseconds(3000))
+                                            : engine::load_roudi_pools(config));
+  for (const auto& pool : pools) std::cout << "pool: " << pool.payload_bytes << " B x " << pool.count << "\n";
+  bool ok = true;
+  for (const auto& file : files) {
+    for (const auto& d : demands_of(file)) {
+      if (d.bytes == 0) continue;
+      auto fits = engine::check_pool_fits(pools, d.bytes, engine::PAYLOAD_ALIGNMENT, file + " " + d.topic);
+      std::cout << (fits ? "ok:   " : "FAIL: ") << d.topic << " " << d.bytes << " B"
+                << (fits ? "" : " (" + fits.error().message + ")") << "\n";
+      ok = ok && fits;
+    }
+  }
+  if (!ok) throw CLI::RuntimeError(EXIT_POOLS);
+}
+
+void print_sample(std::span<const std::byte> bytes, std::uint64_t sequence, const std::string& type) {
+  std::cout << "seq " << sequence << " bytes " << bytes.size() << " type " << type;
+  if (type == "frame") {
+    auto frame = engine::view_frame(bytes);
+    if (!frame) {
+      std::cout << " invalid: " << frame.error().to_string() << "\n";
+      return;
+    }
+    const auto& h = *frame->header;
+    std::cout << " frame " << h.frame_id << " " << h.width << "x" << h.height << " sensor_ns " << h.sensor_stamp_ns
+              << " host_ns " << h.host_stamp_ns << "\n";
+    return;
+  }
+  engine::ObjectListPayload list;
+  std::memcpy(static_cast<void*>(&list), bytes.data(), std::min(bytes.size(), sizeof(list)));
+  const auto count = std::min(list.count, engine::OBJECT_LIST_CAPACITY);
+  std::cout << " frame " << list.frame_id << " objects " << count << "\n";
+  for (std::uint32_t i = 0; i < count; ++i) {
+    const auto& o = list.objects[i];
+    std::cout << "  track " << o.track_id << " label " << std::string(o.label, strnlen(o.label, sizeof(o.label)))
+              << " score " << o.score << (o.unknown ? " unknown" : "") << " centroid " << o.centroid[0] << " "
+              << o.centroid[1] << " " << o.centroid[2] << " points " << o.point_count << "\n";
+  }
+}
+
+void run_echo(const std::string& topic_text, const std::string& type, std::uint64_t count, std::int64_t timeout_ms) {
+  auto topic = value_or_fail(engine::parse_topic(topic_text));
+  auto payload_type = engine::ipc_payload_type(type);
+  if (!payload_type) fail(EXIT_USAGE, payload_type.error());
+  start_runtime("echo");
+  engine::IpcSubscriberConfig config{*payload_type, engine::IpcPolicy::QUEUE, 16, 0};
+  auto subscriber = value_or_fail(engine::IpcSubscriber::create(topic, config));
+  std::uint64_t seen = 0;
+  auto last = std::chrono::steady_clock::now();
+  while (!stop_flag.load() && (count == 0 || seen < count)) {
+    auto taken = subscriber->take();
+    if (!taken) {
+      std::cout << "rejected: " << to_string(taken.error()) << std::endl;
+    } else if (taken->has_value()) {
+      print_sample((*taken)->bytes(), (*taken)->sequence(), type);
+      ++seen;
+      last = std::chrono::steady_clock::now();
+      continue;
+    }
+    if (!engine::probe_roudi()) fail(EXIT_ROUDI_LOST, "RouDi lost while echoing " + topic_text);
+    if (timeout_ms > 0 && std::chrono::steady_clock::now() - last > std::chrono::milliseconds(timeout_ms)) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  std::cout << "received " << seen << " dropped " << subscriber->counters().dropped.load() << " rejected "
+            << subscriber->counters().rejected.load() << std::endl;
+}
+
+}  // namespace
+
+void add_ipc_send(CLI::App& ipc);
+void run_ipc_graph(const std::string& file, std::uint64_t frames);
+
+void add_ipc_command(CLI::App& app) {
+  auto* ipc = app.add_subcommand("ipc", "iceoryx transport: config, doctor, echo, send, run (docs/IPC.md)");
+  ipc->require_subcommand(1);
+  auto* config = ipc->add_subcommand("config", "print a RouDi TOML with pools sized for the graphs' topics");
+  static std::vector<std::string> files;
+  config->add_option("graphs", files, "graph YAML files")->required()->check(CLI::ExistingFile);
+  config->callback([] { run_config(files); });
+  auto* doctor = ipc->add_subcommand("doctor", "RouDi reachable? pools fit the graphs' topics? (exit 20/21)");
+  static std::string roudi_config;
+  static std::vector<std::string> doctor_files;
+  doctor->add_option("--config", roudi_config, "RouDi TOML (default: ask RouDi)")->check(CLI::ExistingFile);
+  doctor->add_option("graphs", doctor_files, "graph YAML files")->check(CLI::ExistingFile);
+  doctor->callback([] { run_doctor(roudi_config, doctor_files); });
+  auto* echo = ipc->add_subcommand("echo", "print what flows on TOPIC");
+  static std::string topic, type = "frame";
+  static std::uint64_t count = 0;
+  static std::int64_t timeout_ms = 0;
+  echo->add_option("topic", topic, "service/instance/event")->required();
+  echo->add_option("--type", type, "frame|objects")->check(CLI::IsMember({"frame", "objects"}));
+  echo->add_option("--count", count, "stop after N samples (0 = endless)");
+  echo->add_option("--timeout-ms", timeout_ms, "stop after this long without data (0 = never)");
+  echo->callback([] { run_echo(topic, type, count, timeout_ms); });
+  add_ipc_send(*ipc);
+  auto* run = ipc->add_subcommand("run", "run a graph with the IPC node kinds; exit 22 if RouDi is lost");
+  static std::string graph_file;
+  static std::uint64_t frames = 0;
+  run->add_option("graph", graph_file, "graph YAML")->required()->check(CLI::ExistingFile);
+  run->add_option("--frames", frames, "stop after N frames");
+  run->callback([] { run_ipc_graph(graph_file, frames); });
+}
+
+void run_ipc_graph(const std::string& file, std::uint64_t frames) {
+  if (auto probe = engine::probe_roudi(); !probe) fail(EXIT_NO_ROUDI, to_string(probe.error()));
+  auto spec = engine::load_graph_file(file);
+  if (!spec) fail(EXIT_BAD_INPUT, engine::to_string(spec.error()));
+  const auto registry = make_ipc_registry();
+  auto graph = engine::build_graph(*spec, registry);
+  if (!graph) fail(EXIT_BAD_INPUT, engine::to_string(graph.error()));
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+  engine::Engine engine(**graph, engine::EngineConfig{});
+  engine.run(engine::RunOptions{frames, &stop_flag});
+  std::cout << engine::format_table(engine.stats());
+  for (const auto& node : (*graph)->spec.nodes) {
+    const auto* ipc = dynamic_cast<const engine::IpcNode*>(engine.node(node.name));
+    if (ipc == nullptr) continue;
+    const auto& c = ipc->ipc_counters();
+    std::cout << "ipc " << node.name << " " << ipc->topic() << " samples " << c.samples.load() << " dropped "
+              << c.dropped.load() << " rejected " << c.rejected.load() << " loan_failures " << c.loan_failures.load()
+              << "\n";
+  }
+  std::cout.flush();
+  if (engine::ipc_roudi_lost() || (engine::ipc_runtime_ready() && !engine::probe_roudi())) {
+    fail(EXIT_ROUDI_LOST, "RouDi lost while running " + file);
+  }
+}
+
+}  // namespace orthoflow::apps
