@@ -8,3 +8,32 @@ write_basic_package_version_file(${PROJECT_BINARY_DIR}/orthoflowConfigVersion.cm
   COMPATIBILITY SameMinorVersion)
 install(FILES ${PROJECT_BINARY_DIR}/orthoflowConfig.cmake ${PROJECT_BINARY_DIR}/orthoflowConfigVersion.cmake
   DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/orthoflow)
+
+# Deployment (issue 10, docs/DEPLOY.md): graph files and the systemd unit example, then a Debian package.
+# `cpack -G DEB` in a build tree writes orthoflow_<version>_<arch>.deb: amd64 natively, arm64 from the
+# aarch64 preset. Native builds compute the Depends line with dpkg-shlibdeps; the cross build cannot
+# (dpkg-shlibdeps reads the host's amd64 database), so it lists the Debian 12 runtime packages of every
+# shared library the orthoflow binary links (readelf -d apps/orthoflow; check it when a library is added).
+file(GLOB ORTHOFLOW_GRAPH_FILES ${PROJECT_SOURCE_DIR}/graphs/*.yaml)
+install(FILES ${ORTHOFLOW_GRAPH_FILES} DESTINATION ${CMAKE_INSTALL_DATADIR}/orthoflow/graphs)
+install(FILES ${PROJECT_SOURCE_DIR}/deploy/orthoflow.service DESTINATION ${CMAKE_INSTALL_DATADIR}/orthoflow/deploy)
+
+set(CPACK_GENERATOR DEB)
+set(CPACK_PACKAGE_NAME orthoflow)
+set(CPACK_PACKAGE_VENDOR orthoflow)
+set(CPACK_PACKAGE_CONTACT "orthoflow maintainers <orthoflow@localhost>")
+set(CPACK_PACKAGE_DESCRIPTION_SUMMARY "${PROJECT_DESCRIPTION}: the orthoflow CLI, graph files, static libraries and headers")
+set(CPACK_PACKAGE_VERSION ${PROJECT_VERSION})
+set(CPACK_PACKAGING_INSTALL_PREFIX /usr)
+set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)  # orthoflow_<version>_<arch>.deb
+set(CPACK_DEBIAN_PACKAGE_SECTION science)
+set(CPACK_DEBIAN_PACKAGE_SUGGESTS "iceoryx")
+set(CPACK_STRIP_FILES ON)
+if(CMAKE_CROSSCOMPILING)
+  set(CPACK_DEBIAN_PACKAGE_ARCHITECTURE arm64)
+  set(CPACK_DEBIAN_PACKAGE_DEPENDS
+    "libc6 (>= 2.36), libstdc++6 (>= 12), libgcc-s1, libtbb12, libyaml-cpp0.7, libcairo2, liblzf1, libleveldb1d, libusb-1.0-0")
+else()
+  set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
+endif()
+include(CPack)

@@ -3,6 +3,7 @@
 # toolchains/aarch64-linux-gnu.cmake): the cross compiler, qemu-user-static and the :arm64 multi-arch
 # -dev packages of every library the product, tests and benchmarks link. Idempotent: when everything
 # is present it changes nothing and needs no network. Called by scripts/install_deps.sh.
+# dpkg-dev: dpkg-shlibdeps, which `cpack -G DEB` uses for the native package's Depends line.
 #
 # Two packages cannot be co-installed with their amd64 twins and are unpacked (dpkg-deb -x) under
 # $ARM64_EXTRA instead, which the toolchain file searches:
@@ -12,7 +13,7 @@ set -euo pipefail
 
 ARM64_EXTRA="${ARM64_EXTRA:-/opt/orthoflow-arm64}"
 PACKAGES=(
-  crossbuild-essential-arm64 qemu-user-static
+  crossbuild-essential-arm64 qemu-user-static dpkg-dev
   libtbb-dev:arm64 libxsimd-dev:arm64 libusb-1.0-0-dev:arm64 liblzf-dev:arm64 libcairo2-dev:arm64
   libleveldb-dev:arm64 libyaml-cpp0.7:arm64
   libiceoryx-posh-dev:arm64 libiceoryx-hoofs-dev:arm64

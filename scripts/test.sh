@@ -2,7 +2,10 @@
 # The whole test suite, as CI runs it (.ci/run calls exactly this):
 #   1. release preset: unit, integration and PCL cross-check tests (ctest);
 #   2. asan preset: the same suite under AddressSanitizer + UndefinedBehaviorSanitizer;
-#   3. fuzz preset: every libFuzzer target for FUZZ_SECONDS (default 60) seconds each.
+#   3. fuzz preset: every libFuzzer target for FUZZ_SECONDS (default 60) seconds each;
+#   4. aarch64 preset: cross-built with toolchains/aarch64-linux-gnu.cmake, ctest under qemu, then
+#      `cpack` of the release and aarch64 builds (one check each: orthoflow_<ver>_<arch>.deb).
+#      AARCH64=0 skips the stage.
 # Prints a closing line "tests: N passed, M failed" and exits non-zero on any failure.
 set -uo pipefail
 cd "$(dirname "$0")/.."
@@ -59,8 +62,37 @@ run_fuzzers() {
   done
 }
 
+# check_deb BUILD_DIR ARCH: cpack -G DEB into BUILD_DIR/deb, then the file name and its Architecture field.
+check_deb() {
+  local dir=$1 arch=$2 deb
+  rm -rf "$dir/deb"
+  if ! cpack -G DEB -B "$dir/deb" --config "$dir/CPackConfig.cmake" >"$logdir/cpack_$arch.log" 2>&1; then
+    cat "$logdir/cpack_$arch.log"
+    echo "package $arch: cpack FAILED"
+    failed=$((failed + 1))
+    return
+  fi
+  deb=$(ls "$dir"/deb/orthoflow_*_"$arch".deb 2>/dev/null | head -1)
+  [ -n "$deb" ] && dpkg-deb -c "$deb" >"$logdir/contents_$arch.txt"
+  if [ -n "$deb" ] && [ "$(dpkg-deb -f "$deb" Architecture)" = "$arch" ] && grep -q "/usr/bin/orthoflow$" "$logdir/contents_$arch.txt"; then
+    echo "package $arch: $(basename "$deb") ($(du -k "$deb" | cut -f1) KiB; Depends: $(dpkg-deb -f "$deb" Depends))"
+    passed=$((passed + 1))
+  else
+    echo "package $arch: no orthoflow_*_$arch.deb holding /usr/bin/orthoflow"
+    failed=$((failed + 1))
+  fi
+}
+
+# The aarch64 stage (issue 10): cross build, every test under qemu-aarch64-static, arm64 and amd64 packages.
+run_aarch64() {
+  run_ctest_preset aarch64
+  [ -f build/aarch64/CPackConfig.cmake ] && check_deb build/aarch64 arm64
+  [ -f build/release/CPackConfig.cmake ] && check_deb build/release amd64
+}
+
 for p in $PRESETS; do run_ctest_preset "$p"; done
 if [ "$FUZZ_SECONDS" -gt 0 ]; then run_fuzzers; fi
+if [ "${AARCH64:-1}" != 0 ]; then run_aarch64; fi
 rm -rf "$logdir"
 echo "elapsed: $(( $(date +%s) - start )) s"
 echo "tests: $passed passed, $failed failed"

@@ -134,7 +134,8 @@ nlohmann::json golden_all(const std::string& shared_dir) {
   return {{"generated_on", ok::simd_arch_name()},
           {"scenes", golden_scenes()},
           {"segmentation", golden_segmentation()},
-          {"good", golden_good(shared_dir)}};
+          {"good", golden_good(shared_dir)},
+          {"learning", golden_learning()}};
 }
 
 }  // namespace orthoflow::testing

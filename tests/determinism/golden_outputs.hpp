@@ -13,6 +13,7 @@
 ///   a prism face across it, so plane coefficients, inlier and cluster sizes may differ slightly;
 ///   the object count must be equal.
 /// - GOOD descriptors (15 bins) of the shared real views and of a synthetic object: L1 distance.
+/// - learner decisions: the same label and unknown flag at every step, scores within a relative tolerance.
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -28,6 +29,10 @@ inline constexpr long GOLDEN_CLUSTER_POINTS_TOL = 3;
 /// @brief Largest L1 distance between a GOOD descriptor (sums to 3) and its golden value.
 inline constexpr double GOLDEN_GOOD_L1_TOL = 2e-3;
 
+/// @brief Largest relative difference of a learner's decision score (the descriptors may differ within
+/// GOLDEN_GOOD_L1_TOL, and the distance kernels agree within 1e-5 relative across SIMD widths).
+inline constexpr double GOLDEN_SCORE_REL_TOL = 1e-3;
+
 /// @brief Seeds of the synthetic scenes (6 objects each, as `orthoflow synth --seed S`).
 inline constexpr unsigned long long GOLDEN_SCENE_SEEDS[] = {3, 11};
 
@@ -39,6 +44,9 @@ inline constexpr unsigned long long GOLDEN_SCENE_SEEDS[] = {3, 11};
 /// @brief GOOD descriptors (15 bins, invariant mode) of every view in @p shared_dir/data/objects and of a
 /// rendered synthetic mug; throws std::runtime_error naming the file when a view cannot be read.
 [[nodiscard]] nlohmann::json golden_good(const std::string& shared_dir);
+/// @brief A fixed open-ended sequence on InstanceLearner and BayesLearner (defaults): 4 categories taught one
+/// by one (2 instances x 2 rendered views each), and after each, the decision on 8 held-out views.
+[[nodiscard]] nlohmann::json golden_learning();
 /// @brief Every section above, plus "generated_on" (the dispatched SIMD architecture).
 [[nodiscard]] nlohmann::json golden_all(const std::string& shared_dir);
 

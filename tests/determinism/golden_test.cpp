@@ -79,4 +79,32 @@ TEST_F(Determinism, GoodDescriptorsAgreeWithinL1Tolerance) {
   }
 }
 
+TEST_F(Determinism, LearnerDecisionsAreTheSame) {
+  const json actual = ot::golden_learning();
+  ASSERT_EQ(actual.size(), golden()["learning"].size());
+  for (const auto& [kind, steps] : golden()["learning"].items()) {
+    ASSERT_EQ(actual.at(kind).size(), steps.size()) << kind;
+    for (std::size_t s = 0; s < steps.size(); ++s) {
+      const json& expected = steps[s]["answers"];
+      const json& got = actual[kind][s]["answers"];
+      ASSERT_EQ(got.size(), expected.size());
+      for (std::size_t a = 0; a < expected.size(); ++a) {
+        const std::string where = kind + " after teaching " + steps[s]["taught"].get<std::string>() + ", view " +
+                                  std::to_string(a);
+        EXPECT_EQ(got[a]["label"], expected[a]["label"]) << where;
+        EXPECT_EQ(got[a]["unknown"], expected[a]["unknown"]) << where;
+        EXPECT_EQ(got[a]["runner_up"], expected[a]["runner_up"]) << where;
+        for (const char* key : {"score", "runner_up_score"}) {
+          if (expected[a][key].is_null()) {  // not finite on the reference machine
+            EXPECT_TRUE(got[a][key].is_null()) << where << " " << key;
+            continue;
+          }
+          const double e = expected[a][key].get<double>();
+          EXPECT_NEAR(got[a][key].get<double>(), e, std::fabs(e) * ot::GOLDEN_SCORE_REL_TOL) << where << " " << key;
+        }
+      }
+    }
+  }
+}
+
 }  // namespace
