@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cmath>
 
 namespace orthoflow::engine {
 
@@ -36,6 +37,42 @@ Result<std::int64_t, std::string> ParamMap::integer(const std::string& key, std:
                std::to_string(max) + "]");
   }
   return value;
+}
+
+Result<double, std::string> ParamMap::number(const std::string& key, double fallback, double min,
+                                             double max) const {
+  const Entry* entry = find(key);
+  if (entry == nullptr) return fallback;
+  double value = 0.0;
+  const char* first = entry->value.data();
+  const char* last = first + entry->value.size();
+  const auto [ptr, ec] = std::from_chars(first, last, value);
+  if (ec != std::errc{} || ptr != last || !std::isfinite(value)) {
+    return err(where(*entry) + ": '" + entry->value + "' is not a finite number");
+  }
+  if (value < min || value > max) {
+    return err(where(*entry) + ": " + entry->value + " is outside [" + std::to_string(min) + ", " +
+               std::to_string(max) + "]");
+  }
+  return value;
+}
+
+Result<std::string, std::string> ParamMap::text(const std::string& key, const std::string& fallback) const {
+  const Entry* entry = find(key);
+  if (entry == nullptr) return fallback;
+  if (entry->value.empty()) return err(where(*entry) + ": must not be empty");
+  return entry->value;
+}
+
+void ParamMap::assign(const std::string& key, std::string value) {
+  for (auto& entry : entries_) {
+    if (entry.key == key) {
+      entry.value = std::move(value);
+      entry.line = 0;
+      return;
+    }
+  }
+  entries_.push_back({key, std::move(value), 0});
 }
 
 Result<std::string, std::string> ParamMap::choice(const std::string& key, const std::string& fallback,

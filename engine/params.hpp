@@ -25,6 +25,13 @@ class ParamMap {
   /// @brief Integer in [min, max]; `fallback` if absent. Error: "parameter 'k' (line L): ...".
   [[nodiscard]] Result<std::int64_t, std::string> integer(const std::string& key, std::int64_t fallback,
                                                          std::int64_t min, std::int64_t max) const;
+  /// @brief Finite real number in [min, max]; `fallback` if absent.
+  [[nodiscard]] Result<double, std::string> number(const std::string& key, double fallback, double min,
+                                                   double max) const;
+  /// @brief Free text (a path, a topic); `fallback` if absent. Error if present but empty.
+  [[nodiscard]] Result<std::string, std::string> text(const std::string& key, const std::string& fallback) const;
+  /// @brief Sets `key` to `value`, replacing an existing entry (command-line overrides of a graph file).
+  void assign(const std::string& key, std::string value);
   /// @brief One of `choices`; `fallback` if absent.
   [[nodiscard]] Result<std::string, std::string> choice(const std::string& key, const std::string& fallback,
                                                        const std::vector<std::string>& choices) const;

@@ -1,0 +1,196 @@
+// `orthoflow run`: the tabletop graph end to end on the embedded synthetic session (or a source
+// given on the command line), with learning, and a summary of what it saw, learned and how fast.
+#include <atomic>
+#include <csignal>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <string>
+
+#include "apps/commands.hpp"
+#include "apps/scene_snapshot_png.hpp"
+#include "engine/engine.hpp"
+#include "engine/graph.hpp"
+#include "graphs/embedded_graphs.hpp"
+#include "graphs/tabletop.hpp"
+
+namespace orthoflow::apps {
+
+namespace {
+
+std::atomic<bool> g_run_stop{false};
+extern "C" void on_run_signal(int /*signal*/) { g_run_stop.store(true, std::memory_order_relaxed); }
+
+struct RunOptions {
+  std::string graph;        // empty: the embedded tabletop graph
+  std::string source;       // synthetic:SEED | pcd:DIR
+  std::uint64_t frames = 0;
+  std::string rate;  // empty: the graph's period (30 Hz for tabletop.yaml)
+  std::string db;
+  std::string learner = "instance";
+  float ct = 1.6F;
+  std::string json_out;
+  std::string snapshot;
+  std::string telemetry_json;
+  int threads = 0;
+};
+
+[[noreturn]] void fail(const std::string& message, int code) {
+  std::cerr << "run: " << message << "\n";
+  throw CLI::RuntimeError(code);
+}
+
+engine::NodeSpec* find_kind(engine::GraphSpec& spec, std::string_view kind) {
+  for (auto& node : spec.nodes) {
+    if (node.kind == kind) return &node;
+  }
+  return nullptr;
+}
+
+// Applies --source, --frames and --rate to the graph's source node.
+void override_source(engine::GraphSpec& spec, const RunOptions& o) {
+  engine::NodeSpec* src = find_kind(spec, "synthetic_source");
+  if (src == nullptr) src = find_kind(spec, "pcd_source");
+  if (src == nullptr) {
+    if (!o.source.empty()) fail("--source needs a graph whose source is synthetic_source or pcd_source", EXIT_USAGE);
+    return;
+  }
+  if (o.source.rfind("pcd:", 0) == 0) {
+    src->kind = "pcd_source";
+    src->params = {};
+    src->params.assign("dir", o.source.substr(4));
+  } else if (o.source.rfind("synthetic:", 0) == 0) {
+    src->kind = "synthetic_source";
+    src->params.assign("seed", o.source.substr(10));
+  } else if (!o.source.empty()) {
+    fail("--source must be synthetic:SEED or pcd:DIR, not '" + o.source + "'", EXIT_USAGE);
+  }
+  if (o.frames > 0 && src->kind == "synthetic_source") src->params.assign("frames", std::to_string(o.frames));
+}
+
+// --rate: the engine paces the source at the graph period, which is also each frame's deadline.
+void override_rate(engine::GraphSpec& spec, const std::string& rate) {
+  if (rate.empty()) return;
+  spec.period_ns = rate == "max" ? 0 : static_cast<std::int64_t>(1e9 / std::stod(rate));
+}
+
+graphs::LearningSettings learning_settings(const engine::GraphSpec& spec, const RunOptions& o) {
+  graphs::LearningSettings settings;
+  // The learner must read descriptors of the describe node's shape.
+  for (const auto& node : spec.nodes) {
+    if (node.kind != "describe") continue;
+    auto bins = node.params.integer("bins", 15, 1, graphs::MAX_GOOD_BINS);
+    auto mode = node.params.choice("mode", "invariant", {"invariant", "reference"});
+    if (bins && mode) {
+      settings.memory.descriptor.bins = static_cast<std::size_t>(*bins);
+      settings.memory.descriptor.mode = *mode == "invariant" ? kernels::GoodMode::INVARIANT : kernels::GoodMode::REFERENCE;
+    }
+  }
+  settings.memory.learner = o.learner == "bayes" ? learning::LearnerKind::BAYES : learning::LearnerKind::INSTANCE;
+  settings.memory.instance.classification_threshold = o.ct;
+  if (!o.db.empty()) settings.db = o.db;
+  return settings;
+}
+
+std::string percent(const graphs::Score& s) {
+  char text[64];
+  std::snprintf(text, sizeof text, "%5.1f%% (%llu/%llu)", 100.0 * s.rate(), static_cast<unsigned long long>(s.right),
+                static_cast<unsigned long long>(s.asked));
+  return text;
+}
+
+void print_summary(const graphs::SessionSummary& s, const engine::GraphStats& stats, const graphs::LearningService& l) {
+  std::cout << "frames:      " << s.frames << " processed, " << stats.total_drops() << " dropped ("
+            << stats.source_drops.load() << " at the source), " << s.frames_with_table << " with a table, "
+            << stats.deadline_misses.load() << " over the period\n";
+  std::cout << "objects:     " << s.object_views << " object views, " << s.tracks_started << " tracks, " << s.key_views
+            << " key views\n";
+  std::cout << "recognition: " << s.recognitions << " answers; " << l.teaches() << " views taught";
+  if (!s.taught.empty()) {
+    std::cout << " (";
+    for (std::size_t i = 0; i < s.taught.size(); ++i) std::cout << (i ? ", " : "") << s.taught[i];
+    std::cout << ")";
+  }
+  std::cout << "\n";
+  if (s.before_teaching.asked + s.after_teaching.asked > 0) {
+    std::cout << "accuracy against the ground truth:\n"
+              << "  category not taught yet (Unknown is right): " << percent(s.before_teaching) << "\n"
+              << "  category taught (its label is right):        " << percent(s.after_teaching) << "\n"
+              << "    on instances never taught themselves:      " << percent(s.new_instances) << "\n";
+  }
+}
+
+void run(const RunOptions& o) {
+  auto spec = o.graph.empty() ? engine::parse_graph(std::string(graphs::embedded_tabletop_yaml()), "embedded:tabletop.yaml")
+                              : engine::load_graph_file(o.graph);
+  if (!spec) fail(engine::to_string(spec.error()), EXIT_BAD_INPUT);
+  override_source(*spec, o);
+  override_rate(*spec, o.rate);
+  auto learning = graphs::LearningService::open(learning_settings(*spec, o));
+  if (!learning) fail(learning.error(), EXIT_FAILURE_GENERIC);
+  std::unique_ptr<graphs::LineWriter> json;
+  if (!o.json_out.empty()) {
+    auto writer = graphs::LineWriter::open(o.json_out);
+    if (!writer) fail(writer.error(), EXIT_FAILURE_GENERIC);
+    json = std::move(*writer);
+  }
+  graphs::SessionLog log(std::move(json));
+  const auto registry = graphs::make_tabletop_registry(**learning, log);
+  auto graph = engine::build_graph(*spec, registry);
+  if (!graph) fail(engine::to_string(graph.error()), EXIT_BAD_INPUT);
+  g_run_stop.store(false);
+  auto previous_int = std::signal(SIGINT, on_run_signal);
+  auto previous_term = std::signal(SIGTERM, on_run_signal);
+  engine::Engine engine(**graph, {o.threads});
+  const auto reason = engine.run({o.frames, &g_run_stop});
+  std::signal(SIGINT, previous_int);
+  std::signal(SIGTERM, previous_term);
+  (*learning)->flush();
+  if (log.json() != nullptr) log.json()->flush();
+  std::cout << "orthoflow run: graph '" << (*graph)->spec.name << "'"
+            << (reason == engine::StopReason::STOP_REQUESTED ? " (stopped by signal)" : "") << "\n";
+  print_summary(log.summary(), engine.stats(), **learning);
+  std::cout << engine::format_table(engine.stats());
+  if (log.json() != nullptr && (log.json()->dropped() > 0 || log.json()->failed())) {
+    std::cerr << "run: JSON lines: " << log.json()->dropped() << " lines dropped"
+              << (log.json()->failed() ? ", a write failed" : "") << "\n";
+  }
+  if (!o.telemetry_json.empty()) {
+    auto writer = graphs::LineWriter::open(o.telemetry_json);
+    if (!writer) fail(writer.error(), EXIT_FAILURE_GENERIC);
+    (*writer)->write(engine::to_json(engine.stats()));
+  }
+  if (!o.snapshot.empty()) {
+    if (auto drawn = write_scene_snapshot_png(log.snapshot(), o.snapshot); !drawn) fail(drawn.error(), EXIT_FAILURE_GENERIC);
+    std::cout << "snapshot: " << o.snapshot << "\n";
+  }
+}
+
+}  // namespace
+
+void add_run_command(CLI::App& app) {
+  auto o = std::make_shared<RunOptions>();
+  auto* cmd = app.add_subcommand("run", "Run the tabletop graph (default: the embedded synthetic session) and summarise");
+  cmd->add_option("--graph", o->graph, "graph file (default: the embedded graphs/tabletop.yaml)");
+  cmd->add_option("--source", o->source, "synthetic:SEED or pcd:DIR (default: the graph's source)");
+  cmd->add_option("--frames", o->frames, "stop after N frames (synthetic: session length)");
+  cmd->add_option("--rate", o->rate, "source rate in Hz, or max (no pacing, no deadline); default: the graph's period")->check([](const std::string& v) {
+    if (v == "max") return std::string();
+    try {
+      return std::stod(v) > 0.0 && std::stod(v) <= 1000.0 ? std::string() : std::string("rate must be in (0, 1000] or max");
+    } catch (...) {
+      return std::string("rate must be a number or max");
+    }
+  });
+  cmd->add_option("--db", o->db, "perceptual memory directory (LevelDB); default: learn in memory only");
+  cmd->add_option("--learner", o->learner, "instance or bayes")->check(CLI::IsMember({"instance", "bayes"}));
+  cmd->add_option("--ct", o->ct, "classification threshold on NOCD (instance learner; docs/LEARNING.md)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--json-out", o->json_out, "one JSON line per frame to FILE ('-' = stdout)");
+  cmd->add_option("--snapshot", o->snapshot, "PNG of the last frame with objects, seen from above the table");
+  cmd->add_option("--telemetry-json", o->telemetry_json, "engine telemetry as JSON to FILE");
+  cmd->add_option("--threads", o->threads, "arena threads (0 = all cores)")->check(CLI::Range(0, 1024));
+  cmd->callback([o] { run(*o); });
+}
+
+}  // namespace orthoflow::apps

@@ -1,0 +1,125 @@
+#pragma once
+/// @file
+/// @brief FrameBlock: how one pool block carries a frame through the tabletop graph. The raw frame
+/// (engine/frame_payload.hpp layout) sits at offset 0, so a source fills it in place; every stage
+/// then writes its results into its own region of the same block (nothing is copied between
+/// stages and nothing is allocated). Regions, each 64-byte aligned:
+///   raw frame | FrameState (counts, plane, objects, truth) | voxel centroids | hull | object points
+///   | descriptors.
+/// Capacity (points per frame) follows from the pool's block size: capacity_for(block_bytes).
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string_view>
+
+#include "engine/frame_payload.hpp"
+#include "kernels/cluster_stats.hpp"
+#include "kernels/plane_distance.hpp"
+#include "memory_pool/result.hpp"
+
+namespace orthoflow::graphs {
+
+inline constexpr std::size_t MAX_OBJECTS = 64;      ///< candidate objects kept per frame
+inline constexpr std::size_t MAX_HULL = 2048;       ///< support-polygon vertices kept
+inline constexpr std::size_t MAX_GOOD_BINS = 20;    ///< descriptor room: 3 * 20^2 floats per object
+inline constexpr std::size_t MAX_DESCRIPTOR = 3 * MAX_GOOD_BINS * MAX_GOOD_BINS;
+inline constexpr std::size_t MAX_TRUTH = 64;        ///< ground-truth objects a source can describe
+inline constexpr std::size_t LABEL_CHARS = 64;      ///< label text, NUL-terminated
+
+/// @brief Fixed-capacity text (labels, categories): copying never allocates.
+struct Text {
+  std::array<char, LABEL_CHARS> chars{};
+  [[nodiscard]] std::string_view view() const noexcept;
+  /// @brief Stores @p s, truncated to LABEL_CHARS - 1 bytes.
+  void assign(std::string_view s) noexcept;
+  [[nodiscard]] bool empty() const noexcept { return chars[0] == '\0'; }
+};
+
+/// @brief One ground-truth object of a synthetic or annotated frame (label value -> category).
+struct TruthObject {
+  std::uint32_t label = 0;  ///< per-pixel label value of its points
+  Text category;            ///< empty if the source does not know it
+};
+
+/// @brief Everything the graph learns about one candidate object of a frame.
+struct ObjectRecord {
+  std::uint32_t first = 0;  ///< its points: object_points()[first, first + count)
+  std::uint32_t count = 0;
+  kernels::ClusterStats stats{};
+  std::uint32_t track_id = 0;  ///< 0 until the tracker assigns one
+  bool new_track = false;      ///< the track started with this view
+  bool moving = false;
+  bool key_view = false;       ///< thesis Table 3.1: tracking started, or static again after moving
+  std::uint32_t truth_label = 0;  ///< majority ground-truth label of its points (0 = none)
+  Text truth_category;            ///< category of that ground-truth object, if known
+  // describe
+  bool described = false;
+  std::uint32_t good_flags = 0;
+  std::uint32_t descriptor_length = 0;
+  std::array<float, 16> frame{};  ///< world -> object, row-major (kernels::GoodResult::frame)
+  std::array<float, 3> bbox{};
+  // recognise
+  bool recognised = false;
+  bool unknown = true;
+  Text label;      ///< this frame's answer (smoothed over the track)
+  float score = 0.0F;
+  Text runner_up;
+  bool taught = false;  ///< this view was taught in this frame
+  Text taught_as;       ///< ... under this label
+};
+
+/// @brief Per-frame results of every stage; lives in the block after the raw frame.
+struct FrameState {
+  std::uint32_t truth_count = 0;
+  std::array<TruthObject, MAX_TRUTH> truth{};
+  std::uint32_t kept = 0;    ///< finite points inside the ROI
+  std::uint32_t voxels = 0;  ///< voxel centroids
+  bool table_found = false;
+  kernels::Plane plane{};
+  std::uint32_t plane_inliers = 0;
+  std::uint32_t hull_count = 0;
+  std::uint32_t clusters = 0;        ///< clusters before the candidate constraints
+  std::uint32_t rejected_size = 0;   ///< failed C_size
+  std::uint32_t rejected_edge = 0;   ///< failed C_edge
+  std::uint32_t object_count = 0;    ///< candidates kept in objects
+  std::array<ObjectRecord, MAX_OBJECTS> objects{};
+  Text error;  ///< why a stage produced nothing for this frame (empty = fine)
+};
+
+/// @brief Typed view of one pool block. Cheap to make (pointer arithmetic only).
+class FrameBlock {
+ public:
+  /// @brief Block bytes needed for frames of up to @p capacity points.
+  [[nodiscard]] static std::size_t bytes_for(std::size_t capacity) noexcept;
+  /// @brief Largest capacity a block of @p block_bytes holds (0 if not even one point).
+  [[nodiscard]] static std::size_t capacity_for(std::size_t block_bytes) noexcept;
+  /// @brief Views @p block. @pre block.size() >= bytes_for(capacity), 64-byte aligned (pool blocks are).
+  FrameBlock(std::span<std::byte> block, std::size_t capacity) noexcept;
+
+  /// @brief Where a source writes the raw frame (engine::write_frame / layout_frame).
+  [[nodiscard]] std::span<std::byte> raw() const noexcept { return raw_; }
+  /// @brief The validated raw frame (also resolves a frame held in an IPC chunk).
+  [[nodiscard]] Result<engine::FrameView, engine::FrameError> frame() const noexcept;
+  [[nodiscard]] FrameState& state() const noexcept { return *state_; }
+  [[nodiscard]] kernels::PointsSpan voxels() const noexcept { return voxels_; }
+  [[nodiscard]] std::span<double> hull_u() const noexcept { return hull_u_; }
+  [[nodiscard]] std::span<double> hull_v() const noexcept { return hull_v_; }
+  [[nodiscard]] kernels::PointsSpan object_points() const noexcept { return object_points_; }
+  /// @brief Points of object @p i (after the objects stage).
+  [[nodiscard]] kernels::PointsView object_view(std::size_t i) const noexcept;
+  /// @brief Descriptor room of object @p i (MAX_DESCRIPTOR floats).
+  [[nodiscard]] std::span<float> descriptor(std::size_t i) const noexcept;
+  [[nodiscard]] std::size_t capacity() const noexcept { return capacity_; }
+
+ private:
+  std::span<std::byte> raw_;
+  FrameState* state_ = nullptr;
+  kernels::PointsSpan voxels_;
+  std::span<double> hull_u_, hull_v_;
+  kernels::PointsSpan object_points_;
+  std::span<float> descriptors_;
+  std::size_t capacity_ = 0;
+};
+
+}  // namespace orthoflow::graphs

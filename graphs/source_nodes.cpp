@@ -1,0 +1,170 @@
+#include "graphs/source_nodes.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <new>
+#include <vector>
+
+#include "drivers/object_catalog.hpp"
+#include "drivers/pcd_io.hpp"
+#include "graphs/node_support.hpp"
+#include "graphs/session_script.hpp"
+
+namespace orthoflow::graphs {
+
+namespace {
+
+using engine::Message;
+using engine::ParamMap;
+using Clock = std::chrono::steady_clock;
+
+const engine::PortSpec SOURCE_OUT[] = {FRAME_OUT};
+
+/// Base of the sources: one output port, capacity, the block of each frame. Pacing is the engine's
+/// (the graph period); a source produces as soon as it is asked.
+class FrameSource : public engine::Node {
+ public:
+  FrameSource(std::size_t capacity, const engine::NodeContext& context)
+      : capacity_(capacity), pool_(context.pool), name_(context.name) {}
+  std::span<const engine::PortSpec> inputs() const noexcept override { return {}; }
+  std::span<const engine::PortSpec> outputs() const noexcept override { return SOURCE_OUT; }
+  bool stateful() const noexcept override { return true; }
+  void process(const Message& /*in*/, engine::Emitter& /*out*/) noexcept override {}
+
+ protected:
+  /// Takes a pool block for the next frame; false (frame skipped, counted by the engine as a source
+  /// drop) if the pool is exhausted.
+  bool take_block(Message& out) noexcept {
+    auto block = pool_->acquire(name_, pool_->block_bytes());
+    if (!block) {
+      out.skipped = true;
+      return false;
+    }
+    out.payload = std::move(*block);
+    return true;
+  }
+  /// Writes @p cloud into the message's block and clears the per-frame state.
+  bool emit_cloud(Message& out, const kernels::PointCloud& cloud) noexcept {
+    const FrameBlock block = block_of(out, capacity_);
+    new (&block.state()) FrameState{};  // value-initialised in place: no temporary on the stack
+    if (cloud.size() > capacity_ || !engine::write_frame(block.raw(), cloud)) {
+      ++oversized_;
+      block.state().error.assign("source: frame larger than the pool block holds");
+      return false;
+    }
+    return true;
+  }
+  std::size_t capacity_;
+  memory_pool::BlockPool* pool_;
+  std::string_view name_;
+  std::uint64_t oversized_ = 0;
+};
+
+class SyntheticSource final : public FrameSource {
+ public:
+  SyntheticSource(std::size_t capacity, const engine::NodeContext& context, drivers::SequenceScript script,
+                  std::uint64_t seed)
+      : FrameSource(capacity, context), sequence_(std::move(script), seed) {
+    cloud_.reserve(640 * 480);
+  }
+  engine::SourceStatus produce(Message& out) noexcept override {
+    if (!sequence_.next(cloud_)) return engine::SourceStatus::END;
+    if (!take_block(out)) return engine::SourceStatus::FRAME;
+    cloud_.info.host_stamp_ns = Clock::now().time_since_epoch().count();
+    emit_cloud(out, cloud_);
+    FrameState& s = block_of(out, capacity_).state();
+    const auto& objects = sequence_.scene().objects;
+    s.truth_count = static_cast<std::uint32_t>(std::min(objects.size(), MAX_TRUTH));
+    for (std::uint32_t k = 0; k < s.truth_count; ++k) {
+      s.truth[k].label = drivers::OBJECT_LABEL_BASE + objects[k].id;
+      s.truth[k].category.assign(drivers::category_name(objects[k].model.category));
+    }
+    return engine::SourceStatus::FRAME;
+  }
+
+ private:
+  drivers::SyntheticSequence sequence_;
+  kernels::PointCloud cloud_;
+};
+
+class PcdSource final : public FrameSource {
+ public:
+  PcdSource(std::size_t capacity, const engine::NodeContext& context, std::vector<std::filesystem::path> files,
+            bool loop)
+      : FrameSource(capacity, context), files_(std::move(files)), loop_(loop) {}
+  engine::SourceStatus produce(Message& out) noexcept override {
+    if (next_ == files_.size()) {
+      if (!loop_ || files_.empty()) return engine::SourceStatus::END;
+      next_ = 0;
+    }
+    const std::uint64_t index = frame_++;
+    if (!take_block(out)) return engine::SourceStatus::FRAME;
+    auto cloud = drivers::read_pcd(files_[next_++]);
+    if (!cloud) {  // a bad file is an empty frame with its error, not the end of the run
+      const FrameBlock block = block_of(out, capacity_);
+      (void)engine::write_frame(block.raw(), kernels::PointCloud{});
+      new (&block.state()) FrameState{};
+      block.state().error.assign("pcd_source: " + cloud.error().to_string());
+      return engine::SourceStatus::FRAME;
+    }
+    cloud->info.frame_id = index;
+    if (cloud->info.sensor_stamp_ns == 0) cloud->info.sensor_stamp_ns = static_cast<std::int64_t>(index) * 33'333'333;
+    cloud->info.host_stamp_ns = Clock::now().time_since_epoch().count();
+    emit_cloud(out, *cloud);
+    return engine::SourceStatus::FRAME;
+  }
+
+ private:
+  std::vector<std::filesystem::path> files_;
+  bool loop_;
+  std::size_t next_ = 0;
+  std::uint64_t frame_ = 0;
+};
+
+NodeResult make_synthetic(const ParamMap& params, const engine::NodeContext& context) {
+  auto capacity = frame_capacity(context);
+  if (!capacity) return err(capacity.error());
+  if (auto ok = params.only({"seed", "frames", "objects"}); !ok) return err(ok.error());
+  std::uint64_t seed = 7, frames = SESSION_FRAMES, objects = 0;
+  std::string e;
+  take(params.integer("seed", 7, 0, INT64_MAX), seed, e);
+  take(params.integer("frames", static_cast<std::int64_t>(SESSION_FRAMES), 1, 100'000'000), frames, e);
+  take(params.integer("objects", 0, 0, drivers::MAX_SCENE_OBJECTS), objects, e);
+  if (!e.empty()) return err(e);
+  if (*capacity < 640 * 480) return err("synthetic_source: pool blocks hold " + std::to_string(*capacity) +
+                                        " points, a 640x480 frame needs 307200 (raise pool block_bytes)");
+  auto script = objects == 0 ? make_session_script(frames, seed)
+                             : drivers::make_sequence_script(static_cast<std::uint32_t>(objects), frames, seed);
+  return std::unique_ptr<engine::Node>(new SyntheticSource(*capacity, context, std::move(script), seed));
+}
+
+NodeResult make_pcd(const ParamMap& params, const engine::NodeContext& context) {
+  auto capacity = frame_capacity(context);
+  if (!capacity) return err(capacity.error());
+  if (auto ok = params.only({"dir", "loop"}); !ok) return err(ok.error());
+  std::string dir, e;
+  std::int64_t loop = 0;
+  take(params.text("dir", ""), dir, e);
+  take(params.integer("loop", 0, 0, 1), loop, e);
+  if (!e.empty()) return err(e);
+  std::error_code ec;
+  std::vector<std::filesystem::path> files;
+  for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
+    if (entry.path().extension() == ".pcd") files.push_back(entry.path());
+  }
+  if (ec) return err("pcd_source: cannot list '" + dir + "': " + ec.message());
+  if (files.empty()) return err("pcd_source: no .pcd files in '" + dir + "'");
+  std::sort(files.begin(), files.end());
+  return std::unique_ptr<engine::Node>(new PcdSource(*capacity, context, std::move(files), loop == 1));
+}
+
+}  // namespace
+
+void add_source_nodes(engine::NodeRegistry& registry) {
+  registry.add("synthetic_source", "synthetic Kinect v1 frames: seed, frames, objects (0 = embedded session)",
+               make_synthetic);
+  registry.add("pcd_source", "the .pcd files of a folder in name order: dir, loop=0|1", make_pcd);
+}
+
+}  // namespace orthoflow::graphs

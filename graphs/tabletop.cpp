@@ -1,0 +1,21 @@
+#include "graphs/tabletop.hpp"
+
+#include "graphs/recognise_node.hpp"
+#include "graphs/segment_nodes.hpp"
+#include "graphs/source_nodes.hpp"
+#include "graphs/track_describe_nodes.hpp"
+
+namespace orthoflow::graphs {
+
+engine::NodeRegistry make_tabletop_registry(LearningService& learning, SessionLog& log) {
+  engine::NodeRegistry registry;
+  engine::add_generic_nodes(registry);
+  add_source_nodes(registry);
+  add_segment_nodes(registry);
+  add_track_describe_nodes(registry);
+  add_recognise_node(registry, learning);
+  add_session_log_node(registry, log);
+  return registry;
+}
+
+}  // namespace orthoflow::graphs

@@ -1,0 +1,140 @@
+#include "graphs/track_describe_nodes.hpp"
+
+#include <vector>
+
+#include "graphs/node_support.hpp"
+#include "graphs/tracker.hpp"
+#include "kernels/good.hpp"
+
+namespace orthoflow::graphs {
+
+namespace {
+
+using engine::Emitter;
+using engine::Message;
+using engine::ParamMap;
+
+const engine::PortSpec TRACK_PORTS[] = {FRAME_IN, OBJECT_OUT};
+const engine::PortSpec DESCRIBE_PORTS[] = {OBJECT_IN, OBJECT_OUT};
+
+class Track final : public engine::Node {
+ public:
+  Track(std::size_t capacity, const TrackerParams& params)
+      : capacity_(capacity), tracker_(params), inputs_(MAX_OBJECTS), outputs_(MAX_OBJECTS) {}
+  std::span<const engine::PortSpec> inputs() const noexcept override { return {TRACK_PORTS, 1}; }
+  std::span<const engine::PortSpec> outputs() const noexcept override { return {TRACK_PORTS + 1, 1}; }
+  bool stateful() const noexcept override { return true; }
+
+  void process(const Message& in, Emitter& out) noexcept override {
+    const FrameBlock block = block_of(in, capacity_);
+    FrameState& s = block.state();
+    const std::size_t n = s.object_count;
+    for (std::size_t k = 0; k < n; ++k) {
+      const kernels::ClusterStats& st = s.objects[k].stats;
+      inputs_[k] = TrackInput{block.object_view(k), st.centroid, st.bbox_min, st.bbox_max};
+    }
+    auto frame = block.frame();
+    const std::int64_t stamp = frame ? frame->header->sensor_stamp_ns : in.stamp_ns;
+    tracker_.update(stamp, std::span<const TrackInput>(inputs_).first(n), outputs_);
+    for (std::size_t k = 0; k < n; ++k) {
+      ObjectRecord& o = s.objects[k];
+      o.track_id = outputs_[k].track_id;
+      o.new_track = outputs_[k].new_track;
+      o.moving = outputs_[k].moving;
+      o.key_view = outputs_[k].key_view;
+    }
+    // One message per object (one empty message when there is none, so the join still sees the frame).
+    Message object = in;
+    object.object_count = static_cast<std::uint32_t>(n);
+    for (std::uint32_t k = 0; k < (n == 0 ? 1U : n); ++k) {
+      object.object_index = k;
+      out.emit(0, object);
+    }
+  }
+
+ private:
+  std::size_t capacity_;
+  Tracker tracker_;
+  std::vector<TrackInput> inputs_;
+  std::vector<TrackOutput> outputs_;
+};
+
+class Describe final : public engine::Node {
+ public:
+  Describe(std::size_t capacity, const kernels::GoodConfig& config, std::size_t slots)
+      : capacity_(capacity), config_(config), scratch_(slots * MAX_OBJECTS, kernels::GoodScratch(config.bins)) {}
+  std::span<const engine::PortSpec> inputs() const noexcept override { return {DESCRIBE_PORTS, 1}; }
+  std::span<const engine::PortSpec> outputs() const noexcept override { return {DESCRIBE_PORTS + 1, 1}; }
+  bool stateful() const noexcept override { return false; }
+
+  // Runs concurrently for different objects: each (slot, object) has its own scratch and its own
+  // record and descriptor region in the block, so no two calls touch the same memory.
+  void process(const Message& in, Emitter& out) noexcept override {
+    if (in.object_count > 0 && in.object_index < MAX_OBJECTS) {
+      const FrameBlock block = block_of(in, capacity_);
+      ObjectRecord& o = block.state().objects[in.object_index];
+      kernels::GoodScratch& scratch = scratch_[in.slot * MAX_OBJECTS + in.object_index];
+      auto good = kernels::compute_good(block.object_view(in.object_index), config_, scratch,
+                                        block.descriptor(in.object_index));
+      o.described = good.has_value();
+      if (good) {
+        o.descriptor_length = static_cast<std::uint32_t>(good->length);
+        o.frame = good->frame;
+        o.bbox = good->bbox;
+        o.good_flags = good->flags;
+      }
+    }
+    out.emit(0, in);
+  }
+
+ private:
+  std::size_t capacity_;
+  kernels::GoodConfig config_;
+  std::vector<kernels::GoodScratch> scratch_;
+};
+
+NodeResult make_track(const ParamMap& params, const engine::NodeContext& context) {
+  auto capacity = frame_capacity(context);
+  if (!capacity) return err(capacity.error());
+  if (auto ok = params.only({"min_share", "box_margin", "lost_timeout_s", "moving_speed", "static_frames"}); !ok) {
+    return err(ok.error());
+  }
+  TrackerParams p;
+  p.max_tracks = MAX_OBJECTS;
+  std::string e;
+  take(params.number("min_share", p.min_share, 0.01, 1.0), p.min_share, e);
+  take(params.number("box_margin", p.box_margin, 0.0, 1.0), p.box_margin, e);
+  take(params.number("lost_timeout_s", p.lost_timeout_s, 0.0, 3600.0), p.lost_timeout_s, e);
+  take(params.number("moving_speed", p.moving_speed, 0.0, 10.0), p.moving_speed, e);
+  take(params.integer("static_frames", p.static_frames, 1, 1000), p.static_frames, e);
+  if (!e.empty()) return err(e);
+  return std::unique_ptr<engine::Node>(new Track(*capacity, p));
+}
+
+NodeResult make_describe(const ParamMap& params, const engine::NodeContext& context) {
+  auto capacity = frame_capacity(context);
+  if (!capacity) return err(capacity.error());
+  if (auto ok = params.only({"bins", "mode", "threshold"}); !ok) return err(ok.error());
+  kernels::GoodConfig config;  // thesis: 15 bins; invariant frame by default (docs/GOOD.md)
+  std::string e, mode = "invariant";
+  take(params.integer("bins", 15, 1, MAX_GOOD_BINS), config.bins, e);
+  take(params.choice("mode", "invariant", {"invariant", "reference"}), mode, e);
+  if (params.has("threshold")) {
+    float t = 0.0F;
+    if (take(params.number("threshold", 0.0, 0.0, 1.0), t, e)) config.threshold = t;
+  }
+  if (!e.empty()) return err(e);
+  config.mode = mode == "invariant" ? kernels::GoodMode::INVARIANT : kernels::GoodMode::REFERENCE;
+  return std::unique_ptr<engine::Node>(new Describe(*capacity, config, context.max_in_flight));
+}
+
+}  // namespace
+
+void add_track_describe_nodes(engine::NodeRegistry& registry) {
+  registry.add("track", "tracks objects by box overlap, splits the frame into objects: min_share, box_margin (m), "
+               "lost_timeout_s, moving_speed (m/s), static_frames", make_track);
+  registry.add("describe", "per object, in parallel: GOOD descriptor and object frame: bins, mode, threshold",
+               make_describe);
+}
+
+}  // namespace orthoflow::graphs

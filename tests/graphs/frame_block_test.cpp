@@ -1,0 +1,53 @@
+#include "graphs/frame_block.hpp"
+
+#include <gtest/gtest.h>
+
+#include <memory>
+
+namespace orthoflow::graphs {
+namespace {
+
+TEST(FrameBlock, CapacityIsTheLargestThatFits) {
+  for (std::size_t capacity : {0UL, 1UL, 15UL, 16UL, 17UL, 1000UL, 640UL * 480UL}) {
+    const std::size_t bytes = FrameBlock::bytes_for(capacity);
+    const std::size_t fits = FrameBlock::capacity_for(bytes);
+    EXPECT_GE(fits, capacity);  // alignment padding may leave room for a few more points
+    EXPECT_LE(FrameBlock::bytes_for(fits), bytes);
+    EXPECT_GT(FrameBlock::bytes_for(fits + 1), bytes);
+  }
+  EXPECT_LE(FrameBlock::bytes_for(640 * 480), 15'000'000U);  // graphs/tabletop.yaml's block size
+}
+
+TEST(FrameBlock, RegionsAreAlignedAndDisjoint) {
+  const std::size_t capacity = 1000;
+  const std::size_t bytes = FrameBlock::bytes_for(capacity);
+  auto memory = std::unique_ptr<std::byte[]>(new (std::align_val_t{64}) std::byte[bytes]);
+  const FrameBlock block({memory.get(), bytes}, capacity);
+  const auto* begin = memory.get();
+  const auto* end = begin + bytes;
+  auto inside = [&](const void* p, std::size_t n) {
+    const auto* b = static_cast<const std::byte*>(p);
+    return b >= begin && b + n <= end && reinterpret_cast<std::uintptr_t>(b) % 64 == 0;
+  };
+  EXPECT_TRUE(inside(&block.state(), sizeof(FrameState)));
+  EXPECT_TRUE(inside(block.voxels().z.data(), capacity * 4));
+  EXPECT_TRUE(inside(block.object_points().x.data(), capacity * 4));
+  EXPECT_TRUE(inside(block.descriptor(MAX_OBJECTS - 1).data(), MAX_DESCRIPTOR * 4));
+  EXPECT_LE(reinterpret_cast<const std::byte*>(block.raw().data() + block.raw().size()),
+            reinterpret_cast<const std::byte*>(&block.state()));
+  // the raw region holds a full frame of that capacity with every optional field
+  EXPECT_GE(block.raw().size(), engine::frame_payload_bytes(static_cast<std::uint32_t>(capacity), 1,
+                                                            engine::FRAME_FIELD_RGB | engine::FRAME_FIELD_LABEL));
+}
+
+TEST(FrameBlock, TextTruncatesAndTerminates) {
+  Text t;
+  EXPECT_TRUE(t.empty());
+  t.assign("mug");
+  EXPECT_EQ(t.view(), "mug");
+  t.assign(std::string(200, 'x'));
+  EXPECT_EQ(t.view().size(), LABEL_CHARS - 1);
+}
+
+}  // namespace
+}  // namespace orthoflow::graphs

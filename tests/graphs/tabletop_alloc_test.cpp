@@ -1,0 +1,81 @@
+// Proves that the tabletop graph, after warm-up, performs no operator new per frame: sources,
+// segmentation, tracking, GOOD, recognition (asking a learner that knows categories) and the session
+// log. Learning events are excluded: a teach rebuilds the learner's snapshot (it allocates, once per
+// lesson, by design; docs/TABLETOP.md). oneTBB's own task allocations do not go through operator new
+// (see tests/engine/engine_alloc_test.cpp).
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstdlib>
+#include <chrono>
+#include <new>
+#include <thread>
+#include <vector>
+
+#include "tabletop_run.hpp"
+
+namespace {
+std::atomic<bool> g_counting{false};
+std::atomic<std::uint64_t> g_allocations{0};
+
+void* counted_alloc(std::size_t size, std::size_t align) {
+  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1, std::memory_order_relaxed);
+  if (size == 0) size = 1;
+  void* p = align > alignof(std::max_align_t) ? std::aligned_alloc(align, (size + align - 1) / align * align)
+                                              : std::malloc(size);
+  if (p == nullptr) throw std::bad_alloc();
+  return p;
+}
+}  // namespace
+
+void* operator new(std::size_t size) { return counted_alloc(size, 0); }
+void* operator new[](std::size_t size) { return counted_alloc(size, 0); }
+void* operator new(std::size_t size, std::align_val_t a) { return counted_alloc(size, static_cast<std::size_t>(a)); }
+void* operator new[](std::size_t size, std::align_val_t a) { return counted_alloc(size, static_cast<std::size_t>(a)); }
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+void operator delete(void* p, std::align_val_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::align_val_t) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
+
+namespace orthoflow::graphs {
+namespace {
+
+TEST(TabletopAllocations, SteadyStateAllocatesNothingPerFrame) {
+  auto learning = test::in_memory_learning();
+  // A learner that knows categories, so every ask walks real stored views.
+  std::vector<float> views(3 * 675, 0.0F);
+  for (std::size_t i = 0; i < views.size(); ++i) views[i] = static_cast<float>(i % 7) / 675.0F;
+  ASSERT_TRUE(learning->teach("thing", std::span<const float>(views).first(2 * 675), 0, 0));
+  ASSERT_TRUE(learning->teach("other", std::span<const float>(views).last(675), 0, 0));
+  // a JSON sink too: its writer thread writes to /dev/null
+  auto json = LineWriter::open("/dev/null");
+  ASSERT_TRUE(json);
+  SessionLog log(std::move(*json));
+  const auto registry = make_tabletop_registry(*learning, log);
+  // random scene with 5 objects, instructor off (teaching allocates by design)
+  auto spec = test::tabletop_spec({{"source", {{"objects", "5"}, {"frames", "60"}}}, {"recognise", {{"instructor", "0"}}}});
+  auto graph = engine::build_graph(spec, registry);
+  ASSERT_TRUE(graph) << engine::to_string(graph.error());
+  engine::Engine engine(**graph, {2});
+  // warm-up: 20 frames, then count over the remaining 40
+  std::atomic<bool> stop{false};
+  std::thread arm([&] {
+    while (log.summary().frames < 20 && !stop.load()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    g_counting.store(true);
+  });
+  engine.run({});
+  g_counting.store(false);
+  stop.store(true);
+  arm.join();
+  EXPECT_EQ(log.summary().frames, 60U);
+  EXPECT_GT(log.summary().object_views, 100U);
+  EXPECT_GT(log.summary().recognitions, 100U);
+  EXPECT_EQ(g_allocations.load(), 0U);
+}
+
+}  // namespace
+}  // namespace orthoflow::graphs
