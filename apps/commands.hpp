@@ -23,6 +23,8 @@ void add_synth_command(CLI::App& app);
 void add_info_command(CLI::App& app);
 /// @brief `segment FILE.pcd`: tabletop plane, objects and per-stage timings; --json, --repeat, PCL-named parameters.
 void add_segment_command(CLI::App& app);
+/// @brief `memory --db DIR teach|ask|correct|list|stats|forget|export|import|calibrate`: the perceptual memory.
+void add_memory_command(CLI::App& app);
 
 /// @brief `ipc config|doctor|echo|send|run`: operate the iceoryx transport (exit codes 20-22 in docs/IPC.md).
 void add_ipc_command(CLI::App& app);

@@ -11,6 +11,7 @@ int main(int argc, char** argv) {
   orthoflow::apps::add_synth_command(app);
   orthoflow::apps::add_info_command(app);
   orthoflow::apps::add_segment_command(app);
+  orthoflow::apps::add_memory_command(app);
   orthoflow::apps::add_ipc_command(app);
   app.set_version_flag("--version", ORTHOFLOW_VERSION);
   try {

@@ -136,6 +136,8 @@ Result<PerceptualMemory, MemoryError> PerceptualMemory::open(const std::filesyst
   s->cfg = cfg;
   s->params = params_of(cfg.descriptor);
   s->learner = make_learner(s->cfg);
+  std::error_code ignored;  // LevelDB creates only the last path component; a failure shows up in Open below
+  std::filesystem::create_directories(dir, ignored);
   leveldb::Options options;
   options.create_if_missing = true;
   options.paranoid_checks = true;
