@@ -51,6 +51,7 @@ struct ObjectRecord {
   bool new_track = false;      ///< the track started with this view
   bool moving = false;
   bool key_view = false;       ///< thesis Table 3.1: tracking started, or static again after moving
+  bool fragment = false;       ///< a piece of an object whose main cluster has the same track id
   std::uint32_t truth_label = 0;  ///< majority ground-truth label of its points (0 = none)
   Text truth_category;            ///< category of that ground-truth object, if known
   // describe
@@ -64,6 +65,7 @@ struct ObjectRecord {
   bool unknown = true;
   Text label;      ///< this frame's answer (smoothed over the track)
   float score = 0.0F;
+  Text nearest;    ///< the best category even when the answer is Unknown
   Text runner_up;
   bool taught = false;  ///< this view was taught in this frame
   Text taught_as;       ///< ... under this label

@@ -20,6 +20,13 @@ struct LearningService::Job {
   std::array<float, JOB_VIEWS * MAX_DESCRIPTOR> values{};
 };
 
+learning::MemoryConfig live_session_memory_config() noexcept {
+  learning::MemoryConfig cfg;
+  cfg.instance.normalise = false;
+  cfg.instance.classification_threshold = DEFAULT_NN_THRESHOLD;
+  return cfg;
+}
+
 Result<std::unique_ptr<LearningService>, std::string> LearningService::open(const LearningSettings& settings) {
   std::unique_ptr<LearningService> s(new LearningService());
   learning::MemoryConfig cfg = settings.memory;

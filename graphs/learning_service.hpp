@@ -32,9 +32,17 @@ struct LearningEvent {
   Text label;
 };
 
+/// @brief The live-session default: plain nearest neighbour over GOOD (L2), Unknown beyond this
+/// distance. A category taught from a few views of one still object has an ICD near zero, which makes
+/// the thesis's NOCD explode for every other instance; docs/TABLETOP.md has the measurements.
+inline constexpr float DEFAULT_NN_THRESHOLD = 0.3F;
+
+/// @brief The in-memory learner settings `orthoflow run` starts from (instance-based, plain NN).
+[[nodiscard]] learning::MemoryConfig live_session_memory_config() noexcept;
+
 /// @brief Learner settings of a service.
 struct LearningSettings {
-  learning::MemoryConfig memory;          ///< descriptor parameters, learner kind and its settings
+  learning::MemoryConfig memory = live_session_memory_config();  ///< descriptor, learner kind, settings
   std::optional<std::filesystem::path> db;  ///< durable memory directory; none = in memory only
 };
 

@@ -3,6 +3,7 @@
 // are gathered (a counting sort by cluster) into the block's object-point region so that describe
 // reads each object as one contiguous span.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <vector>
 
@@ -19,7 +20,8 @@ using engine::Emitter;
 using engine::Message;
 
 const engine::PortSpec PORTS[] = {FRAME_IN, FRAME_OUT};
-constexpr std::size_t TRUTH_BINS = 256;  // ground-truth label values counted per object (synthetic: 100 + id)
+constexpr std::size_t TRUTH_BINS = 256;
+constexpr std::size_t MAX_MERGE = 256;   // clusters beyond this are not merged (a cluttered frame)  // ground-truth label values counted per object (synthetic: 100 + id)
 
 struct ObjectParams {
   float h_min = 0.005F, h_max = 0.5F;
@@ -27,6 +29,7 @@ struct ObjectParams {
   float min_size = 0.02F;     // C_size: the largest extent must reach this (m)
   float max_size = 0.5F;      // C_size: every extent at most this (graspable)
   float edge_margin = 0.02F;  // C_edge: centroid at least this far inside the table polygon (m)
+  float merge_overlap = 0.3F; // merge clusters whose footprints overlap by this share of the smaller (0 = off)
 };
 
 // Distance from (u, v) to the nearest edge of a convex polygon (positive inside).
@@ -83,11 +86,56 @@ class Objects final : public engine::Node {
       s.error.assign("objects: clustering failed");
       return;
     }
-    const std::size_t clusters = std::min(*found, stats_.size());
+    std::size_t clusters = std::min(*found, stats_.size());
+    if (p_.merge_overlap > 0.0F) clusters = merge_stacked(target, labels, basis, clusters);
     kernels::cluster_stats(target, labels, moments_, std::span(stats_).first(clusters));
     s.clusters = static_cast<std::uint32_t>(clusters);
     select(block, basis, hu, hv, clusters);
     gather(block, target, labels, organized ? frame.label : std::span<const std::uint32_t>{});
+  }
+
+  // Clusters whose footprints on the table overlap are one object seen in pieces (a bowl's near and far
+  // walls, a mug's rim and body when a depth edge cuts them apart): objects on a table do not overlap
+  // from above. Union-find over the pairs, ids renumbered by lowest member (deterministic).
+  std::size_t merge_stacked(kernels::PointsView target, std::span<std::int32_t> labels, const kernels::PlaneBasis& b,
+                            std::size_t clusters) noexcept {
+    if (clusters < 2 || clusters > MAX_MERGE) return clusters;
+    for (std::size_t c = 0; c < clusters; ++c) foot_[c] = {1e30, -1e30, 1e30, -1e30};
+    for (std::size_t i = 0; i < target.size(); ++i) {
+      if (labels[i] < 0) continue;
+      const double x = target.x[i] - b.origin[0], y = target.y[i] - b.origin[1], z = target.z[i] - b.origin[2];
+      const double u = x * b.u[0] + y * b.u[1] + z * b.u[2], v = x * b.v[0] + y * b.v[1] + z * b.v[2];
+      auto& f = foot_[static_cast<std::size_t>(labels[i])];
+      f = {std::min(f[0], u), std::max(f[1], u), std::min(f[2], v), std::max(f[3], v)};
+    }
+    for (std::size_t c = 0; c < clusters; ++c) root_[c] = static_cast<std::int32_t>(c);
+    for (std::size_t i = 0; i < clusters; ++i) {
+      for (std::size_t j = i + 1; j < clusters; ++j) {
+        const auto &a = foot_[i], &c = foot_[j];
+        const double w = std::min(a[1], c[1]) - std::max(a[0], c[0]), h = std::min(a[3], c[3]) - std::max(a[2], c[2]);
+        const double smaller = std::min((a[1] - a[0]) * (a[3] - a[2]), (c[1] - c[0]) * (c[3] - c[2]));
+        if (w > 0.0 && h > 0.0 && w * h >= p_.merge_overlap * smaller) unite(i, j);
+      }
+    }
+    std::size_t merged = 0;
+    for (std::size_t c = 0; c < clusters; ++c) {
+      const auto r = static_cast<std::size_t>(find(c));
+      new_id_[c] = r == c ? static_cast<std::int32_t>(merged++) : new_id_[r];  // a root is its lowest member
+    }
+    if (merged == clusters) return clusters;
+    for (std::size_t i = 0; i < target.size(); ++i) {
+      if (labels[i] >= 0) labels[i] = new_id_[static_cast<std::size_t>(labels[i])];
+    }
+    return merged;
+  }
+
+  std::int32_t find(std::size_t c) noexcept {
+    while (root_[c] != static_cast<std::int32_t>(c)) c = static_cast<std::size_t>(root_[c] = root_[static_cast<std::size_t>(root_[c])]);
+    return static_cast<std::int32_t>(c);
+  }
+  void unite(std::size_t a, std::size_t b) noexcept {
+    const std::int32_t ra = find(a), rb = find(b);
+    root_[static_cast<std::size_t>(std::max(ra, rb))] = std::min(ra, rb);  // the lowest id stays the root
   }
 
   // C_size and C_edge; survivors get consecutive object slots (cluster order: deterministic).
@@ -171,6 +219,8 @@ class Objects final : public engine::Node {
   std::vector<kernels::ClusterStats> stats_;
   std::vector<std::int32_t> slot_of_;
   std::vector<std::uint32_t> truth_counts_;
+  std::array<std::array<double, 4>, MAX_MERGE> foot_{};  // u_min, u_max, v_min, v_max
+  std::array<std::int32_t, MAX_MERGE> root_{}, new_id_{};
   kernels::ClusterScratch scratch_;
 };
 
@@ -180,7 +230,7 @@ NodeResult make_objects_node(const engine::ParamMap& params, const engine::NodeC
   auto capacity = frame_capacity(context);
   if (!capacity) return err(capacity.error());
   if (auto ok = params.only({"h_min", "h_max", "tolerance", "min_points", "max_points", "pixel_radius", "min_size",
-                             "max_size", "edge_margin"});
+                             "max_size", "edge_margin", "merge_overlap"});
       !ok) {
     return err(ok.error());
   }
@@ -195,6 +245,7 @@ NodeResult make_objects_node(const engine::ParamMap& params, const engine::NodeC
   take(params.number("min_size", p.min_size, 0.0, 10.0), p.min_size, e);
   take(params.number("max_size", p.max_size, 0.0, 10.0), p.max_size, e);
   take(params.number("edge_margin", p.edge_margin, -1.0, 1.0), p.edge_margin, e);
+  take(params.number("merge_overlap", p.merge_overlap, 0.0, 1.0), p.merge_overlap, e);
   if (!e.empty()) return err(e);
   if (p.h_min >= p.h_max) return err(std::string("objects: h_min must be below h_max"));
   return std::unique_ptr<engine::Node>(new Objects(*capacity, p));

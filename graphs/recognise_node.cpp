@@ -71,11 +71,12 @@ class Recognise final : public engine::Node {
 
   void recognise(const FrameBlock& block, std::uint32_t k, std::uint64_t frame) noexcept {
     ObjectRecord& o = block.state().objects[k];
-    if (!o.described || o.descriptor_length != service_.descriptor_length()) return;
+    if (o.fragment || !o.described || o.descriptor_length != service_.descriptor_length()) return;
     const auto prediction = service_.learner().ask(block.descriptor(k).first(o.descriptor_length), scratch_);
     o.recognised = true;
     o.score = prediction.score;
     o.runner_up.assign(prediction.runner_up.view());
+    o.nearest.assign(prediction.label.view());
     Text answer;
     if (!prediction.unknown) answer.assign(prediction.label.view());
     if (o.track_id == 0) {  // untracked: no smoothing

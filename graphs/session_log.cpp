@@ -91,9 +91,10 @@ void SessionLog::write_json(const FrameBlock& block, std::uint64_t frame_id) noe
     if (std::isfinite(o.score)) std::snprintf(score, sizeof score, "%.6g", static_cast<double>(o.score));
     n += static_cast<std::size_t>(std::snprintf(
         out + n, cap - n,
-        R"(%s{"track":%u,"label":%s%.*s%s,"unknown":%s,"score":%s,"truth":"%.*s","points":%u,"centroid":[%.5f,%.5f,%.5f],"bbox":[%.5f,%.5f,%.5f],"frame":[)",
+        R"(%s{"track":%u,"label":%s%.*s%s,"unknown":%s,"score":%s,"nearest":"%.*s","truth":"%.*s","points":%u,"centroid":[%.5f,%.5f,%.5f],"bbox":[%.5f,%.5f,%.5f],"frame":[)",
         k == 0 ? "" : ",", o.track_id, o.unknown || !plain ? "null" : "\"", o.unknown || !plain ? 0 : static_cast<int>(label.size()),
         label.data(), o.unknown || !plain ? "" : "\"", o.unknown ? "true" : "false", score,
+        plain ? static_cast<int>(o.nearest.view().size()) : 0, o.nearest.view().data(),
         static_cast<int>(o.truth_category.view().size()), o.truth_category.view().data(), o.count,
         static_cast<double>(o.stats.centroid[0]), static_cast<double>(o.stats.centroid[1]),
         static_cast<double>(o.stats.centroid[2]), static_cast<double>(o.bbox[0]), static_cast<double>(o.bbox[1]),

@@ -28,16 +28,16 @@ drivers::SequenceScript make_session_script(std::uint64_t frames, std::uint64_t 
   auto bottle = place(Category::BOTTLE, 0, seed, 0.05, -0.15, 0.0);
   bottle.disappear_frame = end1;
   auto bowl = place(Category::BOWL, 0, seed, 0.30, 0.12, 0.0);  // present all session long
-  auto mug2 = place(Category::MUG, 1, seed, -0.05, 0.15, 2.0);
+  auto mug2 = place(Category::MUG, 1, seed, -0.12, 0.15, 2.0);
   mug2.appear_frame = start2;
-  auto bottle2 = place(Category::BOTTLE, 1, seed, -0.30, 0.05, 1.0);
+  auto bottle2 = place(Category::BOTTLE, 1, seed, -0.30, 0.0, 1.0);
   bottle2.appear_frame = start2;
-  auto box = place(Category::BOX, 0, seed, 0.15, -0.15, 0.5);
-  box.appear_frame = start2;
-  s.objects = {mug, bottle, bowl, mug2, bottle2, box};
+  auto plate = place(Category::PLATE, 0, seed, 0.08, 0.03, 0.0);  // never taught: must be Unknown
+  plate.appear_frame = start2;
+  s.objects = {mug, bottle, bowl, mug2, bottle2, plate};
   return s;
 }
 
-bool instructor_teaches(std::string_view category) noexcept { return category != "box"; }
+bool instructor_teaches(std::string_view category) noexcept { return category != "plate"; }
 
 }  // namespace orthoflow::graphs

@@ -17,11 +17,11 @@ inline constexpr std::uint64_t SESSION_FRAMES = 300;
 /// @brief The session script for @p frames frames (phases scale with it). Deterministic in @p seed
 /// (instance shapes and the sensor noise vary with it, the choreography does not).
 /// Phase 1 (first 40%): first instances of mug, bottle and bowl; the mug slides.
-/// Phase 2 (from 45%): second instances of mug and bottle and a first box (never taught) appear;
+/// Phase 2 (from 45%): second instances of mug and bottle and a plate (never taught) appear;
 /// the bowl stays for the whole session.
 [[nodiscard]] drivers::SequenceScript make_session_script(std::uint64_t frames, std::uint64_t seed);
 
-/// @brief True if the scripted instructor teaches this category (all session categories but "box").
+/// @brief True if the scripted instructor teaches this category (all session categories but "plate").
 [[nodiscard]] bool instructor_teaches(std::string_view category) noexcept;
 
 }  // namespace orthoflow::graphs

@@ -42,6 +42,7 @@ class Track final : public engine::Node {
       o.new_track = outputs_[k].new_track;
       o.moving = outputs_[k].moving;
       o.key_view = outputs_[k].key_view;
+      o.fragment = outputs_[k].fragment;
     }
     // One message per object (one empty message when there is none, so the join still sees the frame).
     Message object = in;

@@ -107,14 +107,36 @@ void Tracker::start_track(const TrackInput& in, std::int64_t stamp_ns, TrackOutp
   out.key_view = true;
 }
 
+// nt: the tracks in the share matrix (those that existed before this frame's new tracks).
+bool Tracker::attach_fragment(std::size_t input, std::size_t nt, const TrackInput& in, TrackOutput& out) noexcept {
+  std::size_t best = nt;
+  for (std::size_t t = 0; t < nt; ++t) {
+    if (taken_[t] != 0 && share_[input * nt + t] >= params_.fragment_share &&
+        (best == nt || share_[input * nt + t] > share_[input * nt + best])) {
+      best = t;
+    }
+  }
+  if (best == nt) return false;
+  Track& t = tracks_[best];
+  for (std::size_t a = 0; a < 3; ++a) {
+    t.box_min[a] = std::min(t.box_min[a], in.box_min[a]);
+    t.box_max[a] = std::max(t.box_max[a], in.box_max[a]);
+  }
+  out = TrackOutput{t.id, false, t.moving, false, true};
+  return true;
+}
+
 void Tracker::update(std::int64_t stamp_ns, std::span<const TrackInput> inputs, std::span<TrackOutput> outputs) noexcept {
   inputs = inputs.first(std::min(inputs.size(), MAX_INPUTS));
   match(stamp_ns, inputs);
   for (std::size_t i = 0; i < inputs.size(); ++i) {
     if (pair_[i] >= 0) continue_track(tracks_[static_cast<std::size_t>(pair_[i])], inputs[i], stamp_ns, outputs[i]);
   }
+  const std::size_t continued = tracks_.size();  // new tracks below are not in the share matrix
   for (std::size_t i = 0; i < inputs.size(); ++i) {
-    if (pair_[i] < 0) start_track(inputs[i], stamp_ns, outputs[i]);
+    if (pair_[i] < 0 && !(continued > 0 && attach_fragment(i, continued, inputs[i], outputs[i]))) {
+      start_track(inputs[i], stamp_ns, outputs[i]);
+    }
   }
   // End the tracks not seen for lost_timeout_s (the new ones were just seen).
   const auto timeout = static_cast<std::int64_t>(params_.lost_timeout_s * 1e9);

@@ -22,6 +22,7 @@ namespace orthoflow::graphs {
 /// @brief Tracker settings (start-up).
 struct TrackerParams {
   float min_share = 0.3F;       ///< share of a cluster's points inside a track's box to continue it
+  float fragment_share = 0.6F;  ///< an extra cluster this much inside a continued track's box is a piece of it
   float box_margin = 0.02F;     ///< metres added around a track's box before counting (sensor noise)
   double lost_timeout_s = 1.0;  ///< a track unseen this long ends
   float moving_speed = 0.03F;   ///< m/s of centroid motion above which an object counts as moving
@@ -43,6 +44,7 @@ struct TrackOutput {
   bool new_track = false;
   bool moving = false;
   bool key_view = false;
+  bool fragment = false;  ///< a piece of an object another cluster of this frame continues (same id)
 };
 
 /// @brief Track state. @note Not thread-safe; allocation-free after construction; deterministic.
@@ -69,6 +71,7 @@ class Tracker {
   void match(std::int64_t stamp_ns, std::span<const TrackInput> inputs) noexcept;
   void continue_track(Track& t, const TrackInput& in, std::int64_t stamp_ns, TrackOutput& out) noexcept;
   void start_track(const TrackInput& in, std::int64_t stamp_ns, TrackOutput& out) noexcept;
+  bool attach_fragment(std::size_t input, std::size_t nt, const TrackInput& in, TrackOutput& out) noexcept;
 
   TrackerParams params_;
   std::vector<Track> tracks_;         // capacity max_tracks, reserved once

@@ -34,9 +34,8 @@ inline engine::GraphSpec tabletop_spec(const Overrides& overrides) {
   return *spec;
 }
 
-inline std::unique_ptr<LearningService> in_memory_learning(float ct = 1.6F) {
-  LearningSettings settings;
-  settings.memory.instance.classification_threshold = ct;
+inline std::unique_ptr<LearningService> in_memory_learning() {
+  LearningSettings settings;  // the live-session default: plain NN, CT = DEFAULT_NN_THRESHOLD
   auto service = LearningService::open(settings);
   EXPECT_TRUE(service) << service.error();
   return std::move(*service);
