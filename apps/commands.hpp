@@ -29,4 +29,6 @@ void add_memory_command(CLI::App& app);
 /// @brief `ipc config|doctor|echo|send|run`: operate the iceoryx transport (exit codes 20-22 in docs/IPC.md).
 void add_ipc_command(CLI::App& app);
 
+/// @brief `run`: the tabletop graph on the embedded session or a given source; summary, JSON lines, snapshot.
+void add_run_command(CLI::App& app);
 }  // namespace orthoflow::apps
