@@ -9,12 +9,13 @@
 
 namespace orthoflow::learning {
 
-/// One category: its views as a dims x count structure-of-arrays matrix (stride = count) and the sum of
-/// its pairwise distances, kept so that ICD is updated in O(new views x count) per teach.
+/// One category: its views as a dims x stride structure-of-arrays matrix (columns count..stride are zero)
+/// and the sum of its pairwise distances, kept so that ICD is updated in O(new views x count) per teach.
 struct InstanceCategory {
   CategoryId id = NO_CATEGORY;
   Label label;
   std::size_t count = 0;
+  std::size_t stride = 0;  // count rounded up to COLUMN_PAD: zero columns keep the kernel in its SIMD body
   std::vector<float> soa;
   double pair_sum = 0.0;  // sum over unordered pairs {U, V}, U != V, of D(U, V)
 };
@@ -36,6 +37,11 @@ namespace {
 
 using CategoryPtr = std::shared_ptr<const InstanceCategory>;
 
+// kernels::distances runs SIMD across columns (16 lanes with AVX-512) and finishes with a scalar tail, so a
+// 10-view category would be all tail. Padding columns to a multiple of 16 lets ask() compute the zero
+// columns too and ignore them: 1.6x the arithmetic of a 10-view category, at SIMD speed.
+constexpr std::size_t COLUMN_PAD = 16;
+
 // A new category holding @p base's views followed by @p views; every new view adds its distances to all
 // earlier views to pair_sum (thesis: ICD_n <- ICD(C_n) after C_n <- C_{n-1} U {O_n}).
 CategoryPtr extend(const InstanceCategory& base, DescriptorBatch views, std::size_t dims) {
@@ -43,18 +49,19 @@ CategoryPtr extend(const InstanceCategory& base, DescriptorBatch views, std::siz
   c->id = base.id;
   c->label = base.label;
   c->count = base.count + views.count();
+  c->stride = (c->count + COLUMN_PAD - 1) / COLUMN_PAD * COLUMN_PAD;
   c->pair_sum = base.pair_sum;
-  c->soa.assign(dims * c->count, 0.0F);
+  c->soa.assign(dims * c->stride, 0.0F);
   for (std::size_t d = 0; d < dims; ++d) {
-    std::copy_n(base.soa.begin() + static_cast<std::ptrdiff_t>(d * base.count), base.count,
-                c->soa.begin() + static_cast<std::ptrdiff_t>(d * c->count));
+    std::copy_n(base.soa.begin() + static_cast<std::ptrdiff_t>(d * base.stride), base.count,
+                c->soa.begin() + static_cast<std::ptrdiff_t>(d * c->stride));
   }
   std::vector<float> dist(c->count);
   for (std::size_t v = 0; v < views.count(); ++v) {
     const std::span<const float> q = views.view(v);
     const std::size_t col = base.count + v;
-    for (std::size_t d = 0; d < dims; ++d) { c->soa[d * c->count + col] = q[d]; }
-    const kernels::DescriptorMatrixView earlier{c->soa, dims, col, c->count};
+    for (std::size_t d = 0; d < dims; ++d) { c->soa[d * c->stride + col] = q[d]; }
+    const kernels::DescriptorMatrixView earlier{c->soa, dims, col, c->stride};
     kernels::distances(q, earlier, kernels::Metric::L2, dist);
     for (std::size_t j = 0; j < col; ++j) { c->pair_sum += static_cast<double>(dist[j]); }
   }
@@ -100,8 +107,9 @@ float ocd(std::span<const float> query, const InstanceCategory& c, bool mean, st
   bool saw_nan = false;
   for (std::size_t j0 = 0; j0 < c.count; j0 += buffer.size()) {
     const std::size_t n = std::min(buffer.size(), c.count - j0);
-    const kernels::DescriptorMatrixView chunk{std::span<const float>(c.soa).subspan(j0), dims, n, c.count};
-    kernels::distances(query, chunk, kernels::Metric::L2, buffer.first(n));
+    const std::size_t computed = std::min(buffer.size(), c.stride - j0);  // padding columns when they fit
+    const kernels::DescriptorMatrixView chunk{std::span<const float>(c.soa).subspan(j0), dims, computed, c.stride};
+    kernels::distances(query, chunk, kernels::Metric::L2, buffer.first(computed));
     for (std::size_t j = 0; j < n; ++j) {
       saw_nan = saw_nan || std::isnan(buffer[j]);
       min_d = std::min(min_d, buffer[j]);
