@@ -188,6 +188,9 @@ Result<void, LearnError> InstanceLearner::forget(std::string_view label) {
 
 Result<void, LearnError> InstanceLearner::restore(std::span<const RestoredCategory> categories, CategoryId next_id) {
   if (auto r = validate_restored(categories, cfg_.descriptor_length, false); !r) { return err(r.error()); }
+  for (const RestoredCategory& rc : categories) {
+    if (rc.views.count() == 0) { return err(LearnError::NO_VIEWS); }  // a model alone is not enough here
+  }
   std::vector<CategoryPtr> next;
   for (const RestoredCategory& rc : categories) {
     InstanceCategory base;

@@ -249,6 +249,10 @@ TEST(Learners, EveryLearnErrorIsReported) {
   EXPECT_EQ(instance.restore(twice, 0).error(), LearnError::DUPLICATE_ID);
   const std::vector<RestoredCategory> same_label{{1, "a", batch(v, 2), {}, 1}, {2, "a", batch(v, 2), {}, 1}};
   EXPECT_EQ(bayes.restore(same_label, 0).error(), LearnError::DUPLICATE_ID);
+  const std::vector<double> acc{1.0, 0.0};
+  const std::vector<RestoredCategory> model_only{{1, "a", {}, acc, 1}};
+  EXPECT_EQ(instance.restore(model_only, 0).error(), LearnError::NO_VIEWS);  // instance needs the views
+  EXPECT_TRUE(bayes.restore(model_only, 0));
   EXPECT_EQ(instance.stats().categories, 2U);  // refused restores changed nothing
   EXPECT_STRNE(to_string(LearnError::DUPLICATE_ID), "unknown learn error");
 }
