@@ -124,8 +124,9 @@ struct CategorySummary {
   float spread = 0.0F;  ///< InstanceLearner: ICD in use; BayesLearner: 0
 };
 
-/// @brief An open-ended category learner. Writers are serialised internally; ask() is wait-free for the
-/// snapshot read (bounded retry when more than SNAPSHOT_READER_SLOTS threads ask at once) and lock-free.
+/// @brief An open-ended category learner. Writers are serialised internally by a mutex; ask() takes no
+/// lock: it pins the current snapshot through a hazard slot (it re-reads only if a writer swapped the
+/// snapshot in between, and yields only when more than SNAPSHOT_READER_SLOTS threads ask at once).
 class Learner {
  public:
   virtual ~Learner() = default;
