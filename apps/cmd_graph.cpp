@@ -10,6 +10,7 @@
 #include "engine/engine.hpp"
 #include "engine/graph.hpp"
 #include "engine/registry.hpp"
+#include "graphs/tabletop.hpp"
 
 namespace orthoflow::apps {
 
@@ -22,10 +23,17 @@ static_assert(std::atomic<bool>::is_always_lock_free);
 
 extern "C" void on_stop_signal(int /*signal*/) { g_stop_requested.store(true, std::memory_order_relaxed); }
 
+// Every kind a graph file may name: generic, IPC and tabletop. The tabletop kinds recognise and
+// session_log bind to a learner and a log that live as long as the process (in memory: `graph run`
+// is for running and timing graphs; `orthoflow run` is the command with a durable memory and a summary).
 engine::NodeRegistry make_registry() {
-  engine::NodeRegistry registry;
-  engine::add_generic_nodes(registry);
-  return registry;
+  static auto learning = graphs::LearningService::open({});
+  static graphs::SessionLog log;
+  if (!learning) {
+    std::cerr << learning.error() << "\n";
+    throw CLI::RuntimeError(EXIT_FAILURE_GENERIC);
+  }
+  return graphs::make_tabletop_registry(**learning, log);
 }
 
 std::unique_ptr<engine::Graph> load_or_throw(const std::string& file, const engine::NodeRegistry& registry) {

@@ -1,5 +1,7 @@
 #include "graphs/frame_block.hpp"
 
+#include "engine/ipc_frame_ref.hpp"
+
 #include <algorithm>
 #include <cstring>
 #include <new>
@@ -82,7 +84,11 @@ FrameBlock::FrameBlock(std::span<std::byte> block, std::size_t capacity) noexcep
   descriptors_ = at<float>(base, l.descriptors, MAX_OBJECTS * MAX_DESCRIPTOR);
 }
 
-Result<engine::FrameView, engine::FrameError> FrameBlock::frame() const noexcept { return engine::view_frame(raw_); }
+Result<engine::FrameView, engine::FrameError> FrameBlock::frame() const noexcept {
+  return engine::view_frame(engine::resolve_frame_bytes(raw_));  // in the block, or in an IPC chunk
+}
+
+bool FrameBlock::external() const noexcept { return engine::resolve_frame_bytes(raw_).data() != raw_.data(); }
 
 kernels::PointsView FrameBlock::object_view(std::size_t i) const noexcept {
   const ObjectRecord& o = state_->objects[i];

@@ -103,6 +103,8 @@ class FrameBlock {
   [[nodiscard]] std::span<std::byte> raw() const noexcept { return raw_; }
   /// @brief The validated raw frame (also resolves a frame held in an IPC chunk).
   [[nodiscard]] Result<engine::FrameView, engine::FrameError> frame() const noexcept;
+  /// @brief True if the raw region holds an engine::FrameRef to a frame elsewhere (ipc_subscribe).
+  [[nodiscard]] bool external() const noexcept;
   [[nodiscard]] FrameState& state() const noexcept { return *state_; }
   [[nodiscard]] kernels::PointsSpan voxels() const noexcept { return voxels_; }
   [[nodiscard]] std::span<double> hull_u() const noexcept { return hull_u_; }

@@ -1,6 +1,7 @@
 #include "graphs/segment_nodes.hpp"
 
 #include <algorithm>
+#include <new>
 #include <vector>
 
 #include "graphs/node_support.hpp"
@@ -39,6 +40,8 @@ class Preprocess final : public FrameStage {
 
   void process(const Message& in, Emitter& out) noexcept override {
     const FrameBlock block = block_of(in, capacity_);
+    // Our sources clear the state; a frame that came through IPC (ipc_subscribe) did not meet one.
+    if (block.external()) new (&block.state()) FrameState{};
     FrameState& s = block.state();
     auto frame = block.frame();
     if (!frame) {

@@ -1,5 +1,6 @@
 #include "graphs/tabletop.hpp"
 
+#include "engine/ipc_nodes.hpp"
 #include "graphs/recognise_node.hpp"
 #include "graphs/segment_nodes.hpp"
 #include "graphs/source_nodes.hpp"
@@ -10,6 +11,7 @@ namespace orthoflow::graphs {
 engine::NodeRegistry make_tabletop_registry(LearningService& learning, SessionLog& log) {
   engine::NodeRegistry registry;
   engine::add_generic_nodes(registry);
+  engine::add_ipc_nodes(registry);  // ipc_subscribe / ipc_publish: graphs split across processes
   add_source_nodes(registry);
   add_segment_nodes(registry);
   add_track_describe_nodes(registry);
