@@ -156,12 +156,23 @@ void print_sample(std::span<const std::byte> bytes, std::uint64_t sequence, cons
   }
 }
 
-void run_echo(const std::string& topic_text, const std::string& type, std::uint64_t count, std::int64_t timeout_ms) {
+struct EchoArgs {
+  std::string topic, type = "frame", policy = "queue";
+  std::uint64_t count = 0, depth = 16;
+  std::int64_t timeout_ms = 0, process_ms = 0;  ///< process_ms: simulated work per sample (slow consumer)
+};
+
+void run_echo(const EchoArgs& a) {
+  const std::string& topic_text = a.topic;
+  const std::string& type = a.type;
+  const std::uint64_t count = a.count;
+  const std::int64_t timeout_ms = a.timeout_ms;
   auto topic = value_or_fail(engine::parse_topic(topic_text));
   auto payload_type = engine::ipc_payload_type(type);
   if (!payload_type) fail(EXIT_USAGE, payload_type.error());
   start_runtime("echo");
-  engine::IpcSubscriberConfig config{*payload_type, engine::IpcPolicy::QUEUE, 16, 0};
+  engine::IpcSubscriberConfig config{*payload_type, a.policy == "latest" ? engine::IpcPolicy::LATEST : engine::IpcPolicy::QUEUE,
+                                     a.depth, 0};
   auto subscriber = value_or_fail(engine::IpcSubscriber::create(topic, config));
   std::uint64_t seen = 0;
   auto last = std::chrono::steady_clock::now();
@@ -172,6 +183,7 @@ void run_echo(const std::string& topic_text, const std::string& type, std::uint6
     } else if (taken->has_value()) {
       print_sample((*taken)->bytes(), (*taken)->sequence(), type);
       ++seen;
+      if (a.process_ms > 0) std::this_thread::sleep_for(std::chrono::milliseconds(a.process_ms));
       last = std::chrono::steady_clock::now();
       continue;
     }
@@ -202,14 +214,16 @@ void add_ipc_command(CLI::App& app) {
   doctor->add_option("graphs", doctor_files, "graph YAML files")->check(CLI::ExistingFile);
   doctor->callback([] { run_doctor(roudi_config, doctor_files); });
   auto* echo = ipc->add_subcommand("echo", "print what flows on TOPIC");
-  static std::string topic, type = "frame";
-  static std::uint64_t count = 0;
-  static std::int64_t timeout_ms = 0;
-  echo->add_option("topic", topic, "service/instance/event")->required();
-  echo->add_option("--type", type, "frame|objects")->check(CLI::IsMember({"frame", "objects"}));
-  echo->add_option("--count", count, "stop after N samples (0 = endless)");
-  echo->add_option("--timeout-ms", timeout_ms, "stop after this long without data (0 = never)");
-  echo->callback([] { run_echo(topic, type, count, timeout_ms); });
+  static EchoArgs echo_args;
+  echo->add_option("topic", echo_args.topic, "service/instance/event")->required();
+  echo->add_option("--type", echo_args.type, "frame|objects")->check(CLI::IsMember({"frame", "objects"}));
+  echo->add_option("--count", echo_args.count, "stop after N samples (0 = endless)");
+  echo->add_option("--timeout-ms", echo_args.timeout_ms, "stop after this long without data (0 = never)");
+  echo->add_option("--policy", echo_args.policy, "latest|queue")->check(CLI::IsMember({"latest", "queue"}));
+  echo->add_option("--depth", echo_args.depth, "queue depth (policy queue)")->check(CLI::Range(1, 256));
+  echo->add_option("--process-ms", echo_args.process_ms, "pause after each sample (simulates a slow consumer)")
+      ->check(CLI::Range(0, 10000));
+  echo->callback([] { run_echo(echo_args); });
   add_ipc_send(*ipc);
   auto* run = ipc->add_subcommand("run", "run a graph with the IPC node kinds; exit 22 if RouDi is lost");
   static std::string graph_file;

@@ -21,6 +21,7 @@ struct SendArgs {
   std::uint64_t history = 0;
   std::uint64_t max_bytes = 0;          ///< 0 = this frame's size
   std::string roudi_config;             ///< RouDi TOML; empty = ask RouDi
+  std::int64_t wait_subscribers_ms = 0; ///< wait this long for a subscriber before sending (0 = no wait)
 };
 
 std::atomic<bool> send_stop{false};
@@ -39,6 +40,19 @@ void fill_frame(std::span<std::byte> chunk, const SendArgs& a, std::uint64_t k) 
     span->points.x[i] = static_cast<float>(k + i);
     span->points.y[i] = static_cast<float>(2 * i);
     span->points.z[i] = static_cast<float>(3 * i);
+  }
+}
+
+// Waits (bounded) until a subscriber is connected, so that scripted receivers see every frame.
+void wait_for_subscribers(const engine::IpcPublisher& publisher, std::int64_t wait_ms) {
+  const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(wait_ms);
+  while (wait_ms > 0 && !publisher.has_subscribers() && !send_stop.load()) {
+    if (std::chrono::steady_clock::now() > until) {
+      std::cerr << "orthoflow ipc send: no subscriber on " << publisher.topic() << " within " << wait_ms << " ms\n";
+      throw CLI::RuntimeError(EXIT_FAILURE_GENERIC);
+    }
+    if (!engine::probe_roudi()) throw (std::cerr << "orthoflow ipc send: RouDi lost\n", CLI::RuntimeError(22));
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
   }
 }
 
@@ -62,6 +76,7 @@ int send(const SendArgs& a) {
     std::cerr << "orthoflow ipc send: " << to_string(publisher.error()) << "\n";
     throw CLI::RuntimeError(publisher.error().code == engine::IpcError::Code::NO_FITTING_POOL ? 21 : 1);
   }
+  wait_for_subscribers(**publisher, a.wait_subscribers_ms);
   std::uint64_t failures = 0;
   for (std::uint64_t k = 0; k < a.frames && !send_stop.load(); ++k) {
     if (!engine::probe_roudi()) {
@@ -96,6 +111,8 @@ void add_ipc_send(CLI::App& ipc) {
   cmd->add_option("--history", args.history, "samples kept for late subscribers")->check(CLI::Range(0, 16));
   cmd->add_option("--max-bytes", args.max_bytes, "largest payload to check against the pools");
   cmd->add_option("--config", args.roudi_config, "RouDi TOML the pools come from (default: ask RouDi)");
+  cmd->add_option("--wait-subscribers-ms", args.wait_subscribers_ms, "wait for a subscriber first (exit 1 on timeout)")
+      ->check(CLI::Range(0, 60000));
   cmd->callback([] { send(args); });
 }
 
