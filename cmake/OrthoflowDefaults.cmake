@@ -10,6 +10,11 @@ function(orthoflow_target_defaults tgt)
     # GCC 12 at -O3 reports -Wrestrict inside libstdc++'s std::string concatenation (GCC bug 105651).
     target_compile_options(${tgt} PRIVATE -Wno-restrict)
   endif()
+  if(CMAKE_SYSTEM_PROCESSOR MATCHES "^(aarch64|arm64|ARM64)$")
+    # Same results as x86-64: no fused multiply-add contraction of scalar code (toolchains/README.md);
+    # also for native builds on an ARM board, which do not use the cross toolchain file.
+    target_compile_options(${tgt} PRIVATE -ffp-contract=off)
+  endif()
 endfunction()
 
 # orthoflow_add_library(folder SOURCES ... [PUBLIC_LIBS ...] [PRIVATE_LIBS ...])

@@ -2,7 +2,7 @@
 
 #include <gtest/gtest.h>
 
-#include <memory>
+#include <vector>
 
 namespace orthoflow::graphs {
 namespace {
@@ -21,9 +21,13 @@ TEST(FrameBlock, CapacityIsTheLargestThatFits) {
 TEST(FrameBlock, RegionsAreAlignedAndDisjoint) {
   const std::size_t capacity = 1000;
   const std::size_t bytes = FrameBlock::bytes_for(capacity);
-  auto memory = std::unique_ptr<std::byte[]>(new (std::align_val_t{64}) std::byte[bytes]);
-  const FrameBlock block({memory.get(), bytes}, capacity);
-  const auto* begin = memory.get();
+  struct alignas(64) Line {
+    std::byte b[64];
+  };
+  std::vector<Line> lines((bytes + 63) / 64);
+  auto* memory = reinterpret_cast<std::byte*>(lines.data());
+  const FrameBlock block({memory, bytes}, capacity);
+  const auto* begin = memory;
   const auto* end = begin + bytes;
   auto inside = [&](const void* p, std::size_t n) {
     const auto* b = static_cast<const std::byte*>(p);
