@@ -5,8 +5,11 @@
 
 #include <cstdio>
 #include <regex>
+#include <thread>
 
 #include "engine/frame_payload.hpp"
+#include "engine/ipc_pubsub.hpp"
+#include "engine/ipc_runtime.hpp"
 #include "tests/ipc/roudi_sandbox.hpp"
 
 namespace orthoflow::tests {
@@ -166,6 +169,56 @@ TEST(IpcCli, NoFittingPoolIsExit21NotAnAbort) {
                     (args.size() > big.size() ? "the TOML file" : "RouDi's introspection"),
                 p);
     }
+  });
+}
+
+TEST(IpcCli, PoolExhaustionIsAnErrorNotAnAbort) {
+  RUN_ISOLATED([](Sandbox& box) {
+    if (box.start_roudi() < 0) return;
+    auto runtime = engine::init_ipc_runtime("exhaust_test");
+    box.check(runtime.has_value(), "init_ipc_runtime with RouDi up");
+    auto pools = engine::load_roudi_pools(CONFIG);
+    box.check(pools.has_value(), "pools of roudi_test.toml");
+    if (!runtime || !pools) return;
+    // 60000-byte payloads only fit the 32 chunks of 64 KiB; iceoryx lets one publisher hold 8 at a
+    // time, so five publishers holding every loan they get run the pool dry.
+    std::vector<std::unique_ptr<engine::IpcPublisher>> publishers;
+    std::size_t held = 0, exhausted = 0, too_many = 0;
+    for (int p = 0; p < 5; ++p) {
+      auto topic = engine::parse_topic("orthoflow/exhaust/t" + std::to_string(p));
+      auto publisher = engine::IpcPublisher::create(*topic, {{engine::FRAME_TYPE_ID, engine::FRAME_VERSION}, 60000},
+                                                    *pools);
+      box.check(publisher.has_value(), "publisher " + std::to_string(p));
+      if (!publisher) return;
+      for (int k = 0; k < 12; ++k) {
+        auto loan = (*publisher)->loan(60000);
+        if (loan) {
+          ++held;  // kept: returned when the publisher goes away
+        } else {
+          exhausted += loan.error().code == engine::IpcError::Code::POOL_EXHAUSTED ? 1U : 0U;
+          too_many += loan.error().code == engine::IpcError::Code::TOO_MANY_LOANS ? 1U : 0U;
+        }
+      }
+      publishers.push_back(std::move(*publisher));
+    }
+    box.check(held == 32, "every chunk of the 64 KiB pool loaned once (" + std::to_string(held) + ")");
+    box.check(exhausted > 0, "POOL_EXHAUSTED once the pool is empty");
+    box.check(too_many > 0, "TOO_MANY_LOANS past a publisher's limit");
+    // Destroyed publishers give their chunks back when RouDi's discovery loop removes their ports
+    // (asynchronously, every ~100 ms in 2.0.3): a new loan succeeds within a bounded wait.
+    publishers.clear();
+    auto topic = engine::parse_topic("orthoflow/exhaust/again");
+    auto again = engine::IpcPublisher::create(*topic, {{engine::FRAME_TYPE_ID, engine::FRAME_VERSION}, 60000}, *pools);
+    bool loaned = false;
+    for (int attempt = 0; again && attempt < 60 && !loaned; ++attempt) {
+      if (auto loan = (*again)->loan(60000)) {
+        loaned = true;
+        (*again)->release(*loan);
+      } else {
+        std::this_thread::sleep_for(50ms);
+      }
+    }
+    box.check(loaned, "a loan succeeds within 3 s after the holders released theirs");
   });
 }
 
