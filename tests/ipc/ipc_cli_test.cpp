@@ -4,7 +4,6 @@
 #include <signal.h>
 
 #include <cstdio>
-#include <regex>
 #include <thread>
 
 #include "engine/frame_payload.hpp"
@@ -30,9 +29,14 @@ const std::string TOPIC = "orthoflow/test/frames";
 
 // Value of "<key> N" in `text` (the echo/send summaries), or -1.
 long long number_after(const std::string& text, const std::string& key) {
-  std::smatch m;
-  if (!std::regex_search(text, m, std::regex(key + " (\\d+)"))) return -1;
-  return std::stoll(m[1].str());
+  // A plain scan (std::regex trips GCC 12's -Wmaybe-uninitialized under the sanitizers).
+  const std::string pattern = key + " ";
+  for (std::size_t at = text.find(pattern); at != std::string::npos; at = text.find(pattern, at + 1)) {
+    std::size_t digit = at + pattern.size(), end = digit;
+    while (end < text.size() && text[end] >= '0' && text[end] <= '9') ++end;
+    if (end > digit) return std::stoll(text.substr(digit, end - digit));
+  }
+  return -1;
 }
 
 std::vector<std::string> send_args(std::uint64_t frames, double period_ms) {
