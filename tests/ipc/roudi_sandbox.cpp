@@ -5,6 +5,7 @@
 #include <sched.h>
 #include <signal.h>
 #include <sys/mount.h>
+#include <sys/stat.h>
 #include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -48,12 +49,38 @@ std::string setup_error(const char* what) {
          " (needs root or CAP_SYS_ADMIN for a private mount namespace)";
 }
 
+// Where the host's /tmp stays reachable after a fresh tmpfs covers /tmp (inside the private /dev/shm).
+constexpr const char* HOST_TMP = "/dev/shm/.host_tmp";
+
+// mkdir -p (0755); false on the first failure other than EEXIST.
+bool make_dirs(const std::string& path) {
+  for (std::size_t at = 1; at <= path.size(); ++at) {
+    if (at != path.size() && path[at] != '/') continue;
+    if (::mkdir(path.substr(0, at).c_str(), 0755) != 0 && errno != EEXIST) return false;
+  }
+  return true;
+}
+
+// A build or checkout under /tmp (CI clones there) would vanish under the fresh tmpfs: bind it back
+// from the host's /tmp so the orthoflow binary and config files stay where the test expects them.
+bool keep_visible(const std::string& dir) {
+  if (dir.rfind("/tmp/", 0) != 0) return true;
+  const std::string host = std::string(HOST_TMP) + dir.substr(4);
+  return make_dirs(dir) && ::mount(host.c_str(), dir.c_str(), nullptr, MS_BIND | MS_REC, nullptr) == 0;
+}
+
 // Returns an empty string on success, else why the namespace could not be set up.
 std::string enter_private_mounts() {
   if (::unshare(CLONE_NEWNS) != 0) return setup_error("unshare(CLONE_NEWNS)");
   if (::mount(nullptr, "/", nullptr, MS_REC | MS_PRIVATE, nullptr) != 0) return setup_error("mount rprivate /");
   if (::mount("tmpfs", "/dev/shm", "tmpfs", 0, "mode=1777") != 0) return setup_error("mount tmpfs /dev/shm");
+  if (!make_dirs(HOST_TMP) || ::mount("/tmp", HOST_TMP, nullptr, MS_BIND | MS_REC, nullptr) != 0) {
+    return setup_error("bind the host /tmp");
+  }
   if (::mount("tmpfs", "/tmp", "tmpfs", 0, "mode=1777") != 0) return setup_error("mount tmpfs /tmp");
+  if (!keep_visible(ORTHOFLOW_SOURCE_DIR) || !keep_visible(ORTHOFLOW_BINARY_DIR)) {
+    return setup_error("bind the source and build directories back under /tmp");
+  }
   return {};
 }
 
