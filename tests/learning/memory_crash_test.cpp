@@ -48,8 +48,15 @@ ChildRun run_and_kill(const std::filesystem::path& dir, std::chrono::millisecond
   ChildRun run;
   std::string text;
   char buf[4096];
-  const auto deadline = std::chrono::steady_clock::now() + delay;
+  // The random delay starts at the child's first acknowledged teach, not at fork: under ASan on a
+  // loaded machine start-up alone (exec, sanitizer init, LevelDB open) can outlast the delay.
+  auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+  bool started = false;
   for (bool open = true; open;) {
+    if (!started && text.find('\n') != std::string::npos) {
+      started = true;
+      deadline = std::chrono::steady_clock::now() + delay;
+    }
     const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
     if (left.count() <= 0) { break; }
     pollfd p{fds[0], POLLIN, 0};
