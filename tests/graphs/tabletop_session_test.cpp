@@ -1,6 +1,7 @@
 // The tabletop graph end to end: the synthetic session (tracking, teaching, Unknown, determinism
 // across thread counts), outside teach events, and the real mOSD frames.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <nlohmann/json.hpp>
 
@@ -21,7 +22,10 @@ struct SessionRun {
 };
 
 SessionRun run_graph(const test::Overrides& overrides, int threads, LearningService& learning) {
-  const auto path = std::filesystem::temp_directory_path() / ("orthoflow_session_" + std::to_string(threads) + ".jsonl");
+  // One file per process and run: ctest runs these tests in parallel processes.
+  static int runs = 0;
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("orthoflow_session_" + std::to_string(::getpid()) + "_" + std::to_string(runs++) + ".jsonl");
   SessionRun result;
   {
     auto json = LineWriter::open(path.string());
@@ -40,20 +44,20 @@ SessionRun run_graph(const test::Overrides& overrides, int threads, LearningServ
   return result;
 }
 
-const test::Overrides SESSION{{"source", {{"frames", "120"}}}};
+const test::Overrides SESSION{{"source", {{"frames", "90"}}}};
 
 TEST(TabletopSession, TracksTeachesAndRecognises) {
   auto learning = test::in_memory_learning();
   const auto r = run_graph(SESSION, 2, *learning);
   const SessionSummary& s = r.summary;
-  ASSERT_EQ(s.frames, 120U);
-  ASSERT_EQ(r.frames.size(), 120U);
-  EXPECT_EQ(s.frames_with_table, 120U);
+  ASSERT_EQ(s.frames, 90U);
+  ASSERT_EQ(r.frames.size(), 90U);
+  EXPECT_EQ(s.frames_with_table, 90U);
   // Tracking: every scripted object keeps one track id while it stays (the mug slides 5 cm/s).
   std::map<std::string, std::set<int>> tracks_of;  // truth category + phase -> track ids
   for (const auto& f : r.frames) {
     for (const auto& o : f["objects"]) {
-      const std::string phase = f["frame"].get<int>() < 48 ? "1" : "2";
+      const std::string phase = f["frame"].get<int>() < 36 ? "1" : "2";  // phase 1 ends at 40% of 90
       const std::string truth = o["truth"];
       tracks_of[truth == "bowl" ? truth : truth + phase].insert(o["track"].get<int>());
     }
@@ -65,7 +69,7 @@ TEST(TabletopSession, TracksTeachesAndRecognises) {
   EXPECT_EQ(s.taught, (std::vector<std::string>{"bowl", "bottle", "mug"}));
   EXPECT_EQ(s.teaches, 9U);
   // A taught category is recognised on a new instance; the never-taught plate is Unknown.
-  EXPECT_GT(s.new_instances.asked, 80U);
+  EXPECT_GT(s.new_instances.asked, 60U);
   EXPECT_GT(s.new_instances.rate(), 0.9);
   EXPECT_GT(s.after_teaching.rate(), 0.9);
   EXPECT_GT(s.before_teaching.asked, 60U);
@@ -78,13 +82,13 @@ TEST(TabletopSession, TracksTeachesAndRecognises) {
       EXPECT_TRUE(o["unknown"].get<bool>()) << f["frame"];
     }
   }
-  EXPECT_GT(plates, 50);
+  EXPECT_GE(plates, 45);  // the plate is on the table for the last 50 frames
 }
 
 TEST(TabletopSession, SameOutputWhateverTheThreadCount) {
   auto one = test::in_memory_learning();
   auto two = test::in_memory_learning();
-  const test::Overrides shorter{{"source", {{"frames", "60"}}}};
+  const test::Overrides shorter{{"source", {{"frames", "30"}}}};
   const auto a = run_graph(shorter, 1, *one);
   const auto b = run_graph(shorter, 2, *two);
   ASSERT_EQ(a.frames.size(), b.frames.size());
