@@ -49,7 +49,6 @@ class FrameSource : public engine::Node {
     const FrameBlock block = block_of(out, capacity_);
     new (&block.state()) FrameState{};  // value-initialised in place: no temporary on the stack
     if (cloud.size() > capacity_ || !engine::write_frame(block.raw(), cloud)) {
-      ++oversized_;
       block.state().error.assign("source: frame larger than the pool block holds");
       return false;
     }
@@ -58,7 +57,6 @@ class FrameSource : public engine::Node {
   std::size_t capacity_;
   memory_pool::BlockPool* pool_;
   std::string_view name_;
-  std::uint64_t oversized_ = 0;
 };
 
 class SyntheticSource final : public FrameSource {
