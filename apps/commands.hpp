@@ -31,4 +31,6 @@ void add_ipc_command(CLI::App& app);
 
 /// @brief `run`: the tabletop graph on the embedded session or a given source; summary, JSON lines, snapshot.
 void add_run_command(CLI::App& app);
+/// @brief `evaluate --dataset DIR --protocol ...`: cross-validation, simulated teacher, context change, robustness.
+void add_evaluate_command(CLI::App& app);
 }  // namespace orthoflow::apps

@@ -14,6 +14,7 @@ int main(int argc, char** argv) {
   orthoflow::apps::add_memory_command(app);
   orthoflow::apps::add_ipc_command(app);
   orthoflow::apps::add_run_command(app);
+  orthoflow::apps::add_evaluate_command(app);
   app.set_version_flag("--version", ORTHOFLOW_VERSION);
   try {
     app.parse(argc, argv);

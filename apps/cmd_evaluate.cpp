@@ -1,0 +1,150 @@
+// `orthoflow evaluate --dataset DIR --protocol cv10|teacher|teacher-context|noise|downsample
+// [--learner instance,bayes] [--approach nn,1,2] [--good-mode invariant,reference] [--bins 5,15] [--runs R]
+// [--seed S] [--folds K] [--levels MM,...] [--tau T] [--breakpoint N] [--threads N] [--out DIR]
+// [--cache DIR | --no-cache]`: the thesis's evaluations (evaluation/, docs/EVALUATION.md). Comma lists
+// give every combination as one variant, all evaluated on the same folds, orders and views.
+#include <cstdlib>
+#include <iostream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "apps/commands.hpp"
+#include "evaluation/progress.hpp"
+#include "evaluation/report.hpp"
+
+namespace orthoflow::apps {
+namespace {
+
+struct EvaluateOptions {
+  std::string dataset;
+  std::string protocol = "cv10";
+  std::vector<std::string> learners{"instance"};
+  std::vector<std::string> approaches{"nn"};
+  std::vector<std::string> modes{"invariant"};
+  std::vector<std::size_t> bins{15};
+  std::vector<double> levels_mm;
+  std::size_t runs = 10;
+  std::uint64_t seed = 1;
+  std::size_t folds = 10;
+  double tau = 0.67;
+  std::size_t breakpoint = 100;
+  std::size_t threads = 0;
+  std::string out;
+  std::string cache;
+  bool no_cache = false;
+  bool quiet = false;
+};
+
+[[noreturn]] void fail(const std::string& message, int code) {
+  std::cerr << "orthoflow evaluate: " << message << '\n';
+  throw CLI::RuntimeError(code);
+}
+
+evaluation::Protocol protocol_of(const std::string& p) {
+  if (p == "teacher") { return evaluation::Protocol::TEACHER; }
+  if (p == "teacher-context") { return evaluation::Protocol::TEACHER_CONTEXT; }
+  if (p == "noise") { return evaluation::Protocol::NOISE; }
+  if (p == "downsample") { return evaluation::Protocol::DOWNSAMPLE; }
+  return evaluation::Protocol::CV10;
+}
+
+/// Every combination of the listed learners, rules, modes and bins (rules apply to instance only).
+std::vector<evaluation::Variant> variants_of(const EvaluateOptions& o) {
+  std::vector<evaluation::Variant> out;
+  for (const std::string& l : o.learners) {
+    const bool bayes = l == "bayes";
+    const std::vector<std::string> rules = bayes ? std::vector<std::string>{"nn"} : o.approaches;
+    for (const std::string& a : rules) {
+      for (const std::string& m : o.modes) {
+        for (const std::size_t b : o.bins) {
+          evaluation::Variant v;
+          v.learner = bayes ? evaluation::LearnerKind::BAYES : evaluation::LearnerKind::INSTANCE;
+          v.rule = a == "1" ? evaluation::InstanceRule::APPROACH_1 : a == "2" ? evaluation::InstanceRule::APPROACH_2 : evaluation::InstanceRule::NEAREST;
+          v.mode = m == "reference" ? kernels::GoodMode::REFERENCE : kernels::GoodMode::INVARIANT;
+          v.bins = b;
+          out.push_back(v);
+        }
+      }
+    }
+  }
+  return out;
+}
+
+std::filesystem::path default_cache() {
+  if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg != nullptr && *xdg != '\0') { return std::filesystem::path(xdg) / "orthoflow/descriptors"; }
+  if (const char* home = std::getenv("HOME"); home != nullptr && *home != '\0') { return std::filesystem::path(home) / ".cache/orthoflow/descriptors"; }
+  return {};
+}
+
+int exit_code_of(const evaluation::EvalError& e) {
+  using Code = evaluation::EvalError::Code;
+  switch (e.code) {
+    case Code::BAD_CONFIG: return EXIT_USAGE;
+    case Code::WRITE_FAILED: return EXIT_FAILURE_GENERIC;
+    default: return EXIT_BAD_INPUT;
+  }
+}
+
+void run_evaluate(const EvaluateOptions& o) {
+  auto dataset = evaluation::scan_dataset(o.dataset);
+  if (!dataset) { fail(dataset.error().to_string(), EXIT_BAD_INPUT); }
+  evaluation::EvalOptions eo;
+  eo.protocol = protocol_of(o.protocol);
+  eo.variants = variants_of(o);
+  eo.runs = o.runs;
+  eo.seed = o.seed;
+  eo.folds = o.folds;
+  for (const double mm : o.levels_mm) { eo.levels_m.push_back(mm / 1000.0); }
+  eo.teacher.tau = o.tau;
+  eo.teacher.breakpoint = o.breakpoint;
+  eo.threads = o.threads;
+  eo.cache_dir = o.no_cache ? std::filesystem::path{} : o.cache.empty() ? default_cache() : std::filesystem::path(o.cache);
+  std::unique_ptr<evaluation::Progress> progress;
+  if (!o.quiet) {
+    progress = std::make_unique<evaluation::Progress>("evaluate " + o.protocol, evaluation::evaluation_work(*dataset, eo), stderr,
+                                                      evaluation::Progress::is_terminal(stderr));
+  }
+  auto result = evaluation::evaluate(*dataset, eo, progress.get());
+  if (progress) { progress->finish(); }
+  if (!result) { fail(result.error().to_string(), exit_code_of(result.error())); }
+  for (const std::string& w : result->warnings) { std::cerr << "orthoflow evaluate: warning: " << w << '\n'; }
+  std::cout << evaluation::summary_markdown(*result);
+  const std::filesystem::path out = o.out.empty() ? std::filesystem::path("evaluation-" + o.protocol) : std::filesystem::path(o.out);
+  auto written = evaluation::write_report(*result, out);
+  if (!written) { fail(written.error().to_string(), EXIT_FAILURE_GENERIC); }
+  std::cout << "\n" << result->describe.computed << " descriptors computed, " << result->describe.cached << " from the cache; "
+            << result->seconds << " s\nwrote";
+  for (const auto& f : *written) { std::cout << ' ' << f.string(); }
+  std::cout << '\n';
+}
+
+}  // namespace
+
+void add_evaluate_command(CLI::App& app) {
+  auto o = std::make_shared<EvaluateOptions>();
+  CLI::App* cmd = app.add_subcommand("evaluate", "Evaluate learners on a dataset DIR/<category>/<instance>/<view>.pcd (docs/EVALUATION.md)");
+  cmd->add_option("--dataset", o->dataset, "dataset directory")->required();
+  cmd->add_option("--protocol", o->protocol, "cv10, teacher, teacher-context, noise or downsample")
+      ->check(CLI::IsMember({"cv10", "teacher", "teacher-context", "noise", "downsample"}));
+  cmd->add_option("--learner", o->learners, "instance and/or bayes (comma list)")->delimiter(',')->check(CLI::IsMember({"instance", "bayes"}));
+  cmd->add_option("--approach", o->approaches, "instance rule(s): nn (nearest neighbour), 1, 2 (thesis NOCD approaches)")
+      ->delimiter(',')->check(CLI::IsMember({"nn", "1", "2"}));
+  cmd->add_option("--good-mode", o->modes, "invariant and/or reference (comma list)")->delimiter(',')->check(CLI::IsMember({"invariant", "reference"}));
+  cmd->add_option("--bins", o->bins, "GOOD bins per side (comma list)")->delimiter(',')->check(CLI::Range(1, 256));
+  cmd->add_option("--runs", o->runs, "repetitions (category orders / fold splits)")->check(CLI::Range(1, 1000));
+  cmd->add_option("--seed", o->seed, "seed of every random choice");
+  cmd->add_option("--folds", o->folds, "folds of the cross-validation")->check(CLI::Range(2, 1000));
+  cmd->add_option("--levels", o->levels_mm, "noise sigmas or voxel sizes in mm (comma list; default thesis 6.4.3)")
+      ->delimiter(',')->check(CLI::Range(0.001, 1000.0));
+  cmd->add_option("--tau", o->tau, "teacher: protocol accuracy threshold")->check(CLI::Range(0.0, 0.999));
+  cmd->add_option("--breakpoint", o->breakpoint, "teacher: iterations without reaching tau before giving up")->check(CLI::Range(1, 1000000));
+  cmd->add_option("--threads", o->threads, "worker threads (0: all cores); results do not depend on it");
+  cmd->add_option("--out", o->out, "output directory (default evaluation-<protocol>)");
+  cmd->add_option("--cache", o->cache, "descriptor cache directory (default $XDG_CACHE_HOME/orthoflow/descriptors)");
+  cmd->add_flag("--no-cache", o->no_cache, "compute every descriptor, read and write no cache");
+  cmd->add_flag("--quiet", o->quiet, "no progress bar");
+  cmd->callback([o] { run_evaluate(*o); });
+}
+
+}  // namespace orthoflow::apps

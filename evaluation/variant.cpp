@@ -1,0 +1,55 @@
+#include "evaluation/variant.hpp"
+
+#include "learning/bayes_learner.hpp"
+#include "learning/instance_learner.hpp"
+#include "memory_pool/assert.hpp"
+
+namespace orthoflow::evaluation {
+
+std::string Variant::name() const {
+  std::string n = learner == LearnerKind::BAYES ? "bayes" : "instance";
+  if (learner == LearnerKind::INSTANCE) {
+    n += rule == InstanceRule::NEAREST ? "-nn" : rule == InstanceRule::APPROACH_1 ? "-nocd1" : "-nocd2";
+  }
+  n += mode == kernels::GoodMode::INVARIANT ? "/invariant/" : "/reference/";
+  return n + std::to_string(bins);
+}
+
+DescriptorSpec Variant::descriptor(Perturbation p, double amount_m, std::uint64_t seed) const {
+  return DescriptorSpec{bins, mode, p, amount_m, seed};
+}
+
+std::unique_ptr<learning::Learner> Variant::make_learner() const {
+  const std::size_t length = 3 * bins * bins;
+  if (learner == LearnerKind::BAYES) {
+    learning::BayesConfig cfg;
+    cfg.descriptor_length = length;
+    return std::make_unique<learning::BayesLearner>(cfg);
+  }
+  learning::InstanceConfig cfg;
+  cfg.descriptor_length = length;
+  cfg.normalise = rule != InstanceRule::NEAREST;
+  cfg.approach = rule == InstanceRule::APPROACH_2 ? learning::NocdApproach::MEAN_DISTANCE : learning::NocdApproach::MIN_DISTANCE;
+  return std::make_unique<learning::InstanceLearner>(cfg);
+}
+
+ClassLearner::ClassLearner(const Variant& variant, const std::vector<std::string>& categories)
+    : categories_(categories), learner_(variant.make_learner()) {}
+
+void ClassLearner::teach(std::uint32_t cls, std::span<const float> views) {
+  const std::size_t length = learner_->descriptor_length();
+  auto id = learner_->teach(categories_[cls], learning::DescriptorBatch{views, length});
+  // The dataset scan validated labels and describe_dataset() produced finite histograms of this length.
+  OF_ENFORCE(id.has_value(), "evaluation: teach refused a dataset view");
+  class_of_[*id] = cls;
+}
+
+std::optional<std::uint32_t> ClassLearner::ask(std::span<const float> view) {
+  const learning::Prediction p = learner_->ask(view, scratch_);
+  if (p.unknown) { return std::nullopt; }
+  const auto it = class_of_.find(p.category);
+  if (it == class_of_.end()) { return std::nullopt; }
+  return it->second;
+}
+
+}  // namespace orthoflow::evaluation
