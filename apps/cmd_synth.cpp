@@ -159,7 +159,7 @@ void add_synth_command(CLI::App& app) {
   synth->add_option("--out", synth_args->out, "output PCD file")->required();
   synth->add_flag("--touching", synth_args->touching, "place objects in touching pairs");
   synth->add_flag("--no-floor", synth_args->no_floor, "leave the floor out");
-  synth->add_option("--categories", synth_args->categories, "comma-separated categories (default: all)");
+  synth->add_option("--categories", synth_args->categories, "comma-separated categories (default: the 12 scene categories)");
   synth->add_option("--ground-truth", synth_args->ground_truth, "write the scene's ground truth as JSON here");
   synth->callback([synth_args] { run_synth(*synth_args); });
 

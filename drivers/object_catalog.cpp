@@ -7,35 +7,20 @@
 #include <numbers>
 #include <string_view>
 
-#include "drivers/synthetic_random.hpp"
+#include "drivers/object_catalog_parts.hpp"
 
 namespace orthoflow::drivers {
 namespace {
 
-constexpr std::array<std::string_view, CATEGORY_COUNT> NAMES = {"bottle", "bowl",  "flask",  "fork", "knife", "mug",
-                                                                "plate",  "spoon", "teapot", "vase", "box",   "can"};
-constexpr std::array<std::uint32_t, CATEGORY_COUNT> COLOURS = {0x2E8B57, 0xF5DEB3, 0x87CEEB, 0xC0C0C0, 0xA9A9A9, 0xB22222,
-                                                               0xFFFAF0, 0xD3D3D3, 0x8B4513, 0x6A5ACD, 0xDAA520, 0xDC143C};
+constexpr std::array<std::string_view, CATEGORY_COUNT> NAMES = {
+    "bottle", "bowl",  "flask", "fork", "knife", "mug", "plate", "spoon",  "teapot", "vase",   "box",  "can",   "glass",
+    "wine_glass", "jug", "pot", "pan",  "ball",  "book", "cereal_box", "jar", "funnel", "bucket", "tray", "remote", "candle"};
+constexpr std::array<std::uint32_t, CATEGORY_COUNT> COLOURS = {
+    0x2E8B57, 0xF5DEB3, 0x87CEEB, 0xC0C0C0, 0xA9A9A9, 0xB22222, 0xFFFAF0, 0xD3D3D3, 0x8B4513, 0x6A5ACD, 0xDAA520, 0xDC143C,
+    0xE0FFFF, 0xF0E68C, 0xCD853F, 0x708090, 0x2F4F4F, 0xFF8C00, 0x4169E1, 0xFFD700, 0xBDB76B, 0x9ACD32, 0x4682B4, 0x8FBC8F,
+    0x1C1C1C, 0xFFF8DC};
 
-struct Builder {
-  ObjectModel& m;
-  void frustum(double z, double r0, double r1, double h, bool open_top = false) {
-    m.parts[m.part_count++] = Primitive{PrimitiveKind::FRUSTUM, {0, 0, z}, {r0, r1, h}, open_top};
-  }
-  void ellipsoid(Vec3 c, Vec3 radii, double clip_min = -1e9, double clip_max = 1e9) {
-    m.parts[m.part_count++] = Primitive{PrimitiveKind::ELLIPSOID, c, radii, false, clip_min, clip_max};
-  }
-  void box(Vec3 c, Vec3 half) { m.parts[m.part_count++] = Primitive{PrimitiveKind::BOX, c, half}; }
-  /// A tube of small spheres along a half circle in the xz plane (mug and teapot handles, spouts).
-  void arc(Vec3 c, double radius, double tube, double from, double to, int n) {
-    for (int i = 0; i < n; ++i) {
-      const double a = from + (to - from) * i / (n - 1);
-      ellipsoid({c[0] + radius * std::sin(a), c[1], c[2] + radius * std::cos(a)}, {tube, tube, tube});
-    }
-  }
-};
-
-void cutlery(Builder& b, Random& r, Category c) {
+void cutlery(ObjectBuilder& b, Random& r, Category c) {
   const double len = r.uniform(0.17, 0.22), t = r.uniform(0.010, 0.014);
   b.box({-0.03, 0, t / 2}, {len / 2 - 0.03, 0.008, t / 2});  // handle
   const double head_x = len / 2 - 0.02;
@@ -49,7 +34,7 @@ void cutlery(Builder& b, Random& r, Category c) {
 }
 
 /// Turned shapes: stacks of frusta (bottle, flask, vase, can).
-void turned(Builder& b, Random& r, Category c) {
+void turned(ObjectBuilder& b, Random& r, Category c) {
   if (c == Category::BOTTLE) {
     const double rad = r.uniform(0.03, 0.045), h = r.uniform(0.12, 0.2), neck = r.uniform(0.012, 0.018);
     const double sh = r.uniform(0.03, 0.05);
@@ -73,7 +58,7 @@ void turned(Builder& b, Random& r, Category c) {
 }
 
 /// Tableware with an opening or a handle (bowl, mug, plate, teapot).
-void tableware(Builder& b, Random& r, Category c) {
+void tableware(ObjectBuilder& b, Random& r, Category c) {
   if (c == Category::BOWL) {
     const double rad = r.uniform(0.06, 0.1), depth = rad * r.uniform(0.5, 0.7);
     b.ellipsoid({0, 0, depth}, {rad, rad, depth}, 0.0, depth);
@@ -93,7 +78,7 @@ void tableware(Builder& b, Random& r, Category c) {
   }
 }
 
-void build(Builder& b, Random& r, Category c) {
+void build(ObjectBuilder& b, Random& r, Category c) {
   switch (c) {
     case Category::BOTTLE:
     case Category::FLASK:
@@ -111,6 +96,20 @@ void build(Builder& b, Random& r, Category c) {
       b.box({0, 0, hz}, {hx, hy, hz});
       break;
     }
+    case Category::GLASS:
+    case Category::WINE_GLASS:
+    case Category::JUG:
+    case Category::POT:
+    case Category::PAN:
+    case Category::BALL:
+    case Category::BOOK:
+    case Category::CEREAL_BOX:
+    case Category::JAR:
+    case Category::FUNNEL:
+    case Category::BUCKET:
+    case Category::TRAY:
+    case Category::REMOTE:
+    case Category::CANDLE: build_household(b, r, c); break;
   }
 }
 
@@ -151,7 +150,7 @@ ObjectModel make_object_model(Category category, std::uint32_t instance, std::ui
   m.instance = instance;
   Random r(0x0B1EC7ULL * 1000003ULL + static_cast<std::uint64_t>(category) * 65537ULL + instance +
            shape_seed * 0x9E3779B97F4A7C15ULL);
-  Builder b{m};
+  ObjectBuilder b{m};
   build(b, r, category);
   measure(m);
   // Instances vary in shade around the category colour.

@@ -1,7 +1,8 @@
 #pragma once
 /// @file
-/// @brief The synthetic object categories (the thesis's restaurant set plus boxes and cans) and
-/// their parametric instances, built from the solids in shape_primitives.hpp.
+/// @brief The synthetic object categories (the thesis's restaurant set plus boxes and cans, then
+/// household objects for the object-view evaluation) and their parametric instances, built from the
+/// solids in shape_primitives.hpp.
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -12,10 +13,22 @@
 
 namespace orthoflow::drivers {
 
-enum class Category : std::uint8_t { BOTTLE, BOWL, FLASK, FORK, KNIFE, MUG, PLATE, SPOON, TEAPOT, VASE, BOX, CAN };
-inline constexpr std::size_t CATEGORY_COUNT = 12;
+/// @brief Object categories. Ids are stable: new categories are only ever appended.
+enum class Category : std::uint8_t {
+  // The tabletop scene set (SCENE_CATEGORY_COUNT): the thesis's restaurant objects, boxes and cans.
+  BOTTLE, BOWL, FLASK, FORK, KNIFE, MUG, PLATE, SPOON, TEAPOT, VASE, BOX, CAN,
+  // Household objects added for the object-view dataset (issue 8: at least 20 categories).
+  GLASS, WINE_GLASS, JUG, POT, PAN, BALL, BOOK, CEREAL_BOX, JAR, FUNNEL, BUCKET, TRAY, REMOTE, CANDLE
+};
+/// @brief Every category: the object-view dataset's default and the names category_from_name knows.
+inline constexpr std::size_t CATEGORY_COUNT = 26;
+/// @brief The first categories, which random tabletop scenes draw from when none are given. Fixed
+/// at the original twelve so that seeded scenes (golden files, sessions, `orthoflow synth`) keep
+/// their bytes as the catalog grows.
+inline constexpr std::size_t SCENE_CATEGORY_COUNT = 12;
+static_assert(SCENE_CATEGORY_COUNT <= CATEGORY_COUNT);
 
-/// @brief Lower-case name ("bottle", ...).
+/// @brief Lower-case name ("bottle", ..., "wine_glass"). @pre @p c is a Category enumerator.
 [[nodiscard]] const char* category_name(Category c) noexcept;
 /// @brief The category with that name, if any.
 [[nodiscard]] std::optional<Category> category_from_name(std::string_view name) noexcept;

@@ -32,7 +32,7 @@ bool on_table(const Footprint& f, const TableSpec& t) {
 }
 
 Category pick_category(const SceneConfig& config, Random& rng) {
-  if (config.categories.empty()) { return static_cast<Category>(rng.below(CATEGORY_COUNT)); }
+  if (config.categories.empty()) { return static_cast<Category>(rng.below(SCENE_CATEGORY_COUNT)); }
   return config.categories[rng.below(config.categories.size())];
 }
 
