@@ -5,6 +5,7 @@
 #include <fstream>
 
 #include "evaluation/dataset.hpp"
+#include "evaluation/derived_views.hpp"
 #include "evaluation/descriptor_cache.hpp"
 #include "evaluation/descriptors.hpp"
 #include "tests/evaluation/box_dataset.hpp"
@@ -162,6 +163,31 @@ TEST(DescriptorCache, RoundTripAndMalformedBytesGiveAnEmptyCache) {
   std::string huge_count = bytes;
   huge_count[16] = '\xff';
   EXPECT_TRUE(parse_descriptor_cache(huge_count, 3).entries.empty());
+}
+
+}  // namespace
+}  // namespace orthoflow::evaluation
+
+namespace orthoflow::evaluation {
+namespace {
+
+TEST(DerivedViews, CropsAreDeterministicPartialAndViewZeroIsTheWholeCloud) {
+  const kernels::PointCloud cloud = testing::box_view(1, 0, 0);
+  const kernels::PointCloud whole = derive_view(cloud, 0, 5);
+  ASSERT_EQ(whole.size(), cloud.size());
+  EXPECT_TRUE(std::equal(whole.x().begin(), whole.x().end(), cloud.x().begin()));
+  for (std::uint32_t v = 1; v < 8; ++v) {
+    const kernels::PointCloud a = derive_view(cloud, v, 5);
+    const kernels::PointCloud b = derive_view(cloud, v, 5);
+    EXPECT_GE(a.size(), cloud.size() * 7 / 10 - 1);
+    EXPECT_LE(a.size(), cloud.size());
+    ASSERT_EQ(a.size(), b.size());
+    EXPECT_TRUE(std::equal(a.z().begin(), a.z().end(), b.z().begin()));
+  }
+  kernels::PointCloud nan_only;
+  nan_only.resize_unorganized(3);
+  for (std::size_t i = 0; i < 3; ++i) { nan_only.x()[i] = std::nanf(""); }
+  EXPECT_TRUE(derive_view(nan_only, 2, 1).empty());
 }
 
 }  // namespace
