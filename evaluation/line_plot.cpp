@@ -24,7 +24,7 @@ struct Rgb {
 // Okabe & Ito (2008) colour-blind-safe palette, most distinct first; yellow last but one (weak on white).
 constexpr std::array<Rgb, 8> PALETTE{{{0, 114, 178}, {213, 94, 0}, {0, 158, 115}, {230, 159, 0},
                                       {204, 121, 167}, {86, 180, 233}, {240, 228, 66}, {0, 0, 0}}};
-constexpr double LEFT = 78, RIGHT = 24, BOTTOM = 56, TOP_NO_TITLE = 20, TOP_TITLE = 42;
+constexpr double LEFT = 78, RIGHT = 30, BOTTOM = 56, TOP_NO_TITLE = 20, TOP_TITLE = 42;
 constexpr double MARKER_RADIUS = 3.5, LINE_WIDTH = 2.0;
 constexpr double MAX_TICKS = 40;  // guards the tick loops against degenerate (tiny relative) ranges
 
@@ -140,26 +140,19 @@ void text_at(cairo_t* cr, const std::string& text, double x, double y, double ax
   cairo_show_text(cr, text.c_str());
 }
 
-std::string tick_label(double k, double step) {
-  char buf[32];
-  const double v = k * step;  // integer multiple: no accumulated drift, and exactly 0 at k == 0
-  std::snprintf(buf, sizeof buf, "%.6g", std::abs(v) < 1e-9 * step ? 0.0 : v);
-  return buf;
-}
-
 // Grid lines and tick labels of one axis (the y axis when y_axis is true).
 void draw_ticks(cairo_t* cr, const Frame& f, bool y_axis) {
   const Axis& a = y_axis ? f.ya : f.xa;
   const double first = std::ceil(a.lo / a.step - 1e-9), last = std::floor(a.hi / a.step + 1e-9);
   cairo_set_font_size(cr, 11.0);
   for (double k = first; k <= last; k += 1.0) {
-    const double p = y_axis ? f.py(k * a.step) : f.px(k * a.step);
+    const double v = k * a.step, p = y_axis ? f.py(v) : f.px(v);  // k * step: no drift from summing steps
     cairo_set_source_rgb(cr, 0.88, 0.88, 0.88);
     cairo_move_to(cr, y_axis ? f.x0 : p, y_axis ? p : f.y0);
     cairo_line_to(cr, y_axis ? f.x1 : p, y_axis ? p : f.y1);
     cairo_stroke(cr);
     cairo_set_source_rgb(cr, 0.2, 0.2, 0.2);
-    text_at(cr, tick_label(k, a.step), y_axis ? f.x0 - 6 : p, y_axis ? p : f.y1 + 6, y_axis ? 1.0 : 0.5,
+    text_at(cr, num(k == 0.0 ? 0.0 : v), y_axis ? f.x0 - 6 : p, y_axis ? p : f.y1 + 6, y_axis ? 1.0 : 0.5,
             y_axis ? 0.5 : 0.0);
   }
 }
@@ -218,8 +211,8 @@ struct Box {  // a legend placement in device coordinates
   [[nodiscard]] bool contains(double px, double py) const { return px >= x && px <= x + w && py >= y && py <= y + h; }
 };
 
-// The plot corner whose legend box covers the fewest samples of the polylines (each point and 7 more along the
-// segment that reaches it); ties keep the first of top-left, top-right, bottom-left, bottom-right.
+// The plot corner whose legend box covers the fewest samples of the polylines (every 4 px along each segment,
+// at most 256 per segment); ties keep the first of top-left, top-right, bottom-left, bottom-right.
 Box legend_box(const PlotSpec& spec, const Frame& f, double w, double h) {
   const std::array<Box, 4> corners{{{f.x0 + 8, f.y0 + 8, w, h}, {f.x1 - 8 - w, f.y0 + 8, w, h},
                                     {f.x0 + 8, f.y1 - 8 - h, w, h}, {f.x1 - 8 - w, f.y1 - 8 - h, w, h}}};
@@ -228,8 +221,9 @@ Box legend_box(const PlotSpec& spec, const Frame& f, double w, double h) {
     for (std::size_t i = 0; i < s.x.size(); ++i) {
       const std::size_t prev = i == 0 ? 0 : i - 1;
       const double x = f.px(s.x[i]), y = f.py(s.y[i]), dx = f.px(s.x[prev]) - x, dy = f.py(s.y[prev]) - y;
-      for (double t = 0.0; t < 1.0; t += 0.125) {
-        for (std::size_t c = 0; c < 4; ++c) covered[c] += corners[c].contains(x + t * dx, y + t * dy) ? 1 : 0;
+      const double n = std::clamp(std::ceil(std::hypot(dx, dy) / 4.0), 1.0, 256.0);
+      for (double k = 0; k < n; k += 1.0) {
+        for (std::size_t c = 0; c < 4; ++c) covered[c] += corners[c].contains(x + k / n * dx, y + k / n * dy) ? 1 : 0;
       }
     }
   }
@@ -331,9 +325,9 @@ std::string PlotError::to_string() const { return std::string(evaluation::to_str
 Result<void, PlotError> validate_plot(const PlotSpec& spec) {
   const auto side_ok = [](int v) { return v >= MIN_PLOT_SIDE && v <= MAX_PLOT_SIDE; };
   if (!side_ok(spec.width) || !side_ok(spec.height)) {
+    const std::string limits = "[" + std::to_string(MIN_PLOT_SIDE) + ", " + std::to_string(MAX_PLOT_SIDE) + "]";
     return fail(PlotError::Code::BAD_SPEC, "plot '" + spec.title + "': size " + std::to_string(spec.width) + "x" +
-                                               std::to_string(spec.height) + " outside [" +
-                                               std::to_string(MIN_PLOT_SIDE) + ", " + std::to_string(MAX_PLOT_SIDE) + "]");
+                                               std::to_string(spec.height) + " outside " + limits);
   }
   const bool lo_ok = !spec.y_min || std::isfinite(*spec.y_min), hi_ok = !spec.y_max || std::isfinite(*spec.y_max);
   if (!lo_ok || !hi_ok || (spec.y_min && spec.y_max && !(*spec.y_min < *spec.y_max))) {

@@ -26,7 +26,8 @@ class Progress {
   /// @brief Reports on @p out with std::chrono::steady_clock.
   /// @pre @p out stays open until finish() or destruction. @p terminal: redraw one line (e.g. isatty(fileno(out))).
   Progress(std::string label, std::size_t total, std::FILE* out, bool terminal);
-  /// @brief Same, with the time source @p now_seconds (called from advance() and finish()).
+  /// @brief Same, with the time source @p now_seconds; it is only called under the drawing mutex, so it need not
+  /// be thread-safe.
   Progress(std::string label, std::size_t total, std::FILE* out, bool terminal, Clock now_seconds);
   /// @brief Calls finish() if it was not called, so a terminal line always ends with a newline.
   ~Progress();
