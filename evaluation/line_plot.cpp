@@ -101,7 +101,9 @@ std::optional<Axis> make_axis(Range r, double target_ticks, bool fixed_lo, bool 
   Axis a{r.lo, r.hi, nice_step(r.hi - r.lo, target_ticks)};
   if (!fixed_lo) a.lo = std::floor(r.lo / a.step) * a.step;
   if (!fixed_hi) a.hi = std::ceil(r.hi / a.step) * a.step;
-  const bool ok = std::isfinite(a.lo) && std::isfinite(a.hi) && a.step > 0 && a.hi > a.lo;
+  // Tick indices k = value / step must stay exact integers in a double (< 2^53) for the tick loop.
+  const bool ok = std::isfinite(a.lo) && std::isfinite(a.hi) && a.step > 0 && a.hi > a.lo &&
+                  std::max(std::abs(a.lo), std::abs(a.hi)) / a.step < 1e15;
   if (!ok || !((a.hi - a.lo) / a.step <= MAX_TICKS)) return std::nullopt;
   return a;
 }
@@ -124,9 +126,10 @@ Result<Frame, PlotError> make_frame(const PlotSpec& spec) {
   const auto maybe_x = make_axis(padded(xr), std::clamp((f.x1 - f.x0) / 90.0, 3.0, 10.0), false, false);
   const auto maybe_y = make_axis(yr, std::clamp((f.y1 - f.y0) / 60.0, 3.0, 10.0), !!spec.y_min, !!spec.y_max);
   if (!maybe_x || !maybe_y) {
-    const Range& r = maybe_x ? yr : xr;
-    return fail(PlotError::Code::BAD_SERIES, std::string(maybe_x ? "y" : "x") + " range [" + num(r.lo) + ", " +
-                                                 num(r.hi) + "] cannot be drawn (overflow or too narrow)");
+    const Range& r = maybe_x ? yr : xr;  // a fixed y range at fault is the spec's, else the data's
+    return fail(maybe_x && spec.y_min && spec.y_max ? PlotError::Code::BAD_SPEC : PlotError::Code::BAD_SERIES,
+                std::string(maybe_x ? "y" : "x") + " range [" + num(r.lo) + ", " + num(r.hi) +
+                    "] cannot be drawn (overflow or too narrow)");
   }
   f.xa = *maybe_x, f.ya = *maybe_y;
   return f;
@@ -145,7 +148,7 @@ void draw_ticks(cairo_t* cr, const Frame& f, bool y_axis) {
   const Axis& a = y_axis ? f.ya : f.xa;
   const double first = std::ceil(a.lo / a.step - 1e-9), last = std::floor(a.hi / a.step + 1e-9);
   cairo_set_font_size(cr, 11.0);
-  for (double k = first; k <= last; k += 1.0) {
+  for (double k = first; k <= last; k += 1.0) {  // make_axis bounds the count and keeps k exact
     const double v = k * a.step, p = y_axis ? f.py(v) : f.px(v);  // k * step: no drift from summing steps
     cairo_set_source_rgb(cr, 0.88, 0.88, 0.88);
     cairo_move_to(cr, y_axis ? f.x0 : p, y_axis ? p : f.y0);

@@ -183,6 +183,11 @@ TEST(LinePlot, BadSpecSizeOrRange) {
   EXPECT_EQ(write_plot_svg(spec, path).error().code, PlotError::Code::BAD_SPEC);
   spec.y_min = std::numeric_limits<double>::quiet_NaN();
   EXPECT_EQ(validate_plot(spec).error().code, PlotError::Code::BAD_SPEC);
+  spec.y_min = 1e20, spec.y_max = 1e20 + 65536;  // ticks of 1e4 at 1e20: indices beyond exact doubles
+  result = write_plot_png(spec, path);
+  ASSERT_FALSE(result);
+  EXPECT_EQ(result.error().code, PlotError::Code::BAD_SPEC);
+  EXPECT_NE(result.error().message.find("y range [1e+20, 1e+20]"), std::string::npos) << result.error().message;
   EXPECT_FALSE(fs::exists(path));
 }
 
