@@ -257,6 +257,8 @@ void draw_legend(cairo_t* cr, const PlotSpec& spec, const Frame& f) {
     set_series_style(cr, i);
     cairo_move_to(cr, box.x + 8, y), cairo_line_to(cr, box.x + 8 + SWATCH, y);
     cairo_stroke(cr);
+    if (spec.series[i].markers) cairo_arc(cr, box.x + 8 + SWATCH / 2, y, MARKER_RADIUS, 0.0, 2 * std::numbers::pi);
+    cairo_fill(cr);
     cairo_set_source_rgb(cr, 0.0, 0.0, 0.0);
     text_at(cr, spec.series[i].name, box.x + 14 + SWATCH, y, 0.0, 0.5);
     y += ROW;
