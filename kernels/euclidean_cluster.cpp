@@ -47,20 +47,40 @@ bool near(PointsView p, std::size_t a, std::size_t b, float tol2) {
 }
 
 /// Sizes the components, keeps those within [min_size, max_size], numbers them by lowest index.
-std::size_t assign_labels(PointsView p, std::span<const std::uint8_t> mask, const ClusterParams& prm,
-                          ClusterScratch& s, std::span<std::int32_t> labels) {
+/// incl(i) tells whether point i takes part (the union-find only linked such points).
+template <class Included>
+std::size_t assign_labels(std::size_t n, Included incl, const ClusterParams& prm, ClusterScratch& s,
+                          std::span<std::int32_t> labels) {
   const Forest forest{s.parent.data()};
-  const std::size_t n = p.size();
   std::fill(s.count.begin(), s.count.begin() + static_cast<std::ptrdiff_t>(n), 0U);
   for (std::size_t i = 0; i < n; ++i) {
-    if (included(p, mask, i)) { ++s.count[forest.find(static_cast<std::uint32_t>(i))]; }
+    if (incl(i)) { ++s.count[forest.find(static_cast<std::uint32_t>(i))]; }
   }
   std::int32_t next = 0;
   for (std::size_t i = 0; i < n; ++i) {
     labels[i] = -1;
-    if (!included(p, mask, i)) { continue; }
+    if (!incl(i)) { continue; }
     const std::uint32_t root = forest.find(static_cast<std::uint32_t>(i));
     if (root == i) {  // first point of its component: count[] is reused to hold the label + 1
+      const bool keep = s.count[i] >= prm.min_size && s.count[i] <= prm.max_size;
+      s.count[i] = keep ? static_cast<std::uint32_t>(++next) : 0U;
+    }
+    labels[i] = static_cast<std::int32_t>(s.count[root]) - 1;
+  }
+  return static_cast<std::size_t>(next);
+}
+
+/// assign_labels() for the ascending list of the included points: touches only them (and clears labels).
+std::size_t assign_labels_listed(std::span<const std::uint32_t> members, const ClusterParams& prm, ClusterScratch& s,
+                                 std::span<std::int32_t> labels) {
+  const Forest forest{s.parent.data()};
+  for (const std::uint32_t i : members) { s.count[i] = 0; }
+  for (const std::uint32_t i : members) { ++s.count[forest.find(i)]; }
+  std::fill(labels.begin(), labels.end(), -1);
+  std::int32_t next = 0;
+  for (const std::uint32_t i : members) {  // ascending: a component's root comes before its other points
+    const std::uint32_t root = forest.find(i);
+    if (root == i) {
       const bool keep = s.count[i] >= prm.min_size && s.count[i] <= prm.max_size;
       s.count[i] = keep ? static_cast<std::uint32_t>(++next) : 0U;
     }
@@ -156,6 +176,38 @@ void link_cells(PointsView p, const Grid& g, float tol2, ClusterScratch& s) {
   }
 }
 
+constexpr std::uint32_t NOT_INCLUDED = 0xFFFFFFFFU;  // parent[] of a pixel that takes no part
+
+/// Links pixel i = (u, v) to the included pixels of the backward half of its (2r+1)^2 window (the r
+/// pixels before it in its row, then the r rows above), which are already linked among themselves:
+/// every edge of the window graph is seen once, from its later pixel. A neighbour whose parent already
+/// is i's root is in i's component: its distance test and find() are skipped (the partition is the
+/// same, only fewer edges are tested). Pixel i is still its own root when it is reached.
+void link_window(PointsView p, std::size_t w, std::size_t u, std::size_t v, const ClusterParams& prm,
+                 ClusterScratch& s) {
+  const Forest forest{s.parent.data()};
+  std::uint32_t* parent = s.parent.data();
+  const float tol2 = prm.tolerance * prm.tolerance;
+  const std::size_t r = prm.pixel_radius, i = v * w + u;
+  const float xi = p.x[i], yi = p.y[i], zi = p.z[i];
+  auto root = static_cast<std::uint32_t>(i);
+  const std::size_t u_lo = u >= r ? u - r : 0, u_hi = std::min(w - 1, u + r), v_lo = v >= r ? v - r : 0;
+  for (std::size_t vv = v_lo; vv <= v; ++vv) {
+    const std::size_t end = vv == v ? u : u_hi + 1;
+    for (std::size_t uu = u_lo; uu < end; ++uu) {
+      const std::size_t j = vv * w + uu;
+      if (parent[j] == NOT_INCLUDED || parent[j] == root) { continue; }
+      const float dx = xi - p.x[j], dy = yi - p.y[j], dz = zi - p.z[j];
+      if (dx * dx + dy * dy + dz * dz > tol2) { continue; }
+      const std::uint32_t other = forest.find(static_cast<std::uint32_t>(j));
+      if (other == root) { continue; }
+      parent[std::max(root, other)] = std::min(root, other);  // roots: the lowest index stays the root
+      root = std::min(root, other);
+    }
+  }
+  parent[i] = root;  // path compression: later windows then mostly see the root directly
+}
+
 }  // namespace
 
 Result<std::size_t, ClusterError> euclidean_cluster_organized(CloudView cloud, std::span<const std::uint8_t> mask,
@@ -163,28 +215,24 @@ Result<std::size_t, ClusterError> euclidean_cluster_organized(CloudView cloud, s
                                                               std::span<std::int32_t> labels) noexcept {
   const PointsView p = cloud.points;
   if (auto ok = check(p.size(), params, scratch); !ok) { return ok; }
-  const Forest forest{scratch.parent.data()};
-  for (std::uint32_t i = 0; i < p.size(); ++i) { scratch.parent[i] = i; }
-  const float tol2 = params.tolerance * params.tolerance;
-  const auto r = static_cast<std::ptrdiff_t>(params.pixel_radius);
-  const auto w = static_cast<std::ptrdiff_t>(cloud.width), h = static_cast<std::ptrdiff_t>(cloud.height);
-  for (std::ptrdiff_t v = 0; v < h; ++v) {
-    for (std::ptrdiff_t u = 0; u < w; ++u) {
-      const auto i = static_cast<std::size_t>(v * w + u);
-      if (!included(p, mask, i)) { continue; }
-      // Forward half of the window: the rest of this row, then the next r rows.
-      for (std::ptrdiff_t dv = 0; dv <= r && v + dv < h; ++dv) {
-        for (std::ptrdiff_t du = dv == 0 ? 1 : -r; du <= r; ++du) {
-          if (u + du < 0 || u + du >= w) { continue; }
-          const auto j = static_cast<std::size_t>((v + dv) * w + u + du);
-          if (included(p, mask, j) && near(p, i, j, tol2)) {
-            forest.unite(static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(j));
-          }
-        }
-      }
-    }
+  // One pass decides which pixels take part (parent = themselves, the others' a sentinel, so a window
+  // reads one word per neighbour) and lists them in ascending order (the later passes touch only them).
+  std::uint32_t* parent = scratch.parent.data();
+  std::size_t m = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const bool in = included(p, mask, i);
+    parent[i] = in ? static_cast<std::uint32_t>(i) : NOT_INCLUDED;
+    scratch.order[m] = static_cast<std::uint32_t>(i);
+    m += in ? 1U : 0U;
   }
-  return assign_labels(p, mask, params, scratch, labels);
+  const auto members = std::span<const std::uint32_t>(scratch.order).first(m);
+  const auto w = static_cast<std::size_t>(cloud.width);
+  std::size_t v = 0, row_start = 0;
+  for (const std::uint32_t i : members) {
+    while (i >= row_start + w) { ++v, row_start += w; }  // rows from the ascending list: no division
+    link_window(p, w, i - row_start, v, params, scratch);
+  }
+  return assign_labels_listed(members, params, scratch, labels.first(p.size()));
 }
 
 Result<std::size_t, ClusterError> euclidean_cluster(PointsView points, std::span<const std::uint8_t> mask,
@@ -195,7 +243,8 @@ Result<std::size_t, ClusterError> euclidean_cluster(PointsView points, std::span
   auto grid_result = build_grid(points, mask, params.tolerance, scratch);
   if (!grid_result) { return err(grid_result.error()); }
   link_cells(points, *grid_result, params.tolerance * params.tolerance, scratch);
-  return assign_labels(points, mask, params, scratch, labels);
+  return assign_labels(
+      points.size(), [&](std::size_t i) { return included(points, mask, i); }, params, scratch, labels);
 }
 
 }  // namespace orthoflow::kernels

@@ -25,8 +25,12 @@ struct Prism {
 /// projection lies inside (or on) the hull polygon; 0 otherwise (NaN points, hulls of < 3 vertices).
 /// @p heights receives the signed heights (SIMD plane_signed_distance).
 /// @pre mask.size() and heights.size() >= points.size(). @return the number of points kept.
-/// @note Allocation-free, thread-safe. Tolerance against the twin: the plane_distance.hpp one for
-/// points whose height is within 1e-6 x (|p| + |d|) of h_min or h_max.
+/// @note Allocation-free, thread-safe. SIMD: heights by plane_signed_distance; the polygon test runs
+/// only on the points whose height is in range, in float against the hull's half-planes (SIMD over
+/// points, loop over edges), and points within the float rounding slack of an edge take the exact
+/// double test of the twin. Tolerance against the twin: the plane_distance.hpp one for points whose
+/// height is within 1e-6 x (|p| + |d|) of h_min or h_max, and points whose double test is itself
+/// decided by rounding (within ~1e-15 relative of a hull edge's line); all others agree.
 std::size_t polygonal_prism(PointsView points, const Prism& prism, std::span<float> heights,
                             std::span<std::uint8_t> mask) noexcept;
 /// @brief Scalar reference twin of polygonal_prism().

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 
+#include "kernels/pixel_subsample.hpp"
 #include "kernels/polygonal_prism.hpp"
 
 namespace orthoflow::kernels {
@@ -29,8 +30,17 @@ SegmentationChain::SegmentationChain(std::size_t max_points, const SegmentationP
       moments_(max_points / std::max<std::size_t>(1, params.cluster.min_size) + 1), stats_(moments_.size()),
       voxel_scratch_(max_points), cluster_scratch_(max_points) {}
 
-Result<std::size_t, SegmentationError> SegmentationChain::filter_and_voxel(CloudView cloud, SegmentationTimings& t) {
+Result<std::size_t, SegmentationError> SegmentationChain::filter_and_voxel(CloudView cloud, bool organized,
+                                                                           SegmentationTimings& t) {
   auto start = Clock::now();
+  if (organized && params_.organized_stride > 0) {
+    // The plane and hull need a sample about as dense as the 5 mm voxels, not a voxel grid over every
+    // kept pixel: a strided pixel sample costs 1/stride^2 of the frame and needs no sort.
+    const std::size_t n = pixel_subsample(cloud, params_.organized_stride, params_.roi, PointsSpan{kx_, ky_, kz_});
+    plane_points_ = PointsView{std::span(kx_).first(n), std::span(ky_).first(n), std::span(kz_).first(n)};
+    t.filter = ms_since(start);
+    return n;
+  }
   const std::size_t kept = crop_box_mask(cloud.points, params_.roi, mask_);
   const PointsSpan kept_span{std::span(kx_).first(kept), std::span(ky_).first(kept), std::span(kz_).first(kept)};
   compact_masked(cloud.points, mask_, kept_span, {});
@@ -72,12 +82,13 @@ Result<std::size_t, SegmentationError> SegmentationChain::objects(CloudView clou
   // The prism runs on the full-resolution pixels (organized) or on the plane's input points.
   const PointsView target = organized ? cloud.points : plane_points_;
   polygonal_prism(target, prism, heights_, mask_);
-  if (organized) {  // the ROI applies to the pixels too
+  if (organized) {  // the ROI applies to the pixels too (only the few prism pixels need the test)
+    const AxisBox& roi = params_.roi;
     for (std::size_t i = 0; i < target.size(); ++i) {
-      const bool in_roi = target.x[i] >= params_.roi.min[0] && target.x[i] <= params_.roi.max[0] &&
-                          target.y[i] >= params_.roi.min[1] && target.y[i] <= params_.roi.max[1] &&
-                          target.z[i] >= params_.roi.min[2] && target.z[i] <= params_.roi.max[2];
-      mask_[i] = in_roi ? mask_[i] : std::uint8_t{0};
+      if (mask_[i] == 0) { continue; }
+      const bool in_roi = target.x[i] >= roi.min[0] && target.x[i] <= roi.max[0] && target.y[i] >= roi.min[1] &&
+                          target.y[i] <= roi.max[1] && target.z[i] >= roi.min[2] && target.z[i] <= roi.max[2];
+      mask_[i] = in_roi ? std::uint8_t{1} : std::uint8_t{0};
     }
   }
   t.prism = ms_since(start);
@@ -97,14 +108,14 @@ Result<SegmentationResult, SegmentationError> SegmentationChain::run(CloudView c
   if (cloud.points.size() > max_points_) { return err(SegmentationError{"segmentation: cloud larger than max_points"}); }
   const auto start = Clock::now();
   SegmentationTimings t;
-  auto voxel_result = filter_and_voxel(cloud, t);
+  const bool organized = params_.use_organized && cloud.organized();
+  auto voxel_result = filter_and_voxel(cloud, organized, t);
   if (!voxel_result) { return err(voxel_result.error()); }
   auto plane_start = Clock::now();
   auto plane_result = ransac_plane(plane_points_, params_.ransac, inliers_);
   if (!plane_result) { return err(SegmentationError{plane_result.error().to_string()}); }
   plane_ = *plane_result;
   t.plane = ms_since(plane_start);
-  const bool organized = params_.use_organized && cloud.organized();
   auto objects_result = objects(cloud, organized, t);
   if (!objects_result) { return err(objects_result.error()); }
   t.total = std::chrono::duration<double, std::milli>(Clock::now() - start).count();

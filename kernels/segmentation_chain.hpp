@@ -29,6 +29,10 @@ struct SegmentationParams {
   float h_max = 0.5F;
   ClusterParams cluster{};
   bool use_organized = true;  ///< organized input: image-space clustering of full-resolution pixels
+  /// Organized input only: RANSAC and the hull run on every organized_stride-th pixel of every
+  /// organized_stride-th row inside the ROI (pixel_subsample), and leaf is not used; 0: the voxel grid
+  /// of leaf over every kept pixel, as for unorganized input.
+  std::uint32_t organized_stride = 4;
 };
 
 /// @brief Wall time of each stage of the last run, milliseconds.
@@ -63,7 +67,7 @@ class SegmentationChain {
   [[nodiscard]] const SegmentationParams& params() const noexcept { return params_; }
 
  private:
-  Result<std::size_t, SegmentationError> filter_and_voxel(CloudView cloud, SegmentationTimings& t);
+  Result<std::size_t, SegmentationError> filter_and_voxel(CloudView cloud, bool organized, SegmentationTimings& t);
   Result<std::size_t, SegmentationError> hull_of_inliers(std::size_t inliers);
   Result<std::size_t, SegmentationError> objects(CloudView cloud, bool organized, SegmentationTimings& t);
 
