@@ -33,6 +33,17 @@ void finish_moments(const ClusterMoments& m, ClusterStats& s) {
   }
 }
 
+/// The first index >= i below n with a label >= 0, or n. Most pixels of a frame are unlabelled: eight
+/// labels are all negative exactly when the AND of their sign bits is set, one test for eight.
+std::size_t skip_unlabelled(std::span<const std::int32_t> labels, std::size_t i, std::size_t n) {
+  while (i + 8 <= n && (labels[i] & labels[i + 1] & labels[i + 2] & labels[i + 3] & labels[i + 4] & labels[i + 5] &
+                        labels[i + 6] & labels[i + 7]) < 0) {
+    i += 8;
+  }
+  while (i < n && labels[i] < 0) { ++i; }
+  return i;
+}
+
 }  // namespace
 
 std::size_t cluster_stats(PointsView points, std::span<const std::int32_t> labels, std::span<ClusterMoments> moments,
@@ -47,7 +58,8 @@ std::size_t cluster_stats(PointsView points, std::span<const std::int32_t> label
   }
   // Pass 1: counts, boxes, reference points. Pass 2: moments around the reference.
   for (std::size_t i = 0; i < points.size(); ++i) {
-    if (labels[i] < 0) { continue; }
+    i = skip_unlabelled(labels, i, points.size());
+    if (i == points.size()) { break; }
     const auto c = static_cast<std::size_t>(labels[i]);
     ClusterStats& s = out[c];
     const std::array<float, 3> p{points.x[i], points.y[i], points.z[i]};
@@ -71,7 +83,8 @@ std::size_t cluster_stats(PointsView points, std::span<const std::int32_t> label
   }
   // Pass 3: extents in the PCA frame around the centroid.
   for (std::size_t i = 0; i < points.size(); ++i) {
-    if (labels[i] < 0) { continue; }
+    i = skip_unlabelled(labels, i, points.size());
+    if (i == points.size()) { break; }
     ClusterStats& s = out[static_cast<std::size_t>(labels[i])];
     const float q[3] = {points.x[i] - s.centroid[0], points.y[i] - s.centroid[1], points.z[i] - s.centroid[2]};
     for (std::size_t r = 0; r < 3; ++r) {

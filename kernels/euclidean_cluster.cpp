@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 
 #include "kernels/detail/radix_sort.hpp"
 
@@ -208,6 +209,32 @@ void link_window(PointsView p, std::size_t w, std::size_t u, std::size_t v, cons
   parent[i] = root;  // path compression: later windows then mostly see the root directly
 }
 
+/// Lists the included points in ascending order (scratch.order) and makes each its own root; every
+/// other parent is NOT_INCLUDED, so a window reads one word per neighbour. Most of a frame is masked
+/// out: eight zero mask bytes are skipped with one 64-bit test. @return the number listed.
+std::size_t list_members(PointsView p, std::span<const std::uint8_t> mask, ClusterScratch& s) {
+  std::uint32_t* parent = s.parent.data();
+  const std::size_t n = p.size();
+  std::fill(parent, parent + n, NOT_INCLUDED);
+  std::size_t m = 0;
+  for (std::size_t i = 0; i < n;) {
+    if (!mask.empty() && i + 8 <= n) {
+      std::uint64_t word = 0;
+      std::memcpy(&word, mask.data() + i, sizeof word);
+      if (word == 0) {
+        i += 8;
+        continue;
+      }
+    }
+    if (included(p, mask, i)) {
+      parent[i] = static_cast<std::uint32_t>(i);
+      s.order[m++] = static_cast<std::uint32_t>(i);
+    }
+    ++i;
+  }
+  return m;
+}
+
 }  // namespace
 
 Result<std::size_t, ClusterError> euclidean_cluster_organized(CloudView cloud, std::span<const std::uint8_t> mask,
@@ -215,16 +242,7 @@ Result<std::size_t, ClusterError> euclidean_cluster_organized(CloudView cloud, s
                                                               std::span<std::int32_t> labels) noexcept {
   const PointsView p = cloud.points;
   if (auto ok = check(p.size(), params, scratch); !ok) { return ok; }
-  // One pass decides which pixels take part (parent = themselves, the others' a sentinel, so a window
-  // reads one word per neighbour) and lists them in ascending order (the later passes touch only them).
-  std::uint32_t* parent = scratch.parent.data();
-  std::size_t m = 0;
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    const bool in = included(p, mask, i);
-    parent[i] = in ? static_cast<std::uint32_t>(i) : NOT_INCLUDED;
-    scratch.order[m] = static_cast<std::uint32_t>(i);
-    m += in ? 1U : 0U;
-  }
+  const std::size_t m = list_members(p, mask, scratch);
   const auto members = std::span<const std::uint32_t>(scratch.order).first(m);
   const auto w = static_cast<std::size_t>(cloud.width);
   std::size_t v = 0, row_start = 0;

@@ -15,11 +15,11 @@ double cross_at(std::span<const double> hu, std::span<const double> hv, std::siz
   return (hu[b] - hu[a]) * (v - hv[a]) - (hv[b] - hv[a]) * (u - hu[a]);
 }
 
-/// The hull as float half-planes (detail::PrismEdges); false when the float prefilter cannot be used
-/// (fewer than 3 or more than MAX_EDGES vertices): every point then takes the exact test.
-bool make_edges(const Prism& prism, detail::PrismEdges& e) {
+}  // namespace
+
+bool detail::make_prism_edges(const Prism& prism, PrismEdges& e) noexcept {
   const std::size_t n = prism.hull_u.size();
-  if (n < 3 || n > detail::PrismEdges::MAX_EDGES || prism.hull_v.size() != n) { return false; }
+  if (n < 3 || n > PrismEdges::MAX_EDGES || prism.hull_v.size() != n) { return false; }
   double c_max = 0.0;
   for (std::size_t k = 0; k < n; ++k) {
     const std::size_t next = k + 1 == n ? 0 : k + 1;
@@ -46,8 +46,6 @@ bool make_edges(const Prism& prism, detail::PrismEdges& e) {
   return std::isfinite(e.scale);
 }
 
-}  // namespace
-
 bool inside_convex_polygon(std::span<const double> hu, std::span<const double> hv, double u, double v) noexcept {
   const std::size_t n = hu.size();
   if (n < 3) { return false; }
@@ -66,7 +64,7 @@ std::size_t polygonal_prism(PointsView points, const Prism& prism, std::span<flo
   OF_ASSERT(mask.size() >= points.size() && heights.size() >= points.size(), "polygonal_prism: spans too small");
   plane_signed_distance(points, prism.plane, heights);
   detail::PrismEdges edges;
-  if (!make_edges(prism, edges)) {
+  if (!detail::make_prism_edges(prism, edges)) {
     return detail::prism_mask_range(points, prism, heights, mask.data(), 0, points.size());
   }
   static auto dispatched = xsimd::dispatch<SimdArchs>(detail::PrismPolygonKernel{});

@@ -1,6 +1,6 @@
 #pragma once
 // SIMD body of polygonal_prism()'s polygon test: lanes whose height is out of range are rejected a
-// batch at a time; the others are projected on the plane in float and tested against every hull edge
+// batch at a time; the others (box test, then) are projected on the plane in float and tested against every hull edge
 // (SIMD over points, loop over edges). Lanes within the rounding slack of an edge take the exact
 // double test, so the decision is the scalar twin's one (see polygonal_prism.hpp for the only caveat).
 #include <limits>
@@ -27,6 +27,9 @@ std::size_t PrismPolygonKernel::operator()(Arch /*arch*/, PointsView pts, const 
     }
     const batch x = batch::load_unaligned(pts.x.data() + i), y = batch::load_unaligned(pts.y.data() + i),
                 z = batch::load_unaligned(pts.z.data() + i);
+    const AxisBox& box = prism.box;
+    const auto in_box = (x >= batch(box.min[0])) && (x <= batch(box.max[0])) && (y >= batch(box.min[1])) &&
+                        (y <= batch(box.max[1])) && (z >= batch(box.min[2])) && (z <= batch(box.max[2]));
     const batch qx = x - batch(e.origin[0]), qy = y - batch(e.origin[1]), qz = z - batch(e.origin[2]);
     const batch u = qx * batch(e.u[0]) + qy * batch(e.u[1]) + qz * batch(e.u[2]);
     const batch v = qx * batch(e.v[0]) + qy * batch(e.v[1]) + qz * batch(e.v[2]);
@@ -35,7 +38,7 @@ std::size_t PrismPolygonKernel::operator()(Arch /*arch*/, PointsView pts, const 
     const batch eps = batch(e.slack) * (xsimd::abs(x) + xsimd::abs(y) + xsimd::abs(z) + batch(e.scale));
     // 1: inside by more than the slack; 2: undecided (exact test); 0: out of range or outside.
     const batch c = xsimd::select(s_min > eps, batch(1.0F), xsimd::select(s_min >= -eps, batch(2.0F), batch(0.0F)));
-    xsimd::select(in_range, c, batch(0.0F)).store_aligned(code);
+    xsimd::select(in_range && in_box, c, batch(0.0F)).store_aligned(code);
     for (std::size_t l = 0; l < LANES; ++l) {
       const bool keep = code[l] == 1.0F || (code[l] == 2.0F && prism_inside_exact(pts, prism, i + l));
       mask[i + l] = keep ? 1 : 0;

@@ -20,13 +20,18 @@ struct PrismEdges {
   float slack = 0.0F, scale = 0.0F;
 };
 
+/// The hull of @p prism as PrismEdges; false when the float prefilter cannot be used (fewer than 3 or
+/// more than MAX_EDGES vertices, a zero-length edge, non-finite values): every point then takes the
+/// exact test.
+bool make_prism_edges(const Prism& prism, PrismEdges& e) noexcept;
+
 struct PrismPolygonKernel {
   template <class Arch>
   std::size_t operator()(Arch arch, PointsView points, const Prism& prism, const PrismEdges& edges,
                          std::span<const float> heights, std::span<std::uint8_t> mask) const noexcept;
 };
 
-/// The exact rule for point i (height in range and projection inside the hull, in double): the scalar
+/// The exact polygon rule for point i (projection inside the hull, in double): the scalar
 /// twin's, the SIMD tail's and the SIMD body's for lanes the float prefilter cannot decide.
 inline bool prism_inside_exact(PointsView pts, const Prism& prism, std::size_t i) noexcept {
   const PlaneBasis& b = prism.basis;
@@ -41,7 +46,10 @@ inline std::size_t prism_mask_range(PointsView pts, const Prism& prism, std::spa
   std::size_t kept = 0;
   for (std::size_t i = begin; i < end; ++i) {
     const float h = heights[i];
-    const bool keep = h >= prism.h_min && h <= prism.h_max && prism_inside_exact(pts, prism, i);  // NaN: false
+    const AxisBox& box = prism.box;
+    const bool in_box = pts.x[i] >= box.min[0] && pts.x[i] <= box.max[0] && pts.y[i] >= box.min[1] &&
+                        pts.y[i] <= box.max[1] && pts.z[i] >= box.min[2] && pts.z[i] <= box.max[2];
+    const bool keep = h >= prism.h_min && h <= prism.h_max && in_box && prism_inside_exact(pts, prism, i);  // NaN: false
     mask[i] = keep ? 1 : 0;
     kept += keep ? 1U : 0U;
   }
