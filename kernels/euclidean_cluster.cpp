@@ -179,34 +179,55 @@ void link_cells(PointsView p, const Grid& g, float tol2, ClusterScratch& s) {
 
 constexpr std::uint32_t NOT_INCLUDED = 0xFFFFFFFFU;  // parent[] of a pixel that takes no part
 
-/// Links pixel i = (u, v) to the included pixels of the backward half of its (2r+1)^2 window (the r
-/// pixels before it in its row, then the r rows above), which are already linked among themselves:
-/// every edge of the window graph is seen once, from its later pixel. A neighbour whose parent already
-/// is i's root is in i's component: its distance test and find() are skipped (the partition is the
-/// same, only fewer edges are tested). Pixel i is still its own root when it is reached.
-void link_window(PointsView p, std::size_t w, std::size_t u, std::size_t v, const ClusterParams& prm,
-                 ClusterScratch& s) {
-  const Forest forest{s.parent.data()};
-  std::uint32_t* parent = s.parent.data();
-  const float tol2 = prm.tolerance * prm.tolerance;
+/// Links pixel i (at xi, yi, zi) to its neighbours one at a time, keeping i's current root. A neighbour
+/// whose parent already is that root is in i's component: no distance test, no find(). clean stays
+/// true while every included neighbour seen is known to end in i's component.
+struct Linker {
+  PointsView p;
+  std::uint32_t* parent;
+  float tol2, xi, yi, zi;
+  std::uint32_t root;
+  bool clean = true;
+  void visit(std::size_t j) noexcept {
+    const std::uint32_t pj = parent[j];
+    if (pj == NOT_INCLUDED || pj == root) { return; }
+    const float dx = xi - p.x[j], dy = yi - p.y[j], dz = zi - p.z[j];
+    if (dx * dx + dy * dy + dz * dz > tol2) {
+      clean = false;  // maybe in another component: not known
+      return;
+    }
+    const std::uint32_t other = Forest{parent}.find(static_cast<std::uint32_t>(j));
+    if (other == root) { return; }
+    parent[std::max(root, other)] = std::min(root, other);  // roots: the lowest index stays the root
+    root = std::min(root, other);
+  }
+};
+
+/// Links pixel i = (u, v) to the backward half of its (2r+1)^2 window (the r pixels before it in its
+/// row, then the r rows above), already linked among themselves: every edge of the window graph is
+/// seen from its later pixel. Row runs: when the left pixel i-1 is included, was clean (every included
+/// pixel of its window ended in its component) and links to i, the part of i's window that i-1's
+/// window covers is in i's component already, so only the new column u + r of the rows above is
+/// visited (the partition is the same, far fewer edges are tested). @return whether i is clean.
+bool link_window(PointsView p, std::size_t w, std::size_t u, std::size_t v, const ClusterParams& prm,
+                 std::uint32_t* parent, bool left_clean) {
   const std::size_t r = prm.pixel_radius, i = v * w + u;
-  const float xi = p.x[i], yi = p.y[i], zi = p.z[i];
-  auto root = static_cast<std::uint32_t>(i);
   const std::size_t u_lo = u >= r ? u - r : 0, u_hi = std::min(w - 1, u + r), v_lo = v >= r ? v - r : 0;
-  for (std::size_t vv = v_lo; vv <= v; ++vv) {
-    const std::size_t end = vv == v ? u : u_hi + 1;
-    for (std::size_t uu = u_lo; uu < end; ++uu) {
-      const std::size_t j = vv * w + uu;
-      if (parent[j] == NOT_INCLUDED || parent[j] == root) { continue; }
-      const float dx = xi - p.x[j], dy = yi - p.y[j], dz = zi - p.z[j];
-      if (dx * dx + dy * dy + dz * dz > tol2) { continue; }
-      const std::uint32_t other = forest.find(static_cast<std::uint32_t>(j));
-      if (other == root) { continue; }
-      parent[std::max(root, other)] = std::min(root, other);  // roots: the lowest index stays the root
-      root = std::min(root, other);
+  Linker link{p, parent, prm.tolerance * prm.tolerance, p.x[i], p.y[i], p.z[i], static_cast<std::uint32_t>(i)};
+  if (left_clean) {
+    link.visit(i - 1);
+    if (link.root != i) {  // i joined i-1's component
+      for (std::size_t vv = v_lo; vv < v && u + r < w; ++vv) { link.visit(vv * w + u + r); }
+      parent[i] = link.root;
+      return link.clean;
     }
   }
-  parent[i] = root;  // path compression: later windows then mostly see the root directly
+  for (std::size_t vv = v_lo; vv <= v; ++vv) {
+    const std::size_t end = vv == v ? u : u_hi + 1;
+    for (std::size_t uu = u_lo; uu < end; ++uu) { link.visit(vv * w + uu); }
+  }
+  parent[i] = link.root;  // path compression: later windows then mostly see the root directly
+  return link.clean;
 }
 
 /// Lists the included points in ascending order (scratch.order) and makes each its own root; every
@@ -245,10 +266,13 @@ Result<std::size_t, ClusterError> euclidean_cluster_organized(CloudView cloud, s
   const std::size_t m = list_members(p, mask, scratch);
   const auto members = std::span<const std::uint32_t>(scratch.order).first(m);
   const auto w = static_cast<std::size_t>(cloud.width);
-  std::size_t v = 0, row_start = 0;
+  std::size_t v = 0, row_start = 0, previous = 0;
+  bool previous_clean = false;
   for (const std::uint32_t i : members) {
     while (i >= row_start + w) { ++v, row_start += w; }  // rows from the ascending list: no division
-    link_window(p, w, i - row_start, v, params, scratch);
+    const bool left_clean = previous_clean && previous + 1 == i && i > row_start;
+    previous_clean = link_window(p, w, i - row_start, v, params, scratch.parent.data(), left_clean);
+    previous = i;
   }
   return assign_labels_listed(members, params, scratch, labels.first(p.size()));
 }

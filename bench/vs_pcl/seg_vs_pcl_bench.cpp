@@ -1,7 +1,9 @@
 // Ours vs PCL 1.13, same frames, same parameters, same run: each stage and the whole tabletop chain on
 // the shared mOSD frames and on synthetic scenes with 3, 10 and 30 objects. 3 warm-up runs, then
 // ROUNDS rounds alternating ours and PCL; prints medians (ms), ratios PCL/ours and detection quality
-// (tests/kernels/seg_quality.hpp rule). Usage: seg_vs_pcl_bench [ROUNDS]. Single-threaded.
+// (tests/kernels/seg_quality.hpp rule). Usage: seg_vs_pcl_bench [ROUNDS]. Single-threaded. The mOSD
+// frames run twice: the default chain (strided pixel sample for the plane) and organized_stride = 0
+// (the voxel grid of every kept pixel, as before).
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -30,9 +32,9 @@ struct Input {
   std::vector<std::uint32_t> gt;  // mOSD-style labels (object k >= 2 as 10k)
 };
 
-void run_input(const Input& in, int rounds) {
+void run_input(const Input& in, int rounds, const ok::SegmentationParams& params = {}, const char* suffix = "") {
   const auto pcl_cloud = ob::to_pcl(in.cloud);
-  ok::SegmentationChain chain(in.cloud.size(), ok::SegmentationParams{});
+  ok::SegmentationChain chain(in.cloud.size(), params);
   std::vector<std::vector<double>> ours(6), theirs(6);
   ob::PclResult pcl_last;
   std::vector<std::int32_t> our_labels;
@@ -49,8 +51,12 @@ void run_input(const Input& in, int rounds) {
     if (r == rounds - 1) { our_labels.assign(seg->labels.begin(), seg->labels.end()); }
   }
   const char* stages[6] = {"filter", "voxel", "plane", "hull+prism", "cluster+stats", "total"};
-  std::printf("| %s |", in.name.c_str());
+  std::printf("| %s%s |", in.name.c_str(), suffix);
   for (int s = 0; s < 6; ++s) {
+    if (median(ours[s]) == 0.0) {  // a stage our chain does not run (the voxel grid on the strided path)
+      std::printf(" not run / %.2f |", median(theirs[s]));
+      continue;
+    }
     std::printf(" %.2f / %.2f = %.1fx |", median(ours[s]), median(theirs[s]), median(theirs[s]) / median(ours[s]));
   }
   const auto q_ours = orthoflow::testing::evaluate(in.gt, our_labels);
@@ -87,6 +93,9 @@ int main(int argc, char** argv) {
     Input in{std::string("mOSD ") + f, std::move(*cloud_result), {}};
     in.gt.assign(in.cloud.label().begin(), in.cloud.label().end());
     run_input(in, rounds);
+    ok::SegmentationParams voxel_params;  // the organized chain with the voxel grid as plane input
+    voxel_params.organized_stride = 0;
+    run_input(in, rounds, voxel_params, " (stride 0: voxel grid)");
   }
   for (const std::uint32_t n : {3U, 10U, 30U}) { run_input(synthetic(n, 1000U + n), rounds); }
   return 0;

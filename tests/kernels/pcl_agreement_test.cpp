@@ -109,6 +109,23 @@ TEST_P(PclAgreement, IdenticalClusterPartitionOnTheSamePoints) {
   EXPECT_TRUE(ours_sets == pcl_sets);
 }
 
+TEST_P(PclAgreement, OrganizedChainPlaneWithinOneDegreeAndFiveMillimetres) {
+  // The organized chain fits the plane on a strided pixel sample (SegmentationParams::organized_stride)
+  // instead of the voxels: the plane tolerance still holds against PCL's voxel RANSAC.
+  ok::SegmentationChain chain(cloud_.size(), ok::SegmentationParams{});
+  auto seg = chain.run(cloud_.view());
+  ASSERT_TRUE(seg) << seg.error().to_string();
+  const auto& c = pcl_.plane.values;
+  ASSERT_EQ(c.size(), 4U);
+  const double len = std::sqrt(double(c[0]) * c[0] + double(c[1]) * c[1] + double(c[2]) * c[2]);
+  const auto& n = seg->plane.plane.normal;
+  double dot = (n[0] * c[0] + n[1] * c[1] + n[2] * c[2]) / len;
+  const double sign = dot < 0 ? -1.0 : 1.0;
+  dot *= sign;
+  EXPECT_LT(std::acos(std::min(1.0, dot)) * 180.0 / 3.14159265358979, 1.0);
+  EXPECT_NEAR(double(seg->plane.plane.d), sign * c[3] / len, 0.005);
+}
+
 INSTANTIATE_TEST_SUITE_P(Mosd, PclAgreement, ::testing::Values("test31.pcd", "test44.pcd", "test55.pcd"),
                          [](const auto& p) { return std::string(p.param).substr(0, 6); });
 

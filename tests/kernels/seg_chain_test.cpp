@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <new>
@@ -76,6 +77,31 @@ TEST_P(SegChainFrames, FindsTableAndObjects) {
   EXPECT_EQ(g_allocations.load(), 0U);
   ASSERT_TRUE(again);
   EXPECT_TRUE(std::equal(first.begin(), first.end(), again->labels.begin()));
+}
+
+TEST(SegChain, OrganizedStrideZeroRunsTheVoxelGrid) {
+  // organized_stride = 0 puts the voxel grid (leaf) back in front of RANSAC on organized input; both
+  // plane inputs give the same table within the tolerance and the same objects on test31.
+  auto cloud_result = orthoflow::drivers::read_pcd(std::string(ORTHOFLOW_SHARED_DIR) + "/data/scenes/test31.pcd");
+  ASSERT_TRUE(cloud_result) << cloud_result.error().to_string();
+  const ok::PointCloud& cloud = *cloud_result;
+  ok::SegmentationParams voxel_params;
+  voxel_params.organized_stride = 0;
+  ok::SegmentationChain strided(cloud.size(), ok::SegmentationParams{}), voxel(cloud.size(), voxel_params);
+  auto a = strided.run(cloud.view());
+  auto b = voxel.run(cloud.view());
+  ASSERT_TRUE(a && b);
+  EXPECT_EQ(a->timings.voxel, 0.0);  // no voxel grid on the strided path
+  EXPECT_GT(b->timings.voxel, 0.0);
+  EXPECT_GT(b->plane.inliers, 4 * a->plane.inliers);  // voxels are about 4x denser than a stride-4 sample
+  const auto& na = a->plane.plane.normal;
+  const auto& nb = b->plane.plane.normal;
+  EXPECT_GT(double(na[0] * nb[0] + na[1] * nb[1] + na[2] * nb[2]), std::cos(3.14159265358979 / 180.0));
+  EXPECT_NEAR(a->plane.plane.d, b->plane.plane.d, 0.005F);
+  const auto qa = orthoflow::testing::evaluate(cloud.label(), a->labels);
+  const auto qb = orthoflow::testing::evaluate(cloud.label(), b->labels);
+  EXPECT_EQ(qa.matched, qb.matched);
+  EXPECT_GE(qa.matched, 2U);
 }
 
 INSTANTIATE_TEST_SUITE_P(Mosd, SegChainFrames,
