@@ -6,7 +6,6 @@
 #include "kernels/pixel_subsample.hpp"
 #include "kernels/polygonal_prism.hpp"
 
-double g_prof[8];
 namespace orthoflow::kernels {
 
 namespace {
@@ -78,14 +77,12 @@ Result<std::size_t, SegmentationError> SegmentationChain::objects(CloudView clou
   auto hull_result = hull_of_inliers(plane_.inliers);
   if (!hull_result) { return hull_result; }
   const std::size_t h = *hull_result;
-  g_prof[0] += ms_since(start); g_prof[5] = double(h);
   const Prism prism{plane_.plane, make_plane_basis(plane_.plane), std::span<const double>(hull_u_).first(h),
                     std::span<const double>(hull_v_).first(h), params_.h_min, params_.h_max,
                     params_.roi};  // the ROI applies to the pixels too (the voxels lie in it already)
   // The prism runs on the full-resolution pixels (organized) or on the plane's input points.
   const PointsView target = organized ? cloud.points : plane_points_;
   polygonal_prism(target, prism, heights_, mask_);
-  g_prof[1] += ms_since(start);
   t.prism = ms_since(start);
   const auto mask = std::span<const std::uint8_t>(mask_).first(target.size());
   auto labels = std::span(labels_).first(target.size());
@@ -93,10 +90,9 @@ Result<std::size_t, SegmentationError> SegmentationChain::objects(CloudView clou
                                                                  params_.cluster, cluster_scratch_, labels)
                                    : euclidean_cluster(target, mask, params_.cluster, cluster_scratch_, labels);
   if (!clusters_result) { return err(SegmentationError{clusters_result.error().to_string()}); }
-  g_prof[3] += ms_since(start);
   const std::size_t clusters = std::min(*clusters_result, stats_.size());
   cluster_stats(target, labels, moments_, std::span(stats_).first(clusters));
-  t.cluster = ms_since(start); g_prof[4] += t.cluster;
+  t.cluster = ms_since(start);
   return clusters;
 }
 
