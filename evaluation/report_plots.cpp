@@ -114,12 +114,20 @@ Series gca_series(const VariantResult& v) {
   return s;
 }
 
-/// Learned categories against iterations, first run (the same category order for every variant).
-Series learning_series(const VariantResult& v) {
-  Series s{v.variant.name(), {}, {}, {}, false};
-  for (const LearnedPoint& p : v.teacher.front().curve) {
+/// Learned categories against iterations of one run, as a staircase ending at the last iteration.
+Series learning_series(const std::string& name, const TeacherRun& run) {
+  Series s{name, {}, {}, {}, false};
+  for (const LearnedPoint& p : run.curve) {
+    if (!s.x.empty()) {
+      s.x.push_back(static_cast<double>(p.iteration));
+      s.y.push_back(s.y.back());
+    }
     s.x.push_back(static_cast<double>(p.iteration));
     s.y.push_back(static_cast<double>(p.learned));
+  }
+  if (!s.x.empty() && run.qci > run.curve.back().iteration) {
+    s.x.push_back(static_cast<double>(run.qci));
+    s.y.push_back(s.y.back());
   }
   return s;
 }
@@ -129,7 +137,11 @@ Series learning_series(const VariantResult& v) {
 std::string summary_markdown(const Evaluation& e) {
   std::ostringstream md;
   md << "### " << to_string(e.options.protocol) << ": " << e.categories.size() << " categories, " << e.instances
-     << " instances, " << e.views << " views; " << e.options.runs << " runs, seed " << e.options.seed << "\n\n";
+     << " instances, " << e.views << " views; " << e.options.runs << " runs, seed " << e.options.seed;
+  if (e.options.protocol == Protocol::TEACHER || e.options.protocol == Protocol::TEACHER_CONTEXT) {
+    md << "; tau " << fixed(e.options.teacher.tau, 2) << ", breakpoint " << e.options.teacher.breakpoint;
+  }
+  md << "\n\n";
   switch (e.options.protocol) {
     case Protocol::CV10: cv_rows(md, e); break;
     case Protocol::TEACHER: teacher_rows(md, e); break;
@@ -147,12 +159,17 @@ std::vector<std::pair<std::string, PlotSpec>> evaluation_plots(const Evaluation&
   if ((p == Protocol::TEACHER || p == Protocol::TEACHER_CONTEXT) && !e.variants.empty()) {
     PlotSpec learned{"Learned categories vs question/correction iterations (run 1)", "question/correction iterations", "learned categories", {}, std::nullopt, std::nullopt, 800, 500};
     PlotSpec gca{"Global classification accuracy vs learned categories (mean ± std over runs)", "learned categories", "global accuracy", {}, 0.0, 1.0, 800, 500};
+    PlotSpec context{"Context change: learned categories vs iterations (run 1)", "question/correction iterations", "learned categories", {}, std::nullopt, std::nullopt, 800, 500};
     for (const VariantResult& v : e.variants) {
-      learned.series.push_back(learning_series(v));
+      learned.series.push_back(learning_series(v.variant.name(), v.teacher.front()));
       gca.series.push_back(gca_series(v));
+      if (!v.context.empty()) {
+        context.series.push_back(learning_series(v.variant.name() + " (A: " + std::to_string(v.rho.front()) + ")", v.context.front()));
+      }
     }
     plots.emplace_back("learned_categories", std::move(learned));
     plots.emplace_back("accuracy_vs_learned", std::move(gca));
+    if (p == Protocol::TEACHER_CONTEXT) { plots.emplace_back("learned_categories_context", std::move(context)); }
   }
   if (p == Protocol::NOISE || p == Protocol::DOWNSAMPLE) {
     const bool noise = p == Protocol::NOISE;

@@ -125,7 +125,7 @@ TEST_F(Experiment, ReportWritesJsonMarkdownAndPlots) {
   ASSERT_TRUE(e);
   auto written = write_report(*e, out / "sub");
   ASSERT_TRUE(written) << written.error().to_string();
-  EXPECT_EQ(written->size(), 6U);
+  EXPECT_EQ(written->size(), 8U);  // json, md, 3 plots x (png, svg)
   for (const fs::path& f : *written) { EXPECT_GT(fs::file_size(f), 100U) << f; }
   const auto j = nlohmann::json::parse(results_json(*e));
   EXPECT_EQ(j["protocol"], "teacher-context");
