@@ -101,6 +101,11 @@ Result<SegmentationResult, SegmentationError> SegmentationChain::run(CloudView c
   const auto start = Clock::now();
   SegmentationTimings t;
   const bool organized = params_.use_organized && cloud.organized();
+  if (organized && cloud.points.size() != std::size_t{cloud.width} * cloud.height) {
+    return err(SegmentationError{"segmentation: organized cloud of " + std::to_string(cloud.points.size()) +
+                                 " points is not " + std::to_string(cloud.width) + " x " +
+                                 std::to_string(cloud.height)});
+  }
   auto voxel_result = filter_and_voxel(cloud, organized, t);
   if (!voxel_result) { return err(voxel_result.error()); }
   auto plane_start = Clock::now();

@@ -2,10 +2,11 @@
 /// @file
 /// @brief The tabletop chain of specs/PIPELINE.md sections 2-4 composed from the kernels, with all its
 /// memory sized once at construction (nothing allocates in run()). Chains (see docs/SEGMENTATION.md):
-/// - organized frame: ROI mask -> voxel grid of the kept points -> RANSAC plane on the voxels -> hull of
-///   the voxel inliers -> prism over the full-resolution pixels -> image-space clustering of those pixels.
+/// - organized frame: strided pixel sample inside the ROI -> RANSAC plane on the sample -> hull of the
+///   sample inliers -> prism (and ROI) over the full-resolution pixels -> image-space clustering of those
+///   pixels. With organized_stride == 0 the sample is replaced by the voxel grid of every kept pixel.
 /// - unorganized cloud: ROI -> voxel grid -> RANSAC -> hull -> prism -> grid clustering, all on voxels.
-/// leaf == 0 skips the voxel grid (RANSAC and hull then run on every kept point).
+/// leaf == 0 skips the voxel grid where it runs (RANSAC and hull then run on every kept point).
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -62,7 +63,8 @@ class SegmentationChain {
  public:
   /// @brief Allocates every buffer for clouds of up to @p max_points points.
   SegmentationChain(std::size_t max_points, const SegmentationParams& params);
-  /// @brief Segments @p cloud. @pre cloud.points.size() <= max_points. Allocation-free.
+  /// @brief Segments @p cloud. @pre cloud.points.size() <= max_points. Allocation-free. An organized
+  /// cloud whose point count is not width x height is an error.
   [[nodiscard]] Result<SegmentationResult, SegmentationError> run(CloudView cloud);
   [[nodiscard]] const SegmentationParams& params() const noexcept { return params_; }
 

@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <new>
 #include <string>
+#include <vector>
 
 #include "drivers/pcd_io.hpp"
 #include "kernels/segmentation_chain.hpp"
@@ -102,6 +103,14 @@ TEST(SegChain, OrganizedStrideZeroRunsTheVoxelGrid) {
   const auto qb = orthoflow::testing::evaluate(cloud.label(), b->labels);
   EXPECT_EQ(qa.matched, qb.matched);
   EXPECT_GE(qa.matched, 2U);
+}
+
+TEST(SegChain, OrganizedSizeMismatchIsAnError) {
+  std::vector<float> x(10, 1.0F), y(10, 0.0F), z(10, 1.0F);
+  ok::SegmentationChain chain(16, ok::SegmentationParams{});
+  auto seg = chain.run(ok::CloudView{{x, y, z}, 4, 4});  // 10 points for a 4 x 4 image
+  ASSERT_FALSE(seg);
+  EXPECT_NE(seg.error().to_string().find("10 points is not 4 x 4"), std::string::npos) << seg.error().to_string();
 }
 
 INSTANTIATE_TEST_SUITE_P(Mosd, SegChainFrames,
