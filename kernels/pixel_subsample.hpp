@@ -16,7 +16,7 @@ namespace orthoflow::kernels {
 /// @pre stride >= 1; cloud.points.size() == width * height; out.size() >= the pixels sampled
 /// (ceil(width / stride) * ceil(height / stride) is enough). @return the number of points written.
 /// @note Allocation-free, thread-safe, deterministic. No SIMD variant: a strided gather that touches
-/// 1 / stride^2 of the frame (memory bound; 20 us for 640x480 at stride 4).
+/// 1 / stride^2 of the pixels (every stride-th row is read; 0.06-0.1 ms for 640x480 at stride 4).
 std::size_t pixel_subsample(CloudView cloud, std::uint32_t stride, const AxisBox& roi, PointsSpan out) noexcept;
 
 }  // namespace orthoflow::kernels
