@@ -58,8 +58,7 @@ std::size_t cluster_stats(PointsView points, std::span<const std::int32_t> label
   }
   // Pass 1: counts, boxes, reference points. Pass 2: moments around the reference.
   for (std::size_t i = 0; i < points.size(); ++i) {
-    i = skip_unlabelled(labels, i, points.size());
-    if (i == points.size()) { break; }
+    if (labels[i] < 0 && (i = skip_unlabelled(labels, i, points.size())) == points.size()) { break; }
     const auto c = static_cast<std::size_t>(labels[i]);
     ClusterStats& s = out[c];
     const std::array<float, 3> p{points.x[i], points.y[i], points.z[i]};
@@ -83,8 +82,7 @@ std::size_t cluster_stats(PointsView points, std::span<const std::int32_t> label
   }
   // Pass 3: extents in the PCA frame around the centroid.
   for (std::size_t i = 0; i < points.size(); ++i) {
-    i = skip_unlabelled(labels, i, points.size());
-    if (i == points.size()) { break; }
+    if (labels[i] < 0 && (i = skip_unlabelled(labels, i, points.size())) == points.size()) { break; }
     ClusterStats& s = out[static_cast<std::size_t>(labels[i])];
     const float q[3] = {points.x[i] - s.centroid[0], points.y[i] - s.centroid[1], points.z[i] - s.centroid[2]};
     for (std::size_t r = 0; r < 3; ++r) {

@@ -76,11 +76,14 @@ std::size_t assign_labels_listed(std::span<const std::uint32_t> members, const C
                                  std::span<std::int32_t> labels) {
   const Forest forest{s.parent.data()};
   for (const std::uint32_t i : members) { s.count[i] = 0; }
-  for (const std::uint32_t i : members) { ++s.count[forest.find(i)]; }
+  for (const std::uint32_t i : members) {  // no link follows: each member can point at its root directly
+    s.parent[i] = forest.find(i);
+    ++s.count[s.parent[i]];
+  }
   std::fill(labels.begin(), labels.end(), -1);
   std::int32_t next = 0;
   for (const std::uint32_t i : members) {  // ascending: a component's root comes before its other points
-    const std::uint32_t root = forest.find(i);
+    const std::uint32_t root = s.parent[i];
     if (root == i) {
       const bool keep = s.count[i] >= prm.min_size && s.count[i] <= prm.max_size;
       s.count[i] = keep ? static_cast<std::uint32_t>(++next) : 0U;
