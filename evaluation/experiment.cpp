@@ -70,13 +70,21 @@ void tick(Progress* p) {
   if (p != nullptr) { p->advance(); }
 }
 
-Result<void, EvalError> run_cv(const Dataset& ds, const EvalOptions& o, Tables& tables, Evaluation& e, Progress* p) {
+/// The fold split of every run (seeded by the run, shared by every variant and level).
+Result<std::vector<Folds>, EvalError> folds_per_run(const Dataset& ds, const EvalOptions& o) {
   std::vector<Folds> folds;
   for (std::size_t r = 0; r < o.runs; ++r) {
     auto f = make_folds(ds, o.folds, run_seed(o.seed, r));
     if (!f) { return err(f.error()); }
     folds.push_back(std::move(*f));
   }
+  return folds;
+}
+
+Result<void, EvalError> run_cv(const Dataset& ds, const EvalOptions& o, Tables& tables, Evaluation& e, Progress* p) {
+  auto run_folds = folds_per_run(ds, o);
+  if (!run_folds) { return err(run_folds.error()); }
+  const std::vector<Folds>& folds = *run_folds;
   for (VariantResult& vr : e.variants) {
     auto t = tables.get(vr.variant.descriptor());
     if (!t) { return err(t.error()); }
@@ -93,12 +101,9 @@ Result<void, EvalError> run_levels(const Dataset& ds, const EvalOptions& o, Tabl
   const Perturbation kind = o.protocol == Protocol::NOISE ? Perturbation::NOISE : Perturbation::DOWNSAMPLE;
   std::vector<double> levels{0.0};
   for (const double l : protocol_levels(o)) { levels.push_back(l); }
-  std::vector<Folds> folds;
-  for (std::size_t r = 0; r < o.runs; ++r) {
-    auto f = make_folds(ds, o.folds, run_seed(o.seed, r));
-    if (!f) { return err(f.error()); }
-    folds.push_back(std::move(*f));
-  }
+  auto run_folds = folds_per_run(ds, o);
+  if (!run_folds) { return err(run_folds.error()); }
+  const std::vector<Folds>& folds = *run_folds;
   for (VariantResult& vr : e.variants) {
     auto clean = tables.get(vr.variant.descriptor());
     if (!clean) { return err(clean.error()); }
