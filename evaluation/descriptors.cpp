@@ -92,6 +92,21 @@ DescriptorCache load_cache(const std::filesystem::path& path, std::size_t length
   return parse_descriptor_cache(bytes, length);
 }
 
+/// Copies the cached descriptor of every view whose file is unchanged into @p table; 1 = taken from the cache.
+std::vector<std::uint8_t> fill_from_cache(const Dataset& ds, const DescriptorCache& cache, std::vector<FileStamp>& stamps,
+                                          DescriptorTable& table) {
+  std::vector<std::uint8_t> hit(ds.views.size(), 0);
+  for (std::size_t v = 0; v < ds.views.size(); ++v) {
+    const auto it = cache.entries.find(ds.views[v].relative);
+    if (stamp_file(ds.root / ds.views[v].relative, stamps[v]) && it != cache.entries.end() && it->second.stamp == stamps[v]) {
+      std::copy(it->second.descriptor.begin(), it->second.descriptor.end(),
+                table.values.begin() + static_cast<std::ptrdiff_t>(v * table.length));
+      hit[v] = 1;
+    }
+  }
+  return hit;
+}
+
 }  // namespace
 
 std::string DescriptorSpec::key() const {
@@ -133,15 +148,7 @@ Result<DescriptorTable, EvalError> describe_dataset(const Dataset& dataset, cons
   const std::filesystem::path file = cache_dir.empty() ? std::filesystem::path{} : cache_path(dataset, spec, cache_dir);
   DescriptorCache cache = file.empty() ? DescriptorCache{spec.length(), {}} : load_cache(file, spec.length());
   std::vector<FileStamp> stamps(n);
-  std::vector<std::uint8_t> hit(n, 0);
-  for (std::size_t v = 0; v < n; ++v) {
-    const auto it = cache.entries.find(dataset.views[v].relative);
-    if (stamp_file(dataset.root / dataset.views[v].relative, stamps[v]) && it != cache.entries.end() &&
-        it->second.stamp == stamps[v]) {
-      std::copy(it->second.descriptor.begin(), it->second.descriptor.end(), table.values.begin() + static_cast<std::ptrdiff_t>(v * table.length));
-      hit[v] = 1;
-    }
-  }
+  const std::vector<std::uint8_t> hit = fill_from_cache(dataset, cache, stamps, table);
   std::vector<std::string> errors(n);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 8), [&](const tbb::blocked_range<std::size_t>& r) {
     kernels::GoodScratch scratch(spec.bins);
