@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 
 #include "kernels/pixel_subsample.hpp"
 #include "kernels/polygonal_prism.hpp"
@@ -17,6 +18,17 @@ double ms_since(Clock::time_point& start) {
   const double ms = std::chrono::duration<double, std::milli>(now - start).count();
   start = now;
   return ms;
+}
+
+/// Indices of the points within tau of the plane (ransac_plane's rule), ascending. @pre out holds them all.
+std::size_t collect_inliers(PointsView p, const Plane& plane, float tau, std::span<std::uint32_t> out) {
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const float dist = plane.normal[0] * p.x[i] + plane.normal[1] * p.y[i] + plane.normal[2] * p.z[i] + plane.d;
+    out[n] = static_cast<std::uint32_t>(i);
+    n += std::fabs(dist) <= tau ? 1U : 0U;  // false for NaN
+  }
+  return n;
 }
 
 }  // namespace
@@ -38,6 +50,10 @@ Result<std::size_t, SegmentationError> SegmentationChain::filter_and_voxel(Cloud
     // kept pixel: a strided pixel sample costs 1/stride^2 of the frame and needs no sort.
     const std::size_t n = pixel_subsample(cloud, params_.organized_stride, params_.roi, PointsSpan{kx_, ky_, kz_});
     plane_points_ = PointsView{std::span(kx_).first(n), std::span(ky_).first(n), std::span(kz_).first(n)};
+    // RANSAC scores its hypotheses on the sample at twice the stride (a quarter of the points); the
+    // refit then uses the full sample (fit_plane_on_sample).
+    const std::size_t m = pixel_subsample(cloud, 2 * params_.organized_stride, params_.roi, PointsSpan{vx_, vy_, vz_});
+    sparse_points_ = PointsView{std::span(vx_).first(m), std::span(vy_).first(m), std::span(vz_).first(m)};
     t.filter = ms_since(start);
     return n;
   }
@@ -96,6 +112,22 @@ Result<std::size_t, SegmentationError> SegmentationChain::objects(CloudView clou
   return clusters;
 }
 
+Result<std::size_t, SegmentationError> SegmentationChain::fit_plane_on_sample(bool organized) {
+  const bool two_level = organized && params_.organized_stride > 0 && sparse_points_.size() >= MIN_SPARSE_POINTS;
+  auto ransac_result = ransac_plane(two_level ? sparse_points_ : plane_points_, params_.ransac, inliers_);
+  if (!ransac_result) { return err(SegmentationError{ransac_result.error().to_string()}); }
+  plane_ = *ransac_result;
+  if (!two_level) { return plane_.inliers; }
+  // The refit of RANSAC (least squares on the inliers, then the inliers of the refit plane) once more on
+  // the full sample: the plane and the hull get the density of the stride-s sample.
+  const float tau = params_.ransac.tau;
+  const std::size_t first = collect_inliers(plane_points_, plane_.plane, tau, inliers_);
+  if (first < 3) { return err(SegmentationError{"segmentation: the plane has fewer than 3 inliers on the sample"}); }
+  plane_.plane = fit_plane(plane_points_, std::span<const std::uint32_t>(inliers_).first(first));
+  plane_.inliers = collect_inliers(plane_points_, plane_.plane, tau, inliers_);
+  return plane_.inliers;
+}
+
 Result<SegmentationResult, SegmentationError> SegmentationChain::run(CloudView cloud) {
   if (cloud.points.size() > max_points_) { return err(SegmentationError{"segmentation: cloud larger than max_points"}); }
   const auto start = Clock::now();
@@ -109,9 +141,8 @@ Result<SegmentationResult, SegmentationError> SegmentationChain::run(CloudView c
   auto voxel_result = filter_and_voxel(cloud, organized, t);
   if (!voxel_result) { return err(voxel_result.error()); }
   auto plane_start = Clock::now();
-  auto plane_result = ransac_plane(plane_points_, params_.ransac, inliers_);
-  if (!plane_result) { return err(SegmentationError{plane_result.error().to_string()}); }
-  plane_ = *plane_result;
+  auto plane_result = fit_plane_on_sample(organized);
+  if (!plane_result) { return err(plane_result.error()); }
   t.plane = ms_since(plane_start);
   auto objects_result = objects(cloud, organized, t);
   if (!objects_result) { return err(objects_result.error()); }

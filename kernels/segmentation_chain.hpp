@@ -2,8 +2,8 @@
 /// @file
 /// @brief The tabletop chain of specs/PIPELINE.md sections 2-4 composed from the kernels, with all its
 /// memory sized once at construction (nothing allocates in run()). Chains (see docs/SEGMENTATION.md):
-/// - organized frame: strided pixel sample inside the ROI -> RANSAC plane on the sample -> hull of the
-///   sample inliers -> prism (and ROI) over the full-resolution pixels -> image-space clustering of those
+/// - organized frame: strided pixel sample inside the ROI -> RANSAC plane (hypotheses scored on the
+///   sample at twice the stride, refit on the sample) -> hull of the sample inliers -> prism (and ROI) over the full-resolution pixels -> image-space clustering of those
 ///   pixels. With organized_stride == 0 the sample is replaced by the voxel grid of every kept pixel.
 /// - unorganized cloud: ROI -> voxel grid -> RANSAC -> hull -> prism -> grid clustering, all on voxels.
 /// leaf == 0 skips the voxel grid where it runs (RANSAC and hull then run on every kept point).
@@ -30,9 +30,10 @@ struct SegmentationParams {
   float h_max = 0.5F;
   ClusterParams cluster{};
   bool use_organized = true;  ///< organized input: image-space clustering of full-resolution pixels
-  /// Organized input only: RANSAC and the hull run on every organized_stride-th pixel of every
-  /// organized_stride-th row inside the ROI (pixel_subsample), and leaf is not used; 0: the voxel grid
-  /// of leaf over every kept pixel, as for unorganized input.
+  /// Organized input only: the plane refit and the hull run on every organized_stride-th pixel of every
+  /// organized_stride-th row inside the ROI (pixel_subsample), RANSAC scores its hypotheses on the sample
+  /// at twice that stride (when it has >= 500 points), and leaf is not used; 0: the voxel grid of leaf
+  /// over every kept pixel, as for unorganized input.
   std::uint32_t organized_stride = 4;
 };
 
@@ -70,6 +71,7 @@ class SegmentationChain {
 
  private:
   Result<std::size_t, SegmentationError> filter_and_voxel(CloudView cloud, bool organized, SegmentationTimings& t);
+  Result<std::size_t, SegmentationError> fit_plane_on_sample(bool organized);
   Result<std::size_t, SegmentationError> hull_of_inliers(std::size_t inliers);
   Result<std::size_t, SegmentationError> objects(CloudView cloud, bool organized, SegmentationTimings& t);
 
@@ -87,6 +89,8 @@ class SegmentationChain {
   VoxelGridScratch voxel_scratch_;
   ClusterScratch cluster_scratch_;
   PointsView plane_points_{};
+  PointsView sparse_points_{};  // organized strided path: RANSAC's hypotheses are scored on these
+  static constexpr std::size_t MIN_SPARSE_POINTS = 500;  // below: RANSAC on the full sample
   RansacPlane plane_{};
 };
 

@@ -113,6 +113,30 @@ TEST(SegChain, OrganizedSizeMismatchIsAnError) {
   EXPECT_NE(seg.error().to_string().find("10 points is not 4 x 4"), std::string::npos) << seg.error().to_string();
 }
 
+TEST(SegChain, SmallOrganizedFrameFitsOnTheFullSample) {
+  // 80 x 60 pixels of a table at z = 1 m with a 12 x 12-pixel box 5 cm above it: the sample at twice the
+  // stride has fewer than 500 points, so RANSAC runs on the stride-4 sample itself.
+  const std::uint32_t w = 80, h = 60;
+  std::vector<float> x, y, z;
+  for (std::uint32_t v = 0; v < h; ++v) {
+    for (std::uint32_t u = 0; u < w; ++u) {
+      const bool box = u >= 30 && u < 42 && v >= 20 && v < 32;
+      const float depth = box ? 0.95F : 1.0F;
+      x.push_back((float(u) - 40.0F) * 0.004F), y.push_back((float(v) - 30.0F) * 0.004F), z.push_back(depth);
+    }
+  }
+  ok::SegmentationParams params;
+  params.cluster.min_size = 20;
+  ok::SegmentationChain chain(x.size(), params);
+  auto seg = chain.run(ok::CloudView{{x, y, z}, w, h});
+  ASSERT_TRUE(seg) << seg.error().to_string();
+  EXPECT_NEAR(seg->plane.plane.normal[2], -1.0F, 1e-4F);  // oriented toward the sensor: d > 0
+  EXPECT_NEAR(seg->plane.plane.d, 1.0F, 1e-4F);
+  EXPECT_EQ(seg->plane.inliers, 300U - 9U);  // the 20 x 15 stride-4 sample minus the 3 x 3 on the box
+  ASSERT_EQ(seg->objects.size(), 1U);
+  EXPECT_EQ(seg->objects[0].points, 144U);
+}
+
 INSTANTIATE_TEST_SUITE_P(Mosd, SegChainFrames,
                          ::testing::Values(Frame{"test31.pcd", 3, 2}, Frame{"test44.pcd", 5, 2},
                                            Frame{"test55.pcd", 14, 8}),
