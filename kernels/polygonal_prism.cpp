@@ -62,13 +62,13 @@ bool inside_convex_polygon(std::span<const double> hu, std::span<const double> h
 std::size_t polygonal_prism(PointsView points, const Prism& prism, std::span<float> heights,
                             std::span<std::uint8_t> mask) noexcept {
   OF_ASSERT(mask.size() >= points.size() && heights.size() >= points.size(), "polygonal_prism: spans too small");
-  plane_signed_distance(points, prism.plane, heights);
   detail::PrismEdges edges;
   if (!detail::make_prism_edges(prism, edges)) {
+    plane_signed_distance(points, prism.plane, heights);
     return detail::prism_mask_range(points, prism, heights, mask.data(), 0, points.size());
   }
   static auto dispatched = xsimd::dispatch<SimdArchs>(detail::PrismPolygonKernel{});
-  return dispatched(points, prism, edges, std::span<const float>(heights), mask);
+  return dispatched(points, prism, edges, heights, mask);  // computes the heights in the same pass
 }
 
 std::size_t polygonal_prism_scalar(PointsView points, const Prism& prism, std::span<float> heights,

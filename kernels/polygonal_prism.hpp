@@ -28,7 +28,8 @@ struct Prism {
 /// of < 3 vertices).
 /// @p heights receives the signed heights (SIMD plane_signed_distance).
 /// @pre mask.size() and heights.size() >= points.size(). @return the number of points kept.
-/// @note Allocation-free, thread-safe. SIMD: heights by plane_signed_distance; the polygon test runs
+/// @note Allocation-free, thread-safe. SIMD: heights as plane_signed_distance computes them, in the
+/// same pass as the rest (the frame is read once); the polygon test runs
 /// only on the points whose height is in range, in float against the hull's half-planes (SIMD over
 /// points, loop over edges); a point within the float rounding slack of an edge line takes the exact
 /// double test of the twin, and every other point is at least that slack inside or outside, where the

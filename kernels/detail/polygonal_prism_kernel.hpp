@@ -3,6 +3,7 @@
 #include <array>
 #include <cmath>
 
+#include "kernels/detail/plane_distance_kernel.hpp"
 #include "kernels/polygonal_prism.hpp"
 #include "kernels/simd_arch.hpp"
 
@@ -28,7 +29,7 @@ bool make_prism_edges(const Prism& prism, PrismEdges& e) noexcept;
 struct PrismPolygonKernel {
   template <class Arch>
   std::size_t operator()(Arch arch, PointsView points, const Prism& prism, const PrismEdges& edges,
-                         std::span<const float> heights, std::span<std::uint8_t> mask) const noexcept;
+                         std::span<float> heights, std::span<std::uint8_t> mask) const noexcept;
 };
 
 /// The exact polygon rule for point i (projection inside the hull, in double): the scalar
