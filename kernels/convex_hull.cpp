@@ -43,38 +43,53 @@ double cross(std::span<const double> u, std::span<const double> v, std::uint32_t
   return (u[a] - u[o]) * (v[b] - v[o]) - (v[a] - v[o]) * (u[b] - u[o]);
 }
 
-/// Akl-Toussaint: drops the points strictly inside the octagon of the extremes along u, v, u+v, u-v
-/// (they cannot be hull vertices). Keeps the rest in index order in @p keep; returns how many.
-std::size_t octagon_filter(std::span<const double> u, std::span<const double> v, std::span<std::uint32_t> keep) {
-  std::array<std::uint32_t, 8> ext{};
+/// Indices of the extreme points along u, v, u+v, u-v and their negations (counter-clockwise from +u;
+/// the first index wins ties). Each direction's best score is kept, not recomputed per point.
+/// @return false when no point is finite.
+bool octagon_extremes(std::span<const double> u, std::span<const double> v, std::array<std::uint32_t, 8>& ext) {
+  constexpr double DU[8] = {1, 1, 0, -1, -1, -1, 0, 1};
+  constexpr double DV[8] = {0, 1, 1, 1, 0, -1, -1, -1};
+  std::array<double, 8> best{};
   bool any = false;
-  auto score = [&](std::size_t dir, std::uint32_t i) {
-    constexpr double DU[8] = {1, 1, 0, -1, -1, -1, 0, 1};
-    constexpr double DV[8] = {0, 1, 1, 1, 0, -1, -1, -1};
-    return DU[dir] * u[i] + DV[dir] * v[i];
-  };
   for (std::uint32_t i = 0; i < u.size(); ++i) {
     if (!std::isfinite(u[i]) || !std::isfinite(v[i])) { continue; }
     for (std::size_t dir = 0; dir < 8; ++dir) {
-      if (!any || score(dir, i) > score(dir, ext[dir])) { ext[dir] = i; }
+      const double s = DU[dir] * u[i] + DV[dir] * v[i];
+      if (!any || s > best[dir]) { ext[dir] = i, best[dir] = s; }
     }
     any = true;
   }
+  return any;
+}
+
+/// Akl-Toussaint: drops the points strictly inside the octagon of the extremes (they cannot be hull
+/// vertices). Keeps the rest in index order in @p keep; returns how many. The proper edges' origins and
+/// directions are computed once; a repeated edge stands in for a degenerate one (same verdict), so each
+/// point is tested against exactly 8 edges without a branch per edge.
+std::size_t octagon_filter(std::span<const double> u, std::span<const double> v, std::span<std::uint32_t> keep) {
+  std::array<std::uint32_t, 8> ext{};
+  if (!octagon_extremes(u, v, ext)) { return 0; }
+  std::array<double, 8> au{}, av{}, du{}, dv{};
+  std::size_t edges = 0;
+  for (std::size_t e = 0; e < 8; ++e) {
+    const std::uint32_t a = ext[e], b = ext[(e + 1) % 8];
+    if (a == b) { continue; }
+    au[edges] = u[a], av[edges] = v[a], du[edges] = u[b] - u[a], dv[edges] = v[b] - v[a];
+    ++edges;
+  }
+  // With no proper edge (all points equal) nothing is interior: a zero edge gives cross 0, not > 0.
+  for (std::size_t e = edges; e < 8; ++e) {
+    const std::size_t src = edges == 0 ? 0 : e % edges;
+    au[e] = au[src], av[e] = av[src], du[e] = du[src], dv[e] = dv[src];
+  }
   std::size_t m = 0;
   for (std::uint32_t i = 0; i < u.size(); ++i) {
-    if (!std::isfinite(u[i]) || !std::isfinite(v[i])) { continue; }
-    // Strictly left of every proper octagon edge (counter-clockwise) means interior; with no proper
-    // edge (all points equal) nothing is interior.
-    bool inside = true;
-    bool any_edge = false;
-    for (std::size_t e = 0; e < 8 && inside; ++e) {
-      const std::uint32_t a = ext[e], b = ext[(e + 1) % 8];
-      if (a == b) { continue; }
-      any_edge = true;
-      inside = cross(u, v, a, b, i) > 0.0;
-    }
-    inside = inside && any_edge;
-    if (!inside) { keep[m++] = i; }
+    // Strictly left of every octagon edge (counter-clockwise) means interior; the same products as
+    // cross(a, b, i) so the verdict is unchanged. NaN gives false, i.e. not interior: skipped below.
+    unsigned left = 0;
+    for (std::size_t e = 0; e < 8; ++e) { left += du[e] * (v[i] - av[e]) - dv[e] * (u[i] - au[e]) > 0.0 ? 1U : 0U; }
+    if (left == 8 || !std::isfinite(u[i]) || !std::isfinite(v[i])) { continue; }
+    keep[m++] = i;
   }
   return m;
 }

@@ -11,21 +11,32 @@ std::size_t PlaneInlierKernel::operator()(Arch /*arch*/, PointsView pts, const P
   constexpr std::size_t LANES = batch::size;
   const std::size_t n = pts.size();
   const batch a(plane.normal[0]), b(plane.normal[1]), c(plane.normal[2]), d(plane.d), t(tau);
-  batch count(0.0F);
+  // Two independent accumulators (even / odd batch): one add chain per batch would bound the loop by
+  // the add latency, not by the loads. Flushed before any lane can reach 2^24 (exact in float).
+  batch count0(0.0F), count1(0.0F);
+  const batch one(1.0F), zero(0.0F);
   std::size_t total = 0;
   std::size_t since_flush = 0;
   std::size_t i = 0;
-  for (; i + LANES <= n; i += LANES) {
-    const batch dist = a * batch::load_unaligned(pts.x.data() + i) + b * batch::load_unaligned(pts.y.data() + i) +
-                       c * batch::load_unaligned(pts.z.data() + i) + d;
-    count = count + xsimd::select(xsimd::abs(dist) <= t, batch(1.0F), batch(0.0F));
-    if (++since_flush == (1U << 20)) {  // keep each lane exact (< 2^24)
-      total += static_cast<std::size_t>(xsimd::hadd(count));
-      count = batch(0.0F);
+  auto inliers = [&](std::size_t k) {
+    const batch dist = a * batch::load_unaligned(pts.x.data() + k) + b * batch::load_unaligned(pts.y.data() + k) +
+                       c * batch::load_unaligned(pts.z.data() + k) + d;
+    return xsimd::select(xsimd::abs(dist) <= t, one, zero);
+  };
+  for (; i + 2 * LANES <= n; i += 2 * LANES) {
+    count0 = count0 + inliers(i);
+    count1 = count1 + inliers(i + LANES);
+    if (++since_flush == (1U << 20)) {
+      total += static_cast<std::size_t>(xsimd::hadd(count0 + count1));
+      count0 = count1 = zero;
       since_flush = 0;
     }
   }
-  total += static_cast<std::size_t>(xsimd::hadd(count));
+  if (i + LANES <= n) {
+    count0 = count0 + inliers(i);
+    i += LANES;
+  }
+  total += static_cast<std::size_t>(xsimd::hadd(count0 + count1));
   return total + count_inliers_range(pts, plane, tau, i, n);
 }
 
