@@ -38,4 +38,13 @@ struct ClusterMoments {
 std::size_t cluster_stats(PointsView points, std::span<const std::int32_t> labels, std::span<ClusterMoments> moments,
                           std::span<ClusterStats> out) noexcept;
 
+/// @brief cluster_stats() visiting only the points of @p members (e.g. the pixels a clustering listed,
+/// ClusterScratch::listed_members()) instead of scanning every label: bit-identical to cluster_stats()
+/// when @p members holds, in ascending order, every index with a label >= 0 (other entries, with label
+/// -1, are skipped). @pre as cluster_stats(); every member < labels.size(). @return out.size().
+/// @note Allocation-free, thread-safe, deterministic.
+std::size_t cluster_stats_listed(PointsView points, std::span<const std::int32_t> labels,
+                                 std::span<const std::uint32_t> members, std::span<ClusterMoments> moments,
+                                 std::span<ClusterStats> out) noexcept;
+
 }  // namespace orthoflow::kernels

@@ -265,8 +265,10 @@ Result<std::size_t, ClusterError> euclidean_cluster_organized(CloudView cloud, s
                                                               const ClusterParams& params, ClusterScratch& scratch,
                                                               std::span<std::int32_t> labels) noexcept {
   const PointsView p = cloud.points;
+  scratch.listed = 0;
   if (auto ok = check(p.size(), params, scratch); !ok) { return ok; }
   const std::size_t m = list_members(p, mask, scratch);
+  scratch.listed = m;
   const auto members = std::span<const std::uint32_t>(scratch.order).first(m);
   const auto w = static_cast<std::size_t>(cloud.width);
   std::size_t v = 0, row_start = 0, previous = 0;
@@ -284,6 +286,7 @@ Result<std::size_t, ClusterError> euclidean_cluster(PointsView points, std::span
                                                     const ClusterParams& params, ClusterScratch& scratch,
                                                     std::span<std::int32_t> labels) noexcept {
   if (auto ok = check(points.size(), params, scratch); !ok) { return ok; }
+  scratch.listed = 0;  // order[] is reused in cell order below
   for (std::uint32_t i = 0; i < points.size(); ++i) { scratch.parent[i] = i; }
   auto grid_result = build_grid(points, mask, params.tolerance, scratch);
   if (!grid_result) { return err(grid_result.error()); }

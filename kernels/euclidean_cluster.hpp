@@ -44,7 +44,13 @@ struct ClusterScratch {
   std::vector<std::uint32_t> parent, count;
   std::vector<std::uint64_t> keys, keys_tmp;
   std::vector<std::uint32_t> order, order_tmp, cell_start;
+  std::size_t listed = 0;  ///< after euclidean_cluster_organized: order[0, listed) = its included pixels, ascending
   [[nodiscard]] std::size_t capacity() const noexcept { return parent.size(); }
+  /// @brief The included pixels of the last euclidean_cluster_organized() (a superset of the labelled
+  /// ones, ascending: cluster_stats_listed()'s members); empty after euclidean_cluster().
+  [[nodiscard]] std::span<const std::uint32_t> listed_members() const noexcept {
+    return std::span<const std::uint32_t>(order).first(listed);
+  }
 };
 
 /// @brief Clusters the finite points i with mask[i] != 0 (all finite points when @p mask is empty) of

@@ -107,7 +107,12 @@ Result<std::size_t, SegmentationError> SegmentationChain::objects(CloudView clou
                                    : euclidean_cluster(target, mask, params_.cluster, cluster_scratch_, labels);
   if (!clusters_result) { return err(SegmentationError{clusters_result.error().to_string()}); }
   const std::size_t clusters = std::min(*clusters_result, stats_.size());
-  cluster_stats(target, labels, moments_, std::span(stats_).first(clusters));
+  // Organized: only the pixels the clustering listed (the prism's), not a scan of the whole label frame.
+  if (organized) {
+    cluster_stats_listed(target, labels, cluster_scratch_.listed_members(), moments_, std::span(stats_).first(clusters));
+  } else {
+    cluster_stats(target, labels, moments_, std::span(stats_).first(clusters));
+  }
   t.cluster = ms_since(start);
   return clusters;
 }

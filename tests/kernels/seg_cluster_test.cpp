@@ -183,4 +183,85 @@ TEST(SegClusterStats, BoxAlongAxesAndRotated) {
   EXPECT_GT(stats[0].covariance[0], 0.0F);
 }
 
+void expect_same_stats(const std::vector<ok::ClusterStats>& a, const std::vector<ok::ClusterStats>& b) {
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t c = 0; c < a.size(); ++c) {
+    EXPECT_EQ(a[c].points, b[c].points) << c;
+    EXPECT_EQ(a[c].centroid, b[c].centroid) << c;
+    EXPECT_EQ(a[c].covariance, b[c].covariance) << c;
+    EXPECT_EQ(a[c].bbox_min, b[c].bbox_min) << c;
+    EXPECT_EQ(a[c].bbox_max, b[c].bbox_max) << c;
+    EXPECT_EQ(a[c].obb_axes, b[c].obb_axes) << c;
+    EXPECT_EQ(a[c].obb_min, b[c].obb_min) << c;
+    EXPECT_EQ(a[c].obb_max, b[c].obb_max) << c;
+  }
+}
+
+TEST(SegClusterStats, ListedEqualsFullScanAndDirectCounts) {
+  // Runs of equal labels (length 1..12, ids interleaved), unlabelled gaps; the member list holds every
+  // index (label -1 entries are skipped) or only the labelled ones: bit-identical to the full scan.
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> coord(-1.0F, 1.0F);
+  Cloud c;
+  std::vector<std::int32_t> labels;
+  while (c.x.size() < 3000) {
+    const auto label = static_cast<std::int32_t>(rng() % 6) - 1;  // -1..4; cluster 5 stays empty
+    for (auto k = rng() % 12 + 1; k > 0; --k) {
+      c.add(coord(rng) + float(label), coord(rng), 100.0F + coord(rng)), labels.push_back(label);
+    }
+  }
+  std::vector<std::uint32_t> all(c.x.size()), labelled;
+  std::iota(all.begin(), all.end(), 0U);
+  for (const std::uint32_t i : all) {
+    if (labels[i] >= 0) { labelled.push_back(i); }
+  }
+  std::vector<ok::ClusterMoments> m(6);
+  std::vector<ok::ClusterStats> full(6), listed_all(6), listed(6);
+  ok::cluster_stats(c.view(), labels, m, full);
+  ok::cluster_stats_listed(c.view(), labels, all, m, listed_all);
+  ok::cluster_stats_listed(c.view(), labels, labelled, m, listed);
+  expect_same_stats(full, listed_all);
+  expect_same_stats(full, listed);
+  for (std::int32_t id = 0; id < 5; ++id) {  // counts and boxes against a direct loop
+    std::size_t n = 0;
+    float lo = std::numeric_limits<float>::infinity();
+    for (std::size_t i = 0; i < c.x.size(); ++i) {
+      if (labels[i] == id) { ++n, lo = std::min(lo, c.z[i]); }
+    }
+    EXPECT_EQ(full[static_cast<std::size_t>(id)].points, n);
+    EXPECT_EQ(full[static_cast<std::size_t>(id)].bbox_min[2], lo);
+    EXPECT_NEAR(full[static_cast<std::size_t>(id)].centroid[0], float(id), 0.1F);
+  }
+  EXPECT_EQ(full[5].points, 0U);
+}
+
+TEST(SegClusterStats, ListedMembersOfOrganizedClustering) {
+  const std::uint32_t w = 32, h = 24;
+  Cloud c;
+  std::vector<std::uint8_t> mask;
+  for (std::uint32_t v = 0; v < h; ++v) {
+    for (std::uint32_t u = 0; u < w; ++u) {
+      const float z = (u / 8 + v / 6) % 2 == 0 ? 1.0F : 1.2F;  // a checkerboard of two depths
+      c.add(0.002F * float(u), 0.002F * float(v), z);
+      mask.push_back((u * 7 + v * 3) % 11 == 0 ? 0 : 1);
+    }
+  }
+  ok::ClusterParams p;
+  p.min_size = 10;
+  ok::ClusterScratch scratch(c.x.size());
+  std::vector<std::int32_t> labels(c.x.size());
+  auto r = ok::euclidean_cluster_organized({c.view(), w, h}, mask, p, scratch, labels);
+  ASSERT_TRUE(r) << r.error().to_string();
+  ASSERT_GT(*r, 1U);
+  EXPECT_EQ(scratch.listed_members().size(),
+            static_cast<std::size_t>(std::count(mask.begin(), mask.end(), std::uint8_t{1})));
+  std::vector<ok::ClusterMoments> m(*r);
+  std::vector<ok::ClusterStats> full(*r), listed(*r);
+  ok::cluster_stats(c.view(), labels, m, full);
+  ok::cluster_stats_listed(c.view(), labels, scratch.listed_members(), m, listed);
+  expect_same_stats(full, listed);
+  ASSERT_TRUE(ok::euclidean_cluster(c.view(), mask, p, scratch, labels));
+  EXPECT_TRUE(scratch.listed_members().empty());  // order[] is in cell order there
+}
+
 }  // namespace
