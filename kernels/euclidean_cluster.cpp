@@ -80,9 +80,11 @@ std::size_t assign_labels_listed(std::span<const std::uint32_t> members, const C
     s.parent[i] = forest.find(i);
     ++s.count[s.parent[i]];
   }
-  std::fill(labels.begin(), labels.end(), -1);
   std::int32_t next = 0;
+  std::size_t cleared = 0;  // labels[0, cleared) are written: the gaps between members get -1 on the way
   for (const std::uint32_t i : members) {  // ascending: a component's root comes before its other points
+    std::fill(labels.begin() + static_cast<std::ptrdiff_t>(cleared), labels.begin() + i, -1);
+    cleared = std::size_t{i} + 1;
     const std::uint32_t root = s.parent[i];
     if (root == i) {
       const bool keep = s.count[i] >= prm.min_size && s.count[i] <= prm.max_size;
@@ -90,6 +92,7 @@ std::size_t assign_labels_listed(std::span<const std::uint32_t> members, const C
     }
     labels[i] = static_cast<std::int32_t>(s.count[root]) - 1;
   }
+  std::fill(labels.begin() + static_cast<std::ptrdiff_t>(cleared), labels.end(), -1);
   return static_cast<std::size_t>(next);
 }
 
@@ -234,26 +237,26 @@ bool link_window(PointsView p, std::size_t w, std::size_t u, std::size_t v, cons
 }
 
 /// Lists the included points in ascending order (scratch.order) and makes each its own root; every
-/// other parent is NOT_INCLUDED, so a window reads one word per neighbour. Most of a frame is masked
-/// out: eight zero mask bytes are skipped with one 64-bit test. @return the number listed.
+/// other parent is NOT_INCLUDED, so a window reads one word per neighbour. One pass writes every parent
+/// (no separate fill of the frame). Most of a frame is masked out: eight zero mask bytes are one 64-bit
+/// test and eight stores. @return the number listed.
 std::size_t list_members(PointsView p, std::span<const std::uint8_t> mask, ClusterScratch& s) {
   std::uint32_t* parent = s.parent.data();
   const std::size_t n = p.size();
-  std::fill(parent, parent + n, NOT_INCLUDED);
   std::size_t m = 0;
   for (std::size_t i = 0; i < n;) {
     if (!mask.empty() && i + 8 <= n) {
       std::uint64_t word = 0;
       std::memcpy(&word, mask.data() + i, sizeof word);
       if (word == 0) {
+        for (std::size_t k = 0; k < 8; ++k) { parent[i + k] = NOT_INCLUDED; }
         i += 8;
         continue;
       }
     }
-    if (included(p, mask, i)) {
-      parent[i] = static_cast<std::uint32_t>(i);
-      s.order[m++] = static_cast<std::uint32_t>(i);
-    }
+    const bool in = included(p, mask, i);
+    parent[i] = in ? static_cast<std::uint32_t>(i) : NOT_INCLUDED;
+    if (in) { s.order[m++] = static_cast<std::uint32_t>(i); }
     ++i;
   }
   return m;
