@@ -1,17 +1,9 @@
 #include "evaluation/cross_validation.hpp"
 
 #include "drivers/synthetic_random.hpp"
+#include "evaluation/detail/shuffle.hpp"
 
 namespace orthoflow::evaluation {
-namespace {
-
-/// Fisher-Yates with the portable generator (std::shuffle's algorithm is library-specific).
-void shuffle(std::vector<std::size_t>& v, drivers::Random& rng) {
-  for (std::size_t i = v.size(); i > 1; --i) { std::swap(v[i - 1], v[rng.below(i)]); }
-}
-
-}  // namespace
-
 Result<Folds, EvalError> make_folds(const Dataset& dataset, std::size_t k, std::uint64_t seed) {
   if (k < 2) { return err(EvalError{EvalError::Code::BAD_CONFIG, "cross-validation needs at least 2 folds, got " + std::to_string(k)}); }
   Folds folds{k, std::vector<std::uint32_t>(dataset.views.size(), 0)};
@@ -23,7 +15,7 @@ Result<Folds, EvalError> make_folds(const Dataset& dataset, std::size_t k, std::
                                                                std::to_string(views.size()) + " view; cross-validation needs 2 or more"});
     }
     drivers::Random rng(seed * 0x9E3779B97F4A7C15ULL + c + 1);
-    shuffle(views, rng);
+    detail::shuffle(views, rng);
     // Continue dealing where the previous category stopped, so small categories do not all land in fold 0.
     for (std::size_t i = 0; i < views.size(); ++i) { folds.fold_of_view[views[i]] = static_cast<std::uint32_t>((start + i) % k); }
     start = (start + views.size()) % k;

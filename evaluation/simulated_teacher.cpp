@@ -4,14 +4,10 @@
 #include <deque>
 
 #include "drivers/synthetic_random.hpp"
+#include "evaluation/detail/shuffle.hpp"
 
 namespace orthoflow::evaluation {
 namespace {
-
-template <class T>
-void shuffle(std::vector<T>& v, drivers::Random& rng) {
-  for (std::size_t i = v.size(); i > 1; --i) { std::swap(v[i - 1], v[rng.below(i)]); }
-}
 
 /// The teacher's bookkeeping for one experiment.
 class Teacher {
@@ -22,7 +18,7 @@ class Teacher {
     for (std::uint32_t c = 0; c < ds.categories.size(); ++c) {
       std::vector<std::size_t> views = ds.views_of(c);
       drivers::Random rng(seed * 0xD1B54A32D192ED03ULL + c + 1);
-      shuffle(views, rng);
+      detail::shuffle(views, rng);
       unseen_[c].assign(views.begin(), views.end());
     }
   }
@@ -152,7 +148,7 @@ std::vector<std::uint32_t> category_order(std::size_t categories, std::uint64_t 
   std::vector<std::uint32_t> order(categories);
   for (std::uint32_t c = 0; c < categories; ++c) { order[c] = c; }
   drivers::Random rng(seed ^ 0xA0761D6478BD642FULL);
-  shuffle(order, rng);
+  detail::shuffle(order, rng);
   return order;
 }
 
