@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cstring>
+#include <type_traits>
 #include <vector>
 
 #include "drivers/file_bytes.hpp"
@@ -146,7 +147,8 @@ void store(kernels::PointCloud& c, std::size_t i, const std::array<double, 11>& 
 bool plausible(const PlyElement& e, std::size_t remaining, bool ascii) {
   std::uint64_t min_bytes = 0;
   for (const PlyProperty& p : e.properties) { min_bytes += p.is_list ? scalar_size(p.count_type) : scalar_size(p.type); }
-  if (ascii) { min_bytes = 2 * e.properties.size(); }
+  // ASCII: every instance is at least a line break, even with no property.
+  if (ascii) { min_bytes = std::max<std::uint64_t>(1, 2 * e.properties.size()); }
   return min_bytes == 0 || e.count <= remaining / min_bytes;
 }
 
@@ -156,6 +158,9 @@ Result<void, IoError> read_element(Source& src, const PlyElement& e, bool is_ver
   auto fail = [&](IoError::Code c, const std::string& what) {
     return err(IoError{c, std::string(name) + ": " + src.where() + ": " + what});
   };
+  // A binary element without properties occupies no bytes, whatever its count: nothing to walk (a count
+  // of 10^9 must not mean 10^9 empty iterations; found by fuzz_ply_reader).
+  if (e.properties.empty() && std::is_same_v<Source, BinarySource>) { return {}; }
   std::vector<Slot> slots;
   for (const PlyProperty& p : e.properties) { slots.push_back(is_vertex && !p.is_list ? slot_of(p.name) : Slot::NONE); }
   for (std::uint64_t i = 0; i < e.count; ++i) {

@@ -102,6 +102,21 @@ TEST(PlyReader, HugeBinaryCountIsRefusedBeforeAllocating) {
   EXPECT_EQ(r.error().code, Code::TRUNCATED);
 }
 
+// An element without properties holds no bytes: a huge count must neither loop (fuzz_ply_reader once
+// timed out on 808,956,253 empty instances; the header caps counts at 2^31) nor be refused in binary; in ASCII each instance is a line.
+TEST(PlyReader, ElementWithoutPropertiesAndHugeCountIsSkippedAtOnce) {
+  std::string s = binary_model(false);
+  s.insert(s.find("end_header"), "element marker 2000000000\n");
+  auto r = od::read_ply_buffer(s, "marker.ply");
+  ASSERT_TRUE(r) << r.error().to_string();
+  EXPECT_EQ(r->size(), 2U);
+  std::string a = ASCII_CUBE;
+  a.insert(a.find("end_header"), "element marker 2000000000\n");
+  auto ascii = od::read_ply_buffer(a, "marker_ascii.ply");
+  ASSERT_FALSE(ascii);
+  EXPECT_EQ(ascii.error().code, Code::TRUNCATED);
+}
+
 TEST(PlyReader, EveryTruncationOfABinaryModelFails) {
   const std::string whole = binary_model(false);
   ASSERT_TRUE(od::read_ply_buffer(whole));
