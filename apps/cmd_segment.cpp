@@ -1,18 +1,27 @@
 // `orthoflow segment FILE.pcd`: the tabletop chain (kernels/segmentation_chain.hpp) on one frame:
-// the table plane, its inlier count, the objects and the per-stage timings (median over --repeat runs).
-// The flags mean what the PCL parameters of specs/BASELINES.md mean: --leaf is VoxelGrid's leaf,
-// --plane-tau/--plane-iters SACSegmentation's distance threshold and max iterations, --cluster-tol and
-// --min-cluster EuclideanClusterExtraction's tolerance and minimum size.
+// the table plane, its inlier count, the clusters, the objects (the clusters that pass C_size and
+// C_edge: what the tabletop graph tracks) and the per-stage timings (median over --repeat runs).
+// Defaults are the PCL baseline's (specs/BASELINES.md); --graph FILE|tabletop takes every segmentation
+// parameter from a graph file's preprocess, table and objects nodes instead, so that the objects are the
+// ones `orthoflow run` finds with that graph. The flags, applied after --graph, mean what the PCL
+// parameters mean: --leaf is VoxelGrid's leaf, --plane-tau/--plane-iters SACSegmentation's distance
+// threshold and max iterations, --cluster-tol and --min-cluster EuclideanClusterExtraction's tolerance
+// and minimum size.
 #include <algorithm>
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <optional>
+#include <span>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
 #include "apps/commands.hpp"
 #include "drivers/pcd_io.hpp"
+#include "engine/graph.hpp"
+#include "graphs/embedded_graphs.hpp"
+#include "graphs/segment_params.hpp"
 #include "kernels/segmentation_chain.hpp"
 
 namespace orthoflow::apps {
@@ -22,7 +31,12 @@ struct SegmentOptions {
   std::string file;
   bool json = false;
   int repeat = 1;
+  std::string graph;  ///< empty: the PCL baseline's parameters
   kernels::SegmentationParams params{};
+  kernels::CandidateParams candidates{};
+  // flags given on the command line (applied over the graph's parameters)
+  std::optional<float> leaf, plane_tau, cluster_tol;
+  std::optional<std::uint32_t> plane_iters, min_cluster;
 };
 
 double median(std::vector<double> v) {
@@ -41,19 +55,28 @@ nlohmann::json median_timings(const std::vector<kernels::SegmentationTimings>& r
     return median(v);
   };
   using T = kernels::SegmentationTimings;
-  return {{"filter", stage(&T::filter)}, {"voxel", stage(&T::voxel)},     {"plane", stage(&T::plane)},
-          {"prism", stage(&T::prism)},   {"cluster", stage(&T::cluster)}, {"total", stage(&T::total)}};
+  return {{"filter", stage(&T::filter)},   {"voxel", stage(&T::voxel)},
+          {"plane", stage(&T::plane)},     {"prism", stage(&T::prism)},
+          {"cluster", stage(&T::cluster)}, {"candidates", stage(&T::candidates)},
+          {"total", stage(&T::total)}};
+}
+
+nlohmann::json stats_json(std::span<const kernels::ClusterStats> list) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const kernels::ClusterStats& s : list) {
+    out.push_back({{"points", s.points}, {"centroid", triple(s.centroid)}, {"bbox_min", triple(s.bbox_min)},
+                   {"bbox_max", triple(s.bbox_max)}});
+  }
+  return out;
 }
 
 nlohmann::json to_json(const kernels::SegmentationResult& seg, const nlohmann::json& timings) {
-  nlohmann::json objects = nlohmann::json::array();
-  for (const kernels::ClusterStats& s : seg.objects) {
-    objects.push_back({{"points", s.points}, {"centroid", triple(s.centroid)}, {"bbox_min", triple(s.bbox_min)},
-                       {"bbox_max", triple(s.bbox_max)}});
-  }
+  const kernels::CandidateCounts& c = seg.candidate_counts;
   return {{"plane", {{"normal", triple(seg.plane.plane.normal)}, {"d", seg.plane.plane.d}}},
           {"inliers", seg.plane.inliers},
-          {"objects", objects},
+          {"clusters", stats_json(seg.clusters)},
+          {"objects", stats_json(seg.candidates)},
+          {"rejected", {{"size", c.rejected_size}, {"edge", c.rejected_edge}, {"capacity", c.over_capacity}}},
           {"timings_ms", timings}};
 }
 
@@ -61,7 +84,7 @@ void print_text(const nlohmann::json& j) {
   const auto& n = j["plane"]["normal"];
   std::printf("plane: normal (%.5f, %.5f, %.5f) d %.5f, %zu inliers\n", n[0].get<double>(), n[1].get<double>(),
               n[2].get<double>(), j["plane"]["d"].get<double>(), j["inliers"].get<std::size_t>());
-  std::printf("objects: %zu\n", j["objects"].size());
+  std::printf("clusters: %zu; objects (C_size, C_edge): %zu\n", j["clusters"].size(), j["objects"].size());
   for (std::size_t k = 0; k < j["objects"].size(); ++k) {
     const auto& o = j["objects"][k];
     std::printf("  %zu: %zu points, centroid (%.4f, %.4f, %.4f), bbox (%.4f, %.4f, %.4f)..(%.4f, %.4f, %.4f)\n", k,
@@ -71,18 +94,44 @@ void print_text(const nlohmann::json& j) {
                 o["bbox_max"][2].get<double>());
   }
   const auto& t = j["timings_ms"];
-  std::printf("timings (ms, median): filter %.3f voxel %.3f plane %.3f prism %.3f cluster %.3f total %.3f\n",
-              t["filter"].get<double>(), t["voxel"].get<double>(), t["plane"].get<double>(), t["prism"].get<double>(),
-              t["cluster"].get<double>(), t["total"].get<double>());
+  std::printf(
+      "timings (ms, median): filter %.3f voxel %.3f plane %.3f prism %.3f cluster %.3f candidates %.3f total %.3f\n",
+      t["filter"].get<double>(), t["voxel"].get<double>(), t["plane"].get<double>(), t["prism"].get<double>(),
+      t["cluster"].get<double>(), t["candidates"].get<double>(), t["total"].get<double>());
 }
 
-void run_segment(const SegmentOptions& opt) {
+[[noreturn]] void fail(const std::string& message, int code) {
+  std::cerr << "orthoflow segment: " << message << '\n';
+  throw CLI::RuntimeError(code);
+}
+
+/// The parameters: the baseline's, or a graph file's (the embedded tabletop graph for "tabletop"),
+/// then the flags given.
+void resolve_params(SegmentOptions& opt) {
+  if (!opt.graph.empty()) {
+    auto spec = opt.graph == "tabletop" ? engine::parse_graph(std::string(graphs::embedded_tabletop_yaml()), "tabletop.yaml")
+                                        : engine::load_graph_file(opt.graph);
+    if (!spec) fail(engine::to_string(spec.error()), EXIT_BAD_INPUT);
+    auto seg = graphs::segmentation_of_graph(*spec);
+    if (!seg) fail(seg.error(), EXIT_BAD_INPUT);
+    opt.params = seg->stages;
+    opt.candidates = seg->candidates;
+  }
+  if (opt.leaf) opt.params.leaf = *opt.leaf;
+  if (opt.plane_tau) opt.params.ransac.tau = *opt.plane_tau;
+  if (opt.plane_iters) opt.params.ransac.max_iterations = *opt.plane_iters;
+  if (opt.cluster_tol) opt.params.cluster.tolerance = *opt.cluster_tol;
+  if (opt.min_cluster) opt.params.cluster.min_size = *opt.min_cluster;
+}
+
+void run_segment(SegmentOptions& opt) {
+  resolve_params(opt);
   auto cloud_result = drivers::read_pcd(opt.file);
   if (!cloud_result) {
     std::cerr << "orthoflow segment: " << cloud_result.error().to_string() << '\n';
     throw CLI::RuntimeError(EXIT_BAD_INPUT);
   }
-  kernels::SegmentationChain chain(cloud_result->size(), opt.params);
+  kernels::SegmentationChain chain(cloud_result->size(), opt.params, opt.candidates);
   std::vector<kernels::SegmentationTimings> runs;
   nlohmann::json out;
   for (int r = 0; r < opt.repeat; ++r) {
@@ -109,12 +158,14 @@ void add_segment_command(CLI::App& app) {
   cmd->add_option("FILE", opt->file, "Input .pcd file")->required()->check(CLI::ExistingFile);
   cmd->add_flag("--json", opt->json, "Print one JSON object (plane, inliers, objects, timings_ms)");
   cmd->add_option("--repeat", opt->repeat, "Runs; timings are the median")->check(CLI::Range(1, 100000));
-  cmd->add_option("--leaf", opt->params.leaf, "Voxel leaf in metres (0: no voxel grid)")->check(CLI::Range(0.0, 1e6));
-  cmd->add_option("--plane-tau", opt->params.ransac.tau, "RANSAC inlier distance, metres")->check(CLI::Range(0.0, 1e6));
-  cmd->add_option("--plane-iters", opt->params.ransac.max_iterations, "RANSAC iterations")->check(CLI::Range(1, 100000000));
-  cmd->add_option("--cluster-tol", opt->params.cluster.tolerance, "Cluster distance tolerance, metres")
+  cmd->add_option("--graph", opt->graph,
+                  "Take the segmentation parameters from this graph file ('tabletop': the embedded one)");
+  cmd->add_option("--leaf", opt->leaf, "Voxel leaf in metres (0: no voxel grid)")->check(CLI::Range(0.0, 1e6));
+  cmd->add_option("--plane-tau", opt->plane_tau, "RANSAC inlier distance, metres")->check(CLI::Range(0.0, 1e6));
+  cmd->add_option("--plane-iters", opt->plane_iters, "RANSAC iterations")->check(CLI::Range(1, 100000000));
+  cmd->add_option("--cluster-tol", opt->cluster_tol, "Cluster distance tolerance, metres")
       ->check(CLI::Range(1e-6, 1e6));
-  cmd->add_option("--min-cluster", opt->params.cluster.min_size, "Minimum points per object");
+  cmd->add_option("--min-cluster", opt->min_cluster, "Minimum points per cluster")->check(CLI::Range(1, 100000000));
   cmd->callback([opt] { run_segment(*opt); });
 }
 

@@ -11,11 +11,13 @@
 #include <cstddef>
 #include <cstdint>
 #include <span>
+#include <string>
 #include <string_view>
 
 #include "engine/frame_payload.hpp"
 #include "kernels/cluster_stats.hpp"
 #include "kernels/plane_distance.hpp"
+#include "kernels/tabletop_stages.hpp"
 #include "memory_pool/result.hpp"
 
 namespace orthoflow::graphs {
@@ -71,12 +73,41 @@ struct ObjectRecord {
   Text taught_as;       ///< ... under this label
 };
 
+/// @brief Why a frame produced nothing (or less than it should). Plain data: set on the frame path
+/// without allocating. One rule: the first error a frame meets is the one it reports (set() keeps it;
+/// later stages see a frame that already failed and do not overwrite it).
+struct FrameError {
+  enum class Code : std::uint8_t {
+    NONE,
+    FRAME_TOO_LARGE,  ///< source: more points than the pool block holds (value: the point count)
+    FILE_UNREADABLE,  ///< pcd_source: the file did not parse (cause: drivers::IoError::Code; detail: message)
+    INVALID_FRAME,    ///< the block holds no valid frame (cause: engine::FrameError)
+    SEGMENTATION,     ///< a segmentation stage failed: segmentation holds the stage's typed reason
+  };
+  Code code = Code::NONE;
+  std::uint8_t cause = 0;
+  double value = 0.0;
+  kernels::SegmentationError segmentation{};
+  Text stage;   ///< the node that reported it
+  Text detail;  ///< FILE_UNREADABLE: the reader's message (truncated)
+  [[nodiscard]] bool empty() const noexcept { return code == Code::NONE; }
+  /// @brief Records an error unless the frame already has one. @return true if recorded.
+  bool set(Code c, std::string_view node, std::uint8_t why = 0, double number = 0.0) noexcept;
+  /// @brief Records a segmentation stage's error (same first-error rule).
+  bool set(std::string_view node, const kernels::SegmentationError& e) noexcept;
+  /// @brief "node: CODE: reason". Allocates: off the frame path.
+  [[nodiscard]] std::string to_string() const;
+};
+
 /// @brief Per-frame results of every stage; lives in the block after the raw frame.
 struct FrameState {
   std::uint32_t truth_count = 0;
   std::array<TruthObject, MAX_TRUTH> truth{};
-  std::uint32_t kept = 0;    ///< finite points inside the ROI
-  std::uint32_t voxels = 0;  ///< voxel centroids
+  std::uint32_t kept = 0;    ///< finite points inside the ROI that fed the plane input
+  std::uint32_t voxels = 0;  ///< plane input: dense sample (organized) or voxel centroids, at voxels()[0, voxels)
+  std::uint32_t sparse = 0;  ///< plane input: RANSAC's scoring sample, at voxels()[voxels, voxels + sparse)
+  bool organized_path = false;  ///< preprocess took the organized path (kernels::takes_organized_path)
+  kernels::AxisBox roi{};       ///< the region of interest preprocess applied (the prism applies it too)
   bool table_found = false;
   kernels::Plane plane{};
   std::uint32_t plane_inliers = 0;
@@ -84,9 +115,10 @@ struct FrameState {
   std::uint32_t clusters = 0;        ///< clusters before the candidate constraints
   std::uint32_t rejected_size = 0;   ///< failed C_size
   std::uint32_t rejected_edge = 0;   ///< failed C_edge
+  std::uint32_t rejected_capacity = 0;  ///< passed both but found the MAX_OBJECTS records full
   std::uint32_t object_count = 0;    ///< candidates kept in objects
   std::array<ObjectRecord, MAX_OBJECTS> objects{};
-  Text error;  ///< why a stage produced nothing for this frame (empty = fine)
+  FrameError error;  ///< why a stage produced nothing for this frame (empty = fine)
 };
 
 /// @brief Typed view of one pool block. Cheap to make (pointer arithmetic only).

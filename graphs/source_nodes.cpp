@@ -49,7 +49,7 @@ class FrameSource : public engine::Node {
     const FrameBlock block = block_of(out, capacity_);
     new (&block.state()) FrameState{};  // value-initialised in place: no temporary on the stack
     if (cloud.size() > capacity_ || !engine::write_frame(block.raw(), cloud)) {
-      block.state().error.assign("source: frame larger than the pool block holds");
+      block.state().error.set(FrameError::Code::FRAME_TOO_LARGE, name_, 0, static_cast<double>(cloud.size()));
       return false;
     }
     return true;
@@ -103,7 +103,9 @@ class PcdSource final : public FrameSource {
       const FrameBlock block = block_of(out, capacity_);
       (void)engine::write_frame(block.raw(), kernels::PointCloud{});
       new (&block.state()) FrameState{};
-      block.state().error.assign("pcd_source: " + cloud.error().to_string());
+      FrameError& e = block.state().error;
+      e.set(FrameError::Code::FILE_UNREADABLE, name_, static_cast<std::uint8_t>(cloud.error().code));
+      e.detail.assign(cloud.error().message);
       return engine::SourceStatus::FRAME;
     }
     cloud->info.frame_id = index;

@@ -98,7 +98,7 @@ nlohmann::json golden_segmentation() {
     if (!seg_result) { throw std::runtime_error("segmentation of scene " + std::to_string(seed) + ": " +
                                                 seg_result.error().to_string()); }
     std::vector<std::size_t> sizes;
-    for (const ok::ClusterStats& c : seg_result->objects) { sizes.push_back(c.points); }
+    for (const ok::ClusterStats& c : seg_result->clusters) { sizes.push_back(c.points); }
     std::sort(sizes.begin(), sizes.end(), std::greater<>());
     const ok::Plane& p = seg_result->plane.plane;
     out[std::to_string(seed)] = {{"normal", {exact(p.normal[0]), exact(p.normal[1]), exact(p.normal[2])}},

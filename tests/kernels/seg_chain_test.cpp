@@ -68,7 +68,7 @@ TEST_P(SegChainFrames, FindsTableAndObjects) {
               seg.timings.voxel, seg.timings.plane, seg.timings.prism, seg.timings.cluster);
   EXPECT_EQ(q.gt_objects, f.gt_objects);
   EXPECT_GE(q.matched, f.min_matched);
-  EXPECT_EQ(seg.objects.size(), q.clusters);
+  EXPECT_EQ(seg.clusters.size(), q.clusters);
   // Deterministic: a second run gives the same labels, and allocates nothing.
   const std::vector<std::int32_t> first(seg.labels.begin(), seg.labels.end());
   g_allocations = 0;
@@ -133,8 +133,8 @@ TEST(SegChain, SmallOrganizedFrameFitsOnTheFullSample) {
   EXPECT_NEAR(seg->plane.plane.normal[2], -1.0F, 1e-4F);  // oriented toward the sensor: d > 0
   EXPECT_NEAR(seg->plane.plane.d, 1.0F, 1e-4F);
   EXPECT_EQ(seg->plane.inliers, 300U - 9U);  // the 20 x 15 stride-4 sample minus the 3 x 3 on the box
-  ASSERT_EQ(seg->objects.size(), 1U);
-  EXPECT_EQ(seg->objects[0].points, 144U);
+  ASSERT_EQ(seg->clusters.size(), 1U);
+  EXPECT_EQ(seg->clusters[0].points, 144U);
 }
 
 INSTANTIATE_TEST_SUITE_P(Mosd, SegChainFrames,

@@ -1,0 +1,39 @@
+#pragma once
+/// @file
+/// @brief The parameters of the preprocess, table and objects node kinds, parsed into the one
+/// kernels::SegmentationParams / CandidateParams pair the chain takes, so that a graph file and
+/// `orthoflow segment --graph FILE` mean the same segmentation (start-up only: these allocate).
+#include <string>
+
+#include "engine/graph.hpp"
+#include "engine/params.hpp"
+#include "kernels/segmentation_chain.hpp"
+#include "memory_pool/result.hpp"
+
+namespace orthoflow::graphs {
+
+/// @brief The segmentation of the tabletop graph: the stage parameters and the candidate constraints.
+struct TabletopSegmentation {
+  kernels::SegmentationParams stages = defaults();
+  kernels::CandidateParams candidates{};
+  /// @brief The node kinds' defaults (where they differ from the chain's PCL-baseline ones: the
+  /// footprint merge is on, clusters need 50 points with a 2-pixel window).
+  [[nodiscard]] static kernels::SegmentationParams defaults() noexcept;
+};
+
+/// @brief preprocess: roi_min_x..roi_max_z (m), leaf (m, 0 = off), organized_stride (0 = voxel grid).
+[[nodiscard]] Result<void, std::string> parse_preprocess_params(const engine::ParamMap& params,
+                                                                kernels::SegmentationParams& out);
+/// @brief table: tau (m), iterations, confidence, seed.
+[[nodiscard]] Result<void, std::string> parse_table_params(const engine::ParamMap& params,
+                                                           kernels::SegmentationParams& out);
+/// @brief objects: h_min, h_max, tolerance, min_points, max_points, pixel_radius, merge_overlap and the
+/// candidate constraints min_size, max_size, edge_margin.
+[[nodiscard]] Result<void, std::string> parse_objects_params(const engine::ParamMap& params,
+                                                             TabletopSegmentation& out);
+
+/// @brief The segmentation a graph file runs: the parameters of its preprocess, table and objects
+/// nodes (each kind at most once; a kind that is absent keeps its defaults). Errors name the node.
+[[nodiscard]] Result<TabletopSegmentation, std::string> segmentation_of_graph(const engine::GraphSpec& spec);
+
+}  // namespace orthoflow::graphs
