@@ -15,7 +15,7 @@
 
 #include "apps/commands.hpp"
 #include "apps/json_numbers.hpp"
-#include "drivers/pcd_io.hpp"
+#include "formats/pcd_io.hpp"
 #include "kernels/good.hpp"
 
 namespace orthoflow::apps {
@@ -158,7 +158,7 @@ bool write_png(const std::string& path, const Described& d, std::size_t n) {
 }
 
 void run_describe(const DescribeOptions& o) {
-  auto cloud_result = drivers::read_pcd(o.file);
+  auto cloud_result = formats::read_pcd(o.file);
   if (!cloud_result) { fail(cloud_result.error().to_string(), EXIT_BAD_INPUT); }
   const kernels::GoodConfig cfg{o.bins, o.mode == "reference" ? kernels::GoodMode::REFERENCE : kernels::GoodMode::INVARIANT,
                                 o.threshold};

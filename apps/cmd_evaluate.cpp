@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "apps/commands.hpp"
-#include "drivers/pcd_io.hpp"
+#include "formats/pcd_io.hpp"
 #include "evaluation/derived_views.hpp"
 #include "evaluation/progress.hpp"
 #include "evaluation/report.hpp"
@@ -132,7 +132,7 @@ struct DeriveOptions {
 /// FILE stem = category; views go to OUT/<stem>/<stem>_0/view_NNN.pcd.
 void run_derive(const DeriveOptions& o) {
   for (const std::string& file : o.files) {
-    auto cloud = drivers::read_pcd(file);
+    auto cloud = formats::read_pcd(file);
     if (!cloud) {
       std::cerr << "orthoflow derive-views: " << cloud.error().to_string() << '\n';
       throw CLI::RuntimeError(EXIT_BAD_INPUT);
@@ -144,7 +144,7 @@ void run_derive(const DeriveOptions& o) {
     for (std::uint32_t v = 0; v < o.views; ++v) {
       char name[32];
       std::snprintf(name, sizeof name, "view_%03u.pcd", v);
-      auto written = drivers::write_pcd(evaluation::derive_view(*cloud, v, o.seed), dir / name, drivers::PcdEncoding::BINARY);
+      auto written = formats::write_pcd(evaluation::derive_view(*cloud, v, o.seed), dir / name, formats::PcdEncoding::BINARY);
       if (!written) {
         std::cerr << "orthoflow derive-views: " << written.error().to_string() << '\n';
         throw CLI::RuntimeError(EXIT_FAILURE_GENERIC);

@@ -14,10 +14,10 @@
 
 #include "apps/commands.hpp"
 #include "apps/json_numbers.hpp"
-#include "drivers/file_bytes.hpp"
-#include "drivers/pcd_io.hpp"
-#include "drivers/ply_header.hpp"
-#include "drivers/ply_reader.hpp"
+#include "formats/file_bytes.hpp"
+#include "formats/pcd_io.hpp"
+#include "formats/ply_header.hpp"
+#include "formats/ply_reader.hpp"
 #include "kernels/cloud_stats.hpp"
 
 namespace orthoflow::apps {
@@ -33,43 +33,43 @@ struct FileSummary {
 };
 
 /// PCD-style type letter and size, e.g. "F4", "U1" (PLY properties are reported the same way).
-std::string type_name(drivers::ScalarType type) {
-  using drivers::ScalarType;
+std::string type_name(formats::ScalarType type) {
+  using formats::ScalarType;
   const char letter = type == ScalarType::FLOAT32 || type == ScalarType::FLOAT64 ? 'F'
                       : type == ScalarType::INT8 || type == ScalarType::INT16 || type == ScalarType::INT32
                           ? 'I'
                           : 'U';
-  return std::string(1, letter) + std::to_string(drivers::scalar_size(type));
+  return std::string(1, letter) + std::to_string(formats::scalar_size(type));
 }
 
-[[noreturn]] void bad_input(const drivers::IoError& error) {
+[[noreturn]] void bad_input(const formats::IoError& error) {
   std::cerr << "orthoflow info: " << error.to_string() << '\n';
   throw CLI::RuntimeError(EXIT_BAD_INPUT);
 }
 
 FileSummary summarize_pcd(std::span<const char> bytes, const std::string& name) {
-  auto header_result = drivers::parse_pcd_header(bytes, name);
+  auto header_result = formats::parse_pcd_header(bytes, name);
   if (!header_result) { bad_input(header_result.error()); }
-  auto cloud_result = drivers::read_pcd_buffer(bytes, name);
+  auto cloud_result = formats::read_pcd_buffer(bytes, name);
   if (!cloud_result) { bad_input(cloud_result.error()); }
-  FileSummary s{"pcd", header_result->version, drivers::to_string(header_result->encoding), {},
+  FileSummary s{"pcd", header_result->version, formats::to_string(header_result->encoding), {},
                 std::move(*cloud_result)};
-  for (const drivers::PointField& f : header_result->fields) {
+  for (const formats::PointField& f : header_result->fields) {
     s.fields.push_back({{"name", f.name}, {"type", type_name(f.type)}, {"count", f.count}});
   }
   return s;
 }
 
 FileSummary summarize_ply(std::span<const char> bytes, const std::string& name) {
-  auto header_result = drivers::parse_ply_header(bytes, name);
+  auto header_result = formats::parse_ply_header(bytes, name);
   if (!header_result) { bad_input(header_result.error()); }
-  auto cloud_result = drivers::read_ply_buffer(bytes, name);
+  auto cloud_result = formats::read_ply_buffer(bytes, name);
   if (!cloud_result) { bad_input(cloud_result.error()); }
   constexpr std::array<const char*, 3> FORMATS{"ascii", "binary_little_endian", "binary_big_endian"};
   FileSummary s{"ply", "1.0", FORMATS[static_cast<std::size_t>(header_result->format)], {}, std::move(*cloud_result)};
-  for (const drivers::PlyElement& e : header_result->elements) {
+  for (const formats::PlyElement& e : header_result->elements) {
     if (e.name != "vertex") { continue; }  // faces and other elements are skipped by the reader
-    for (const drivers::PlyProperty& p : e.properties) {
+    for (const formats::PlyProperty& p : e.properties) {
       s.fields.push_back({{"name", p.name}, {"type", (p.is_list ? "list " : "") + type_name(p.type)}, {"count", 1}});
     }
   }
@@ -129,7 +129,7 @@ void print_text(const nlohmann::json& j) {
 }
 
 void run_info(const std::string& path, bool as_json) {
-  auto bytes_result = drivers::read_file_bytes(path);
+  auto bytes_result = formats::read_file_bytes(path);
   if (!bytes_result) { bad_input(bytes_result.error()); }
   const std::vector<char>& bytes = *bytes_result;
   // Dispatch on content, not extension: every PLY file starts with the magic line "ply".

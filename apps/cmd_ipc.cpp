@@ -150,7 +150,7 @@ void print_sample(std::span<const std::byte> bytes, std::uint64_t sequence, cons
   std::cout << " frame " << list.frame_id << " objects " << count << "\n";
   for (std::uint32_t i = 0; i < count; ++i) {
     const auto& o = list.objects[i];
-    std::cout << "  track " << o.track_id << " label " << std::string(o.label, strnlen(o.label, sizeof(o.label)))
+    std::cout << "  track " << o.track_id << " label " << o.label.view()
               << " score " << o.score << (o.unknown ? " unknown" : "") << " centroid " << o.centroid[0] << " "
               << o.centroid[1] << " " << o.centroid[2] << " points " << o.point_count << "\n";
   }

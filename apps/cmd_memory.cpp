@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "apps/commands.hpp"
-#include "drivers/pcd_io.hpp"
+#include "formats/pcd_io.hpp"
 #include "kernels/good.hpp"
 #include "learning/calibration.hpp"
 #include "learning/perceptual_memory.hpp"
@@ -57,7 +57,7 @@ learning::PerceptualMemory open_memory(const MemoryOptions& o) {
 
 // The GOOD descriptor of one object PCD as a view record (object frame and bbox from compute_good).
 learning::ViewRecord view_of(const std::string& file, const kernels::GoodConfig& good) {
-  auto cloud_result = drivers::read_pcd(file);
+  auto cloud_result = formats::read_pcd(file);
   if (!cloud_result) { fail(cloud_result.error().to_string(), EXIT_BAD_INPUT); }
   kernels::GoodScratch scratch(good.bins);
   learning::ViewRecord v;

@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "apps/commands.hpp"
-#include "drivers/pcd_io.hpp"
+#include "formats/pcd_io.hpp"
 #include "engine/graph.hpp"
 #include "graphs/embedded_graphs.hpp"
 #include "graphs/segment_params.hpp"
@@ -126,7 +126,7 @@ void resolve_params(SegmentOptions& opt) {
 
 void run_segment(SegmentOptions& opt) {
   resolve_params(opt);
-  auto cloud_result = drivers::read_pcd(opt.file);
+  auto cloud_result = formats::read_pcd(opt.file);
   if (!cloud_result) {
     std::cerr << "orthoflow segment: " << cloud_result.error().to_string() << '\n';
     throw CLI::RuntimeError(EXIT_BAD_INPUT);

@@ -12,14 +12,14 @@
 #include <vector>
 
 #include "apps/commands.hpp"
-#include "drivers/object_dataset.hpp"
-#include "drivers/pcd_io.hpp"
-#include "drivers/synthetic_scene.hpp"
+#include "simulation/object_dataset.hpp"
+#include "formats/pcd_io.hpp"
+#include "simulation/synthetic_scene.hpp"
 
 namespace orthoflow::apps {
 namespace {
 
-using drivers::Category;
+using simulation::Category;
 
 constexpr double RAD_TO_DEG = 180.0 / 3.14159265358979323846;
 
@@ -30,11 +30,11 @@ std::vector<Category> parse_categories(const std::string& list) {
   std::string name;
   while (std::getline(in, name, ',')) {
     if (name.empty()) { continue; }
-    const auto maybe_category = drivers::category_from_name(name);
+    const auto maybe_category = simulation::category_from_name(name);
     if (!maybe_category) {
       std::cerr << "unknown category '" << name << "' (known: ";
-      for (std::size_t i = 0; i < drivers::CATEGORY_COUNT; ++i) {
-        std::cerr << (i ? "," : "") << drivers::category_name(static_cast<Category>(i));
+      for (std::size_t i = 0; i < simulation::CATEGORY_COUNT; ++i) {
+        std::cerr << (i ? "," : "") << simulation::category_name(static_cast<Category>(i));
       }
       std::cerr << ")\n";
       throw CLI::RuntimeError(EXIT_USAGE);
@@ -44,34 +44,34 @@ std::vector<Category> parse_categories(const std::string& list) {
   return out;
 }
 
-nlohmann::json vec(const drivers::Vec3& v) { return nlohmann::json::array({v[0], v[1], v[2]}); }
+nlohmann::json vec(const simulation::Vec3& v) { return nlohmann::json::array({v[0], v[1], v[2]}); }
 
-nlohmann::json ground_truth(const drivers::Scene& scene, const kernels::PointCloud& cloud, std::uint64_t seed) {
-  const drivers::TableFrame f = drivers::table_frame(scene.table);
+nlohmann::json ground_truth(const simulation::Scene& scene, const kernels::PointCloud& cloud, std::uint64_t seed) {
+  const simulation::TableFrame f = simulation::table_frame(scene.table);
   nlohmann::json gt;
   gt["seed"] = seed;
   gt["width"] = cloud.width();
   gt["height"] = cloud.height();
   gt["frame"] = "sensor: x right, y down, z forward, metres";
   gt["pose_convention"] = "row-major 4x4 sensor_from_object; origin at the footprint centre on the table, z = table normal";
-  gt["labels"] = {{"none", drivers::LABEL_NONE}, {"table", drivers::LABEL_TABLE}, {"floor", drivers::LABEL_FLOOR},
-                  {"object_base", drivers::OBJECT_LABEL_BASE}};
+  gt["labels"] = {{"none", simulation::LABEL_NONE}, {"table", simulation::LABEL_TABLE}, {"floor", simulation::LABEL_FLOOR},
+                  {"object_base", simulation::OBJECT_LABEL_BASE}};
   nlohmann::json corners = nlohmann::json::array();
-  for (const auto& c : drivers::table_corners(scene.table)) { corners.push_back(vec(c)); }
+  for (const auto& c : simulation::table_corners(scene.table)) { corners.push_back(vec(c)); }
   gt["table"] = {{"normal", vec(f.normal)}, {"d", f.d}, {"corners", corners}, {"distance_m", scene.table.distance_m},
                  {"tilt_deg", scene.table.tilt_rad * RAD_TO_DEG}, {"width_m", scene.table.width_m},
                  {"depth_m", scene.table.depth_m}, {"floor_drop_m", scene.table.floor_drop_m}};
   std::vector<std::size_t> visible(scene.objects.size(), 0);
   for (std::uint32_t l : cloud.label()) {
-    const int id = drivers::object_of_label(l);
+    const int id = simulation::object_of_label(l);
     if (id >= 0) { ++visible[static_cast<std::size_t>(id)]; }
   }
   gt["objects"] = nlohmann::json::array();
   for (std::size_t i = 0; i < scene.objects.size(); ++i) {
-    const drivers::PlacedObject& o = scene.objects[i];
-    gt["objects"].push_back({{"id", i}, {"label", drivers::OBJECT_LABEL_BASE + i},
-                             {"category", drivers::category_name(o.model.category)}, {"instance", o.model.instance},
-                             {"pose", drivers::object_pose(f, o)}, {"yaw_rad", o.yaw},
+    const simulation::PlacedObject& o = scene.objects[i];
+    gt["objects"].push_back({{"id", i}, {"label", simulation::OBJECT_LABEL_BASE + i},
+                             {"category", simulation::category_name(o.model.category)}, {"instance", o.model.instance},
+                             {"pose", simulation::object_pose(f, o)}, {"yaw_rad", o.yaw},
                              {"table_xy", {o.table_x, o.table_y}}, {"footprint_radius_m", o.model.footprint_radius},
                              {"height_m", o.model.height}, {"visible_points", visible[i]}});
   }
@@ -89,16 +89,16 @@ struct SynthArgs {
 };
 
 void run_synth(const SynthArgs& a) {
-  drivers::SceneConfig config;
+  simulation::SceneConfig config;
   config.objects = a.objects;
   config.touching = a.touching;
   config.floor = !a.no_floor;
   config.categories = parse_categories(a.categories);
-  const drivers::Scene scene = drivers::make_scene(config, a.seed);
+  const simulation::Scene scene = simulation::make_scene(config, a.seed);
   kernels::PointCloud cloud;
-  drivers::Random rng(~a.seed);
-  drivers::render_scene(scene, drivers::RenderOptions{}, rng, cloud);
-  if (auto written = drivers::write_pcd(cloud, a.out); !written) {
+  core::Rng rng(~a.seed);
+  simulation::render_scene(scene, simulation::RenderOptions{}, rng, cloud);
+  if (auto written = formats::write_pcd(cloud, a.out); !written) {
     std::cerr << written.error().to_string() << "\n";
     throw CLI::RuntimeError(EXIT_FAILURE_GENERIC);
   }
@@ -131,18 +131,18 @@ struct DatasetArgs {
 };
 
 void run_dataset(const DatasetArgs& a) {
-  drivers::DatasetConfig config;
+  simulation::DatasetConfig config;
   config.categories = parse_categories(a.categories);
   config.instances = a.instances;
   config.views = a.views;
   config.seed = a.seed;
-  const auto summary_result = drivers::write_object_dataset(config, a.out);
+  const auto summary_result = simulation::write_object_dataset(config, a.out);
   if (!summary_result) {
     std::cerr << summary_result.error().to_string() << "\n";
-    throw CLI::RuntimeError(summary_result.error().code == drivers::DatasetError::Code::BAD_CONFIG ? EXIT_USAGE
+    throw CLI::RuntimeError(summary_result.error().code == simulation::DatasetError::Code::BAD_CONFIG ? EXIT_USAGE
                                                                                                   : EXIT_FAILURE_GENERIC);
   }
-  const drivers::DatasetSummary& s = summary_result.value();
+  const simulation::DatasetSummary& s = summary_result.value();
   std::cout << a.out << ": " << s.categories << " categories x " << a.instances << " instances x " << a.views
             << " views = " << s.files << " views written, " << s.points << " points (fewest in one view: " << s.min_points
             << ")\n";
@@ -154,7 +154,7 @@ void add_synth_command(CLI::App& app) {
   auto synth_args = std::make_shared<SynthArgs>();
   CLI::App* synth = app.add_subcommand("synth", "Render one synthetic Kinect v1 tabletop frame (organized PCD with rgb and label)");
   synth->add_option("--objects", synth_args->objects, "objects to place (fewer if they do not fit)")
-      ->check(CLI::Range(0, static_cast<int>(drivers::MAX_SCENE_OBJECTS)));
+      ->check(CLI::Range(0, static_cast<int>(simulation::MAX_SCENE_OBJECTS)));
   synth->add_option("--seed", synth_args->seed, "seed: same seed, same bytes");
   synth->add_option("--out", synth_args->out, "output PCD file")->required();
   synth->add_flag("--touching", synth_args->touching, "place objects in touching pairs");

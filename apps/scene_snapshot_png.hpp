@@ -5,7 +5,7 @@
 #include <string>
 
 #include "graphs/session_log.hpp"
-#include "memory_pool/result.hpp"
+#include "core/result.hpp"
 
 namespace orthoflow::apps {
 

@@ -13,7 +13,7 @@
 #include <string>
 
 #include "kernels/point_cloud.hpp"
-#include "memory_pool/result.hpp"
+#include "core/result.hpp"
 
 namespace orthoflow::engine {
 

@@ -10,7 +10,7 @@
 
 #include "engine/node.hpp"
 #include "engine/params.hpp"
-#include "memory_pool/result.hpp"
+#include "core/result.hpp"
 
 namespace orthoflow::engine {
 

@@ -11,7 +11,7 @@
 #include "engine/params.hpp"
 #include "engine/registry.hpp"
 #include "memory_pool/block_pool.hpp"
-#include "memory_pool/result.hpp"
+#include "core/result.hpp"
 
 namespace orthoflow::engine {
 

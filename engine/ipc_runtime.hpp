@@ -12,7 +12,7 @@
 #include <string_view>
 #include <vector>
 
-#include "memory_pool/result.hpp"
+#include "core/result.hpp"
 
 namespace orthoflow::engine {
 

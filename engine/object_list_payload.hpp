@@ -7,17 +7,18 @@
 #include <cstdint>
 #include <type_traits>
 
+#include "core/fixed_text.hpp"
+
 namespace orthoflow::engine {
 
 inline constexpr std::uint32_t OBJECT_LIST_TYPE_ID = 0x4C4F464FU;  ///< "OFOL" in little-endian bytes
 inline constexpr std::uint16_t OBJECT_LIST_VERSION = 1;
 inline constexpr std::uint32_t OBJECT_LIST_CAPACITY = 64;
-inline constexpr std::size_t OBJECT_LABEL_CHARS = 64;
 
 /// @brief One object: track, label, pose frame and size.
 struct ObjectEntry {
   std::uint64_t track_id;
-  char label[OBJECT_LABEL_CHARS];  ///< NUL-terminated
+  core::Text label;                ///< the category, or empty when unknown
   float score;                     ///< recognition score (lower distance = better, see learning/)
   std::uint32_t unknown;           ///< 1 if no known category matched
   float centroid[3];               ///< metres, sensor frame

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "memory_pool/result.hpp"
+#include "core/result.hpp"
 
 namespace orthoflow::engine {
 

@@ -1,6 +1,6 @@
 #include "engine/registry.hpp"
 
-#include "memory_pool/assert.hpp"
+#include "core/assert.hpp"
 
 namespace orthoflow::engine {
 

@@ -9,7 +9,7 @@
 
 #include "engine/node.hpp"
 #include "engine/params.hpp"
-#include "memory_pool/result.hpp"
+#include "core/result.hpp"
 
 namespace orthoflow::engine {
 

@@ -1,6 +1,6 @@
 #include "evaluation/cross_validation.hpp"
 
-#include "drivers/synthetic_random.hpp"
+#include "core/rng.hpp"
 #include "evaluation/detail/shuffle.hpp"
 
 namespace orthoflow::evaluation {
@@ -14,7 +14,7 @@ Result<Folds, EvalError> make_folds(const Dataset& dataset, std::size_t k, std::
       return err(EvalError{EvalError::Code::TOO_FEW_VIEWS, "category '" + dataset.categories[c] + "' has " +
                                                                std::to_string(views.size()) + " view; cross-validation needs 2 or more"});
     }
-    drivers::Random rng(seed * 0x9E3779B97F4A7C15ULL + c + 1);
+    core::Rng rng(seed * 0x9E3779B97F4A7C15ULL + c + 1);
     detail::shuffle(views, rng);
     // Continue dealing where the previous category stopped, so small categories do not all land in fold 0.
     for (std::size_t i = 0; i < views.size(); ++i) { folds.fold_of_view[views[i]] = static_cast<std::uint32_t>((start + i) % k); }

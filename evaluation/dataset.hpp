@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "evaluation/eval_error.hpp"
-#include "memory_pool/result.hpp"
+#include "core/result.hpp"
 
 namespace orthoflow::evaluation {
 

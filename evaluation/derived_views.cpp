@@ -4,7 +4,7 @@
 #include <cmath>
 #include <vector>
 
-#include "drivers/synthetic_random.hpp"
+#include "core/rng.hpp"
 
 namespace orthoflow::evaluation {
 
@@ -22,7 +22,7 @@ kernels::PointCloud derive_view(const kernels::PointCloud& cloud, std::uint32_t 
   kernels::PointCloud out;
   if (finite.empty()) { return out; }
   for (double& v : c) { v /= static_cast<double>(finite.size()); }
-  drivers::Random rng(seed * 0x9E3779B97F4A7C15ULL + index);
+  core::Rng rng(seed * 0x9E3779B97F4A7C15ULL + index);
   // A random direction (normalised Gaussian vector) and the share of points to keep along it.
   double d[3] = {rng.normal(), rng.normal(), rng.normal()};
   const double norm = std::max(1e-12, std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]));

@@ -7,8 +7,8 @@
 #include <fstream>
 #include <iterator>
 
-#include "drivers/pcd_io.hpp"
-#include "drivers/synthetic_random.hpp"
+#include "formats/pcd_io.hpp"
+#include "core/rng.hpp"
 #include "evaluation/descriptor_cache.hpp"
 #include "evaluation/progress.hpp"
 #include "kernels/voxel_grid.hpp"
@@ -50,7 +50,7 @@ void finite_points(const kernels::PointCloud& cloud, kernels::PointCloud& out) {
 std::string describe_one(const Dataset& ds, std::size_t v, const DescriptorSpec& spec, kernels::GoodScratch& scratch,
                          std::span<float> out) {
   const std::filesystem::path path = ds.root / ds.views[v].relative;
-  auto cloud = drivers::read_pcd(path);
+  auto cloud = formats::read_pcd(path);
   if (!cloud) { return path.string() + ": " + cloud.error().to_string(); }
   kernels::PointCloud view;
   if (!perturb_view(*cloud, spec, ds.views[v].relative, view)) {
@@ -121,7 +121,7 @@ bool perturb_view(const kernels::PointCloud& cloud, const DescriptorSpec& spec, 
                   kernels::PointCloud& out) {
   finite_points(cloud, out);
   if (spec.perturbation == Perturbation::NOISE && spec.amount_m > 0.0) {
-    drivers::Random rng(fnv1a(view_key, spec.seed ^ 0x9E3779B97F4A7C15ULL));
+    core::Rng rng(fnv1a(view_key, spec.seed ^ 0x9E3779B97F4A7C15ULL));
     for (std::size_t i = 0; i < out.size(); ++i) {
       out.x()[i] += static_cast<float>(spec.amount_m * rng.normal());
       out.y()[i] += static_cast<float>(spec.amount_m * rng.normal());

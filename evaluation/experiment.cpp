@@ -7,7 +7,7 @@
 #include <cmath>
 #include <map>
 
-#include "drivers/synthetic_random.hpp"
+#include "core/rng.hpp"
 #include "evaluation/progress.hpp"
 
 namespace orthoflow::evaluation {
@@ -135,7 +135,7 @@ void run_teachers(const Dataset& ds, const EvalOptions& o, const DescriptorTable
 
 /// Thesis 7.3.1: rho drawn uniformly in [0.65, 0.85] x ALC, kept within [1, categories - 1].
 std::size_t draw_rho(const EvalOptions& o, std::size_t r, double alc, std::size_t categories) {
-  drivers::Random rng(run_seed(o.seed, r) ^ 0x5851F42D4C957F2DULL);
+  core::Rng rng(run_seed(o.seed, r) ^ 0x5851F42D4C957F2DULL);
   const double u = 0.65 + 0.2 * rng.uniform();
   const auto rho = static_cast<std::size_t>(std::llround(u * alc));
   return std::clamp<std::size_t>(rho, 1, categories - 1);

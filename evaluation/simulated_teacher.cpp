@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <deque>
 
-#include "drivers/synthetic_random.hpp"
+#include "core/rng.hpp"
 #include "evaluation/detail/shuffle.hpp"
 
 namespace orthoflow::evaluation {
@@ -17,7 +17,7 @@ class Teacher {
       : ds_(ds), d_(d), order_(order), cfg_(cfg), learner_(v, ds.categories), unseen_(ds.categories.size()) {
     for (std::uint32_t c = 0; c < ds.categories.size(); ++c) {
       std::vector<std::size_t> views = ds.views_of(c);
-      drivers::Random rng(seed * 0xD1B54A32D192ED03ULL + c + 1);
+      core::Rng rng(seed * 0xD1B54A32D192ED03ULL + c + 1);
       detail::shuffle(views, rng);
       unseen_[c].assign(views.begin(), views.end());
     }
@@ -147,7 +147,7 @@ TeacherRun run_teacher(const Dataset& dataset, const DescriptorTable& descriptor
 std::vector<std::uint32_t> category_order(std::size_t categories, std::uint64_t seed) {
   std::vector<std::uint32_t> order(categories);
   for (std::uint32_t c = 0; c < categories; ++c) { order[c] = c; }
-  drivers::Random rng(seed ^ 0xA0761D6478BD642FULL);
+  core::Rng rng(seed ^ 0xA0761D6478BD642FULL);
   detail::shuffle(order, rng);
   return order;
 }

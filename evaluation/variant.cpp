@@ -2,7 +2,7 @@
 
 #include "learning/bayes_learner.hpp"
 #include "learning/instance_learner.hpp"
-#include "memory_pool/assert.hpp"
+#include "core/assert.hpp"
 
 namespace orthoflow::evaluation {
 

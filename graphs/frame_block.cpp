@@ -44,16 +44,6 @@ kernels::PointsSpan xyz_at(std::byte* base, std::size_t offset, std::size_t capa
 
 }  // namespace
 
-std::string_view Text::view() const noexcept {
-  return {chars.data(), static_cast<std::size_t>(std::find(chars.begin(), chars.end(), '\0') - chars.begin())};
-}
-
-void Text::assign(std::string_view s) noexcept {
-  const std::size_t n = std::min(s.size(), LABEL_CHARS - 1);
-  std::memcpy(chars.data(), s.data(), n);
-  chars[n] = '\0';
-}
-
 std::size_t FrameBlock::bytes_for(std::size_t capacity) noexcept { return layout(capacity).end; }
 
 std::size_t FrameBlock::capacity_for(std::size_t block_bytes) noexcept {

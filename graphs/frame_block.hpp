@@ -14,11 +14,12 @@
 #include <string>
 #include <string_view>
 
+#include "core/fixed_text.hpp"
 #include "engine/frame_payload.hpp"
 #include "kernels/cluster_stats.hpp"
 #include "kernels/plane_distance.hpp"
 #include "kernels/tabletop_stages.hpp"
-#include "memory_pool/result.hpp"
+#include "core/result.hpp"
 
 namespace orthoflow::graphs {
 
@@ -27,16 +28,9 @@ inline constexpr std::size_t MAX_HULL = 2048;       ///< support-polygon vertice
 inline constexpr std::size_t MAX_GOOD_BINS = 20;    ///< descriptor room: 3 * 20^2 floats per object
 inline constexpr std::size_t MAX_DESCRIPTOR = 3 * MAX_GOOD_BINS * MAX_GOOD_BINS;
 inline constexpr std::size_t MAX_TRUTH = 64;        ///< ground-truth objects a source can describe
-inline constexpr std::size_t LABEL_CHARS = 64;      ///< label text, NUL-terminated
 
-/// @brief Fixed-capacity text (labels, categories): copying never allocates.
-struct Text {
-  std::array<char, LABEL_CHARS> chars{};
-  [[nodiscard]] std::string_view view() const noexcept;
-  /// @brief Stores @p s, truncated to LABEL_CHARS - 1 bytes.
-  void assign(std::string_view s) noexcept;
-  [[nodiscard]] bool empty() const noexcept { return chars[0] == '\0'; }
-};
+/// @brief Fixed-capacity text (labels, categories, node names): copying never allocates.
+using Text = core::Text;
 
 /// @brief One ground-truth object of a synthetic or annotated frame (label value -> category).
 struct TruthObject {
@@ -80,7 +74,7 @@ struct FrameError {
   enum class Code : std::uint8_t {
     NONE,
     FRAME_TOO_LARGE,  ///< source: more points than the pool block holds (value: the point count)
-    FILE_UNREADABLE,  ///< pcd_source: the file did not parse (cause: drivers::IoError::Code; detail: message)
+    FILE_UNREADABLE,  ///< pcd_source: the file did not parse (cause: formats::IoError::Code; detail: message)
     INVALID_FRAME,    ///< the block holds no valid frame (cause: engine::FrameError)
     SEGMENTATION,     ///< a segmentation stage failed: segmentation holds the stage's typed reason
   };

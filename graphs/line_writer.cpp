@@ -31,29 +31,24 @@ LineWriter::~LineWriter() {
 }
 
 bool LineWriter::write(std::string_view line) noexcept {
-  const std::size_t head = head_.load(std::memory_order_relaxed);
-  const std::size_t used = head - tail_.load(std::memory_order_acquire);
-  if (used + line.size() + 1 > ring_.size()) {
+  // Room for the line and its newline is checked first (the consumer only frees room), so both go in
+  // or neither does.
+  if (ring_.capacity() - ring_.size() < line.size() + 1 || !ring_.try_push_all({line.data(), line.size()}) ||
+      !ring_.try_push('\n')) {
     dropped_.fetch_add(1, std::memory_order_relaxed);
     return false;
   }
-  for (std::size_t i = 0; i < line.size(); ++i) ring_[(head + i) % ring_.size()] = line[i];
-  ring_[(head + line.size()) % ring_.size()] = '\n';
-  head_.store(head + line.size() + 1, std::memory_order_release);
   return true;
 }
 
 // Writes out everything queued so far; true if there was something.
 bool LineWriter::drain() noexcept {
-  const std::size_t tail = tail_.load(std::memory_order_relaxed);
-  const std::size_t head = head_.load(std::memory_order_acquire);
-  if (head == tail) return false;
-  const std::size_t start = tail % ring_.size();
-  const std::size_t first = std::min(head - tail, ring_.size() - start);
-  bool ok = std::fwrite(ring_.data() + start, 1, first, file_) == first;
-  if (head - tail > first) ok = ok && std::fwrite(ring_.data(), 1, head - tail - first, file_) == head - tail - first;
+  const auto [first, second] = ring_.readable();
+  if (first.empty()) return false;
+  bool ok = std::fwrite(first.data(), 1, first.size(), file_) == first.size();
+  if (!second.empty()) ok = ok && std::fwrite(second.data(), 1, second.size(), file_) == second.size();
   if (!ok) failed_.store(true);
-  tail_.store(head, std::memory_order_release);
+  ring_.release(first.size() + second.size());
   return true;
 }
 
@@ -68,7 +63,7 @@ void LineWriter::loop() noexcept {
 }
 
 void LineWriter::flush() noexcept {
-  while (tail_.load() != head_.load()) std::this_thread::sleep_for(POLL);
+  while (ring_.size() != 0) std::this_thread::sleep_for(POLL);
   if (std::fflush(file_) != 0) failed_.store(true);
 }
 

@@ -11,7 +11,8 @@
 #include <thread>
 #include <vector>
 
-#include "memory_pool/result.hpp"
+#include "core/result.hpp"
+#include "core/spsc_ring.hpp"
 
 namespace orthoflow::graphs {
 
@@ -37,8 +38,7 @@ class LineWriter {
   bool drain() noexcept;
   std::FILE* file_;
   bool owned_;
-  std::vector<char> ring_;
-  std::atomic<std::size_t> head_{0}, tail_{0};
+  core::SpscRing<char> ring_;
   std::atomic<bool> stop_{false}, failed_{false};
   std::atomic<std::uint64_t> dropped_{0};
   std::thread thread_;

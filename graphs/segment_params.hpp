@@ -8,7 +8,7 @@
 #include "engine/graph.hpp"
 #include "engine/params.hpp"
 #include "kernels/segmentation_chain.hpp"
-#include "memory_pool/result.hpp"
+#include "core/result.hpp"
 
 namespace orthoflow::graphs {
 

@@ -4,10 +4,10 @@ namespace orthoflow::graphs {
 
 namespace {
 
-drivers::ScriptedObject place(drivers::Category category, std::uint32_t instance, std::uint64_t seed, double x,
+simulation::ScriptedObject place(simulation::Category category, std::uint32_t instance, std::uint64_t seed, double x,
                               double y, double yaw) {
-  drivers::ScriptedObject o;
-  o.start.model = drivers::make_object_model(category, instance, seed);
+  simulation::ScriptedObject o;
+  o.start.model = simulation::make_object_model(category, instance, seed);
   o.start.table_x = x;
   o.start.table_y = y;
   o.start.yaw = yaw;
@@ -16,9 +16,9 @@ drivers::ScriptedObject place(drivers::Category category, std::uint32_t instance
 
 }  // namespace
 
-drivers::SequenceScript make_session_script(std::uint64_t frames, std::uint64_t seed) {
-  using drivers::Category;
-  drivers::SequenceScript s;
+simulation::SequenceScript make_session_script(std::uint64_t frames, std::uint64_t seed) {
+  using simulation::Category;
+  simulation::SequenceScript s;
   s.frames = frames;
   const std::uint64_t end1 = frames * 2 / 5, start2 = frames * 9 / 20;
   // Table coordinates: x to the right, y away from the sensor, origin at the table centre (metres).

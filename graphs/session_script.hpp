@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <string_view>
 
-#include "drivers/synthetic_sequence.hpp"
+#include "simulation/synthetic_sequence.hpp"
 
 namespace orthoflow::graphs {
 
@@ -19,7 +19,7 @@ inline constexpr std::uint64_t SESSION_FRAMES = 300;
 /// Phase 1 (first 40%): first instances of mug, bottle and bowl; the mug slides.
 /// Phase 2 (from 45%): second instances of mug and bottle and a plate (never taught) appear;
 /// the bowl stays for the whole session.
-[[nodiscard]] drivers::SequenceScript make_session_script(std::uint64_t frames, std::uint64_t seed);
+[[nodiscard]] simulation::SequenceScript make_session_script(std::uint64_t frames, std::uint64_t seed);
 
 /// @brief True if the scripted instructor teaches this category (all session categories but "plate").
 [[nodiscard]] bool instructor_teaches(std::string_view category) noexcept;

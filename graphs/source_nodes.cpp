@@ -6,8 +6,8 @@
 #include <new>
 #include <vector>
 
-#include "drivers/object_catalog.hpp"
-#include "drivers/pcd_io.hpp"
+#include "simulation/object_catalog.hpp"
+#include "formats/pcd_io.hpp"
 #include "graphs/node_support.hpp"
 #include "graphs/session_script.hpp"
 
@@ -61,7 +61,7 @@ class FrameSource : public engine::Node {
 
 class SyntheticSource final : public FrameSource {
  public:
-  SyntheticSource(std::size_t capacity, const engine::NodeContext& context, drivers::SequenceScript script,
+  SyntheticSource(std::size_t capacity, const engine::NodeContext& context, simulation::SequenceScript script,
                   std::uint64_t seed)
       : FrameSource(capacity, context), sequence_(std::move(script), seed) {
     cloud_.reserve(640 * 480);
@@ -75,14 +75,14 @@ class SyntheticSource final : public FrameSource {
     const auto& objects = sequence_.scene().objects;
     s.truth_count = static_cast<std::uint32_t>(std::min(objects.size(), MAX_TRUTH));
     for (std::uint32_t k = 0; k < s.truth_count; ++k) {
-      s.truth[k].label = drivers::OBJECT_LABEL_BASE + objects[k].id;
-      s.truth[k].category.assign(drivers::category_name(objects[k].model.category));
+      s.truth[k].label = simulation::OBJECT_LABEL_BASE + objects[k].id;
+      s.truth[k].category.assign(simulation::category_name(objects[k].model.category));
     }
     return engine::SourceStatus::FRAME;
   }
 
  private:
-  drivers::SyntheticSequence sequence_;
+  simulation::SyntheticSequence sequence_;
   kernels::PointCloud cloud_;
 };
 
@@ -98,7 +98,7 @@ class PcdSource final : public FrameSource {
     }
     const std::uint64_t index = frame_++;
     if (!take_block(out)) return engine::SourceStatus::FRAME;
-    auto cloud = drivers::read_pcd(files_[next_++]);
+    auto cloud = formats::read_pcd(files_[next_++]);
     if (!cloud) {  // a bad file is an empty frame with its error, not the end of the run
       const FrameBlock block = block_of(out, capacity_);
       (void)engine::write_frame(block.raw(), kernels::PointCloud{});
@@ -130,12 +130,12 @@ NodeResult make_synthetic(const ParamMap& params, const engine::NodeContext& con
   std::string e;
   take(params.integer("seed", 7, 0, INT64_MAX), seed, e);
   take(params.integer("frames", static_cast<std::int64_t>(SESSION_FRAMES), 1, 100'000'000), frames, e);
-  take(params.integer("objects", 0, 0, drivers::MAX_SCENE_OBJECTS), objects, e);
+  take(params.integer("objects", 0, 0, simulation::MAX_SCENE_OBJECTS), objects, e);
   if (!e.empty()) return err(e);
   if (*capacity < 640 * 480) return err("synthetic_source: pool blocks hold " + std::to_string(*capacity) +
                                         " points, a 640x480 frame needs 307200 (raise pool block_bytes)");
   auto script = objects == 0 ? make_session_script(frames, seed)
-                             : drivers::make_sequence_script(static_cast<std::uint32_t>(objects), frames, seed);
+                             : simulation::make_sequence_script(static_cast<std::uint32_t>(objects), frames, seed);
   return std::unique_ptr<engine::Node>(new SyntheticSource(*capacity, context, std::move(script), seed));
 }
 

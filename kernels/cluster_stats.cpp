@@ -4,7 +4,7 @@
 #include <algorithm>
 #include <limits>
 
-#include "memory_pool/assert.hpp"
+#include "core/assert.hpp"
 
 namespace orthoflow::kernels {
 

@@ -3,7 +3,7 @@
 #include <limits>
 
 #include "kernels/detail/crop_kernel.hpp"
-#include "memory_pool/assert.hpp"
+#include "core/assert.hpp"
 
 namespace orthoflow::kernels {
 

@@ -1,7 +1,7 @@
 #include "kernels/depth_projection.hpp"
 
 #include "kernels/detail/depth_projection_kernel.hpp"
-#include "memory_pool/assert.hpp"
+#include "core/assert.hpp"
 
 namespace orthoflow::kernels {
 

@@ -23,7 +23,7 @@ struct DepthCamera {
 
 /// @brief Fills @p table_m with the reciprocal-linear fit Z = 1 / (raw * -0.0030711016 + 3.3309495161)
 /// (KINECT_V1.md 8.1), in metres; 0 ("no reading") for raw 2047 and for raw >= 1080 (near the pole).
-/// A device table (drivers::make_depth_table) can be used instead. @note Deterministic.
+/// A device table (simulation::make_depth_table) can be used instead. @note Deterministic.
 void fill_disparity_table_reciprocal(std::span<float, DISPARITY_TABLE_SIZE> table_m) noexcept;
 
 /// @brief Back-projects a width x height raw image: z = table[raw & 0x7FF], x = (u - cx) / fx * z,

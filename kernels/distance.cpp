@@ -3,7 +3,7 @@
 #include <cmath>
 
 #include "kernels/detail/distance_kernel.hpp"
-#include "memory_pool/assert.hpp"
+#include "core/assert.hpp"
 
 namespace orthoflow::kernels {
 

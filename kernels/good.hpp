@@ -19,7 +19,7 @@
 
 #include "kernels/pca_frame.hpp"
 #include "kernels/point_cloud.hpp"
-#include "memory_pool/result.hpp"
+#include "core/result.hpp"
 
 namespace orthoflow::kernels {
 

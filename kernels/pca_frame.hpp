@@ -8,7 +8,7 @@
 #include <cstdint>
 
 #include "kernels/point_cloud.hpp"
-#include "memory_pool/result.hpp"
+#include "core/result.hpp"
 
 namespace orthoflow::kernels {
 

@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "memory_pool/assert.hpp"
+#include "core/assert.hpp"
 
 namespace orthoflow::kernels {
 

@@ -1,7 +1,7 @@
 #include "kernels/plane_distance.hpp"
 
 #include "kernels/detail/plane_distance_kernel.hpp"
-#include "memory_pool/assert.hpp"
+#include "core/assert.hpp"
 
 namespace orthoflow::kernels {
 

@@ -2,7 +2,7 @@
 
 #include <limits>
 
-#include "memory_pool/assert.hpp"
+#include "core/assert.hpp"
 
 namespace orthoflow::kernels {
 

@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "kernels/detail/polygonal_prism_kernel.hpp"
-#include "memory_pool/assert.hpp"
+#include "core/assert.hpp"
 
 namespace orthoflow::kernels {
 

@@ -3,7 +3,7 @@
 #include <Eigen/Eigenvalues>
 #include <cmath>
 
-#include "kernels/rng.hpp"
+#include "core/rng.hpp"
 
 namespace orthoflow::kernels {
 
@@ -28,9 +28,9 @@ bool finite_at(PointsView p, std::size_t i) {
 
 /// A plane through 3 random finite points, or false when the draw is degenerate: repeated index,
 /// coincident or collinear points (sine of the angle between the edges below 1e-6).
-bool draw_hypothesis(PointsView pts, Rng& rng, Plane& out) {
+bool draw_hypothesis(PointsView pts, core::Rng& rng, Plane& out) {
   const auto n = pts.size();
-  const std::uint32_t i0 = rng.below(n), i1 = rng.below(n), i2 = rng.below(n);
+  const auto i0 = rng.below(n), i1 = rng.below(n), i2 = rng.below(n);
   if (i0 == i1 || i0 == i2 || i1 == i2 || !finite_at(pts, i0) || !finite_at(pts, i1) || !finite_at(pts, i2)) {
     return false;
   }
@@ -87,7 +87,7 @@ Result<RansacPlane, RansacError> ransac_impl(PointsView pts, const RansacParams&
   std::size_t finite = 0;
   for (std::size_t i = 0; i < pts.size() && finite < 3; ++i) { finite += finite_at(pts, i) ? 1U : 0U; }
   if (finite < 3) { return err(RansacError{Code::TOO_FEW_POINTS, double(finite)}); }
-  Rng rng(prm.seed);
+  core::Rng rng(prm.seed);
   Plane best;
   std::size_t best_count = 0;
   std::uint32_t it = 0;

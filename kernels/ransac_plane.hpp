@@ -10,7 +10,7 @@
 
 #include "kernels/plane_distance.hpp"
 #include "kernels/point_cloud.hpp"
-#include "memory_pool/result.hpp"
+#include "core/result.hpp"
 
 namespace orthoflow::kernels {
 

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "kernels/point_cloud.hpp"
-#include "memory_pool/result.hpp"
+#include "core/result.hpp"
 
 namespace orthoflow::kernels {
 

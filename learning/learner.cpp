@@ -8,17 +8,6 @@
 
 namespace orthoflow::learning {
 
-std::string_view Label::view() const noexcept {
-  // The last byte is always zero (from() writes at most LABEL_MAX_BYTES), so strnlen stays in bounds.
-  return std::string_view(text.data(), ::strnlen(text.data(), text.size()));
-}
-
-Label Label::from(std::string_view s) noexcept {
-  Label label;
-  const std::size_t n = std::min(s.size(), LABEL_MAX_BYTES);
-  std::copy_n(s.data(), n, label.text.data());
-  return label;
-}
 
 const char* to_string(LearnError error) noexcept {
   switch (error) {

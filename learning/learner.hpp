@@ -13,7 +13,8 @@
 #include <string_view>
 #include <vector>
 
-#include "memory_pool/result.hpp"
+#include "core/fixed_text.hpp"
+#include "core/result.hpp"
 
 namespace orthoflow::learning {
 
@@ -22,18 +23,11 @@ using CategoryId = std::uint32_t;
 /// @brief The category of a Prediction that names none (unknown, or nothing learned yet).
 inline constexpr CategoryId NO_CATEGORY = 0xFFFFFFFFU;
 /// @brief Longest label in bytes (Label keeps it inline with a terminating zero).
-inline constexpr std::size_t LABEL_MAX_BYTES = 63;
+inline constexpr std::size_t LABEL_MAX_BYTES = core::TEXT_MAX_BYTES;
 
 /// @brief A category name stored inline (no allocation), so a Prediction can be copied and kept after
-/// the learner changes.
-struct Label {
-  std::array<char, LABEL_MAX_BYTES + 1> text{};
-  /// @brief The label up to its terminating zero ("" when empty).
-  [[nodiscard]] std::string_view view() const noexcept;
-  /// @brief Copies @p s; @pre 0 < s.size() <= LABEL_MAX_BYTES (check with validate_label()).
-  [[nodiscard]] static Label from(std::string_view s) noexcept;
-  [[nodiscard]] bool operator==(const Label& other) const noexcept { return view() == other.view(); }
-};
+/// the learner changes. Label::from(s) keeps at most LABEL_MAX_BYTES bytes (check with validate_label()).
+using Label = core::Text;
 
 /// @brief The answer of Learner::ask().
 /// score is the decision value: the NOCD of the best category for InstanceLearner (plain L2 distance to the

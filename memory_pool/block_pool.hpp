@@ -10,7 +10,7 @@
 #include <string>
 #include <string_view>
 
-#include "memory_pool/result.hpp"
+#include "core/result.hpp"
 
 namespace orthoflow::memory_pool {
 

@@ -8,7 +8,7 @@
 #include <random>
 #include <vector>
 
-#include "drivers/pcd_io.hpp"
+#include "formats/pcd_io.hpp"
 #include "kernels/good.hpp"
 #include "kernels/simd_arch.hpp"
 
@@ -23,7 +23,7 @@ struct Cloud {
 
 const Cloud& cloud(std::size_t copies) {
   static const Cloud base = [] {
-    auto cloud_result = orthoflow::drivers::read_pcd(ORTHOFLOW_SHARED_DIR "/testdata/good/timing/timing_5k.pcd");
+    auto cloud_result = orthoflow::formats::read_pcd(ORTHOFLOW_SHARED_DIR "/testdata/good/timing/timing_5k.pcd");
     if (!cloud_result) {
       std::fprintf(stderr, "%s\n", cloud_result.error().to_string().c_str());
       std::exit(1);

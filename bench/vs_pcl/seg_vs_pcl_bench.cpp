@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "bench/vs_pcl/pcl_chain.hpp"
-#include "drivers/pcd_io.hpp"
-#include "drivers/synthetic_scene.hpp"
+#include "formats/pcd_io.hpp"
+#include "simulation/synthetic_scene.hpp"
 #include "kernels/segmentation_chain.hpp"
 #include "tests/kernels/seg_quality.hpp"
 
@@ -68,14 +68,14 @@ void run_input(const Input& in, int rounds, const ok::SegmentationParams& params
 }
 
 Input synthetic(std::uint32_t objects, std::uint64_t seed) {
-  orthoflow::drivers::SceneConfig config;
+  orthoflow::simulation::SceneConfig config;
   config.objects = objects;
-  const auto scene = orthoflow::drivers::make_scene(config, seed);
-  orthoflow::drivers::Random rng(seed);
+  const auto scene = orthoflow::simulation::make_scene(config, seed);
+  orthoflow::core::Rng rng(seed);
   Input in{"synthetic " + std::to_string(scene.objects.size()) + " objects", ok::PointCloud{}, {}};
-  orthoflow::drivers::render_scene(scene, {}, rng, in.cloud);
+  orthoflow::simulation::render_scene(scene, {}, rng, in.cloud);
   for (const std::uint32_t l : in.cloud.label()) {
-    const int obj = orthoflow::drivers::object_of_label(l);
+    const int obj = orthoflow::simulation::object_of_label(l);
     in.gt.push_back(obj >= 0 ? static_cast<std::uint32_t>(obj + 2) * 10U : 0U);
   }
   return in;
@@ -88,7 +88,7 @@ int main(int argc, char** argv) {
   std::printf("| input | filter ours / PCL = ratio | voxel | plane | hull+prism | cluster+stats | total | gt objects | ours | PCL |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|\n");
   for (const char* f : {"test31.pcd", "test44.pcd", "test55.pcd"}) {
-    auto cloud_result = orthoflow::drivers::read_pcd(std::string(ORTHOFLOW_SHARED_DIR) + "/data/scenes/" + f);
+    auto cloud_result = orthoflow::formats::read_pcd(std::string(ORTHOFLOW_SHARED_DIR) + "/data/scenes/" + f);
     if (!cloud_result) { std::printf("%s: %s\n", f, cloud_result.error().to_string().c_str()); return 1; }
     Input in{std::string("mOSD ") + f, std::move(*cloud_result), {}};
     in.gt.assign(in.cloud.label().begin(), in.cloud.label().end());

@@ -5,12 +5,12 @@
 #include <utility>
 #include <vector>
 
-#include "drivers/synthetic_random.hpp"
+#include "core/rng.hpp"
 
 namespace orthoflow::evaluation::detail {
 
 template <class T>
-void shuffle(std::vector<T>& v, drivers::Random& rng) {
+void shuffle(std::vector<T>& v, core::Rng& rng) {
   for (std::size_t i = v.size(); i > 1; --i) { std::swap(v[i - 1], v[rng.below(i)]); }
 }
 

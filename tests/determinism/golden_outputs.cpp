@@ -12,10 +12,10 @@
 #include <stdexcept>
 #include <vector>
 
-#include "drivers/object_catalog.hpp"
-#include "drivers/object_dataset.hpp"
-#include "drivers/pcd_io.hpp"
-#include "drivers/synthetic_scene.hpp"
+#include "simulation/object_catalog.hpp"
+#include "simulation/object_dataset.hpp"
+#include "formats/pcd_io.hpp"
+#include "simulation/synthetic_scene.hpp"
 #include "kernels/good.hpp"
 #include "kernels/segmentation_chain.hpp"
 #include "kernels/simd_arch.hpp"
@@ -23,7 +23,8 @@
 namespace orthoflow::testing {
 namespace {
 
-namespace od = orthoflow::drivers;
+namespace ofmt = orthoflow::formats;
+namespace osim = orthoflow::simulation;
 namespace ok = orthoflow::kernels;
 
 template <class T>
@@ -40,10 +41,10 @@ std::string fnv1a64(std::span<const T> values) {
 
 // The scene `orthoflow synth --seed S` writes (apps/cmd_synth.cpp): make_scene(seed), noise from ~seed.
 ok::PointCloud render_seeded_scene(std::uint64_t seed) {
-  const od::Scene scene = od::make_scene(od::SceneConfig{}, seed);
+  const osim::Scene scene = osim::make_scene(osim::SceneConfig{}, seed);
   ok::PointCloud cloud;
-  od::Random rng(~seed);
-  od::render_scene(scene, od::RenderOptions{}, rng, cloud);
+  core::Rng rng(~seed);
+  osim::render_scene(scene, osim::RenderOptions{}, rng, cloud);
   return cloud;
 }
 
@@ -117,15 +118,15 @@ nlohmann::json golden_good(const std::string& shared_dir) {
   }
   std::sort(files.begin(), files.end());  // directory order is not portable
   for (const auto& f : files) {
-    auto cloud_result = od::read_pcd(f);
+    auto cloud_result = ofmt::read_pcd(f);
     if (!cloud_result) { throw std::runtime_error(f.string() + ": " + cloud_result.error().to_string()); }
     out[f.filename().string()] = good_entry(*cloud_result);
   }
   // A rendered view: the renderer is bit-exact, so this also checks GOOD on a known-identical input.
-  const od::ObjectModel mug = od::make_object_model(od::Category::MUG, 1, 7);
+  const osim::ObjectModel mug = osim::make_object_model(osim::Category::MUG, 1, 7);
   ok::PointCloud frame, view;
-  od::Random rng(42);
-  od::render_object_view(mug, od::ViewSpec{0.7, 0.4, 0.9}, od::RenderOptions{}, rng, frame, view);
+  core::Rng rng(42);
+  osim::render_object_view(mug, osim::ViewSpec{0.7, 0.4, 0.9}, osim::RenderOptions{}, rng, frame, view);
   out["synthetic_mug"] = good_entry(view);
   return out;
 }

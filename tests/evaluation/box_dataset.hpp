@@ -8,8 +8,8 @@
 #include <filesystem>
 #include <string>
 
-#include "drivers/pcd_io.hpp"
-#include "drivers/synthetic_random.hpp"
+#include "formats/pcd_io.hpp"
+#include "core/rng.hpp"
 
 namespace orthoflow::evaluation::testing {
 
@@ -22,7 +22,7 @@ inline std::filesystem::path unique_dir(const std::string& name) {
 }
 
 inline kernels::PointCloud box_view(int category, int instance, int view) {
-  drivers::Random rng(static_cast<std::uint64_t>(category * 1000 + instance * 100 + view + 1));
+  core::Rng rng(static_cast<std::uint64_t>(category * 1000 + instance * 100 + view + 1));
   const double hx = 0.02 + 0.03 * category + 0.002 * instance, hy = 0.03, hz = 0.02 + 0.015 * (category % 3);
   const double angle = 0.6 * view + 0.3 * instance;
   kernels::PointCloud cloud;
@@ -46,7 +46,7 @@ inline void write_box_dataset(const std::filesystem::path& root, int categories,
       const std::filesystem::path dir = root / ("box" + std::to_string(c)) / ("inst" + std::to_string(i));
       std::filesystem::create_directories(dir);
       for (int v = 0; v < views; ++v) {
-        (void)drivers::write_pcd(box_view(c, i, v), dir / ("view" + std::to_string(v) + ".pcd"), drivers::PcdEncoding::BINARY);
+        (void)formats::write_pcd(box_view(c, i, v), dir / ("view" + std::to_string(v) + ".pcd"), formats::PcdEncoding::BINARY);
       }
     }
   }

@@ -102,7 +102,7 @@ TEST(Descriptors, CacheIsReusedAndInvalidatedByAChangedFile) {
   // A rewritten file (other points, other size) is described again; the others still come from the cache.
   kernels::PointCloud other = testing::box_view(1, 1, 1);
   other.resize_unorganized(300);
-  ASSERT_TRUE(drivers::write_pcd(other, root / "box0/inst0/view0.pcd", drivers::PcdEncoding::BINARY));
+  ASSERT_TRUE(formats::write_pcd(other, root / "box0/inst0/view0.pcd", formats::PcdEncoding::BINARY));
   auto c = describe_dataset(*ds, spec, cache, nullptr, &third, nullptr);
   ASSERT_TRUE(c);
   EXPECT_EQ(third.computed, 1U);

@@ -3,12 +3,12 @@
 #include <cstdint>
 #include <span>
 
-#include "drivers/pcd_io.hpp"
+#include "formats/pcd_io.hpp"
 #include "fuzz_roundtrip.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::span<const char> bytes(reinterpret_cast<const char*>(data), size);
-  auto cloud = orthoflow::drivers::read_pcd_buffer(bytes, "fuzz");
+  auto cloud = orthoflow::formats::read_pcd_buffer(bytes, "fuzz");
   if (!cloud) {
     if (cloud.error().message.empty()) { __builtin_trap(); }
     return 0;

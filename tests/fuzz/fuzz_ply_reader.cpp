@@ -3,13 +3,13 @@
 #include <cstdint>
 #include <span>
 
-#include "drivers/ply_reader.hpp"
+#include "formats/ply_reader.hpp"
 #include "fuzz_roundtrip.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   namespace ok = orthoflow::kernels;
   const std::span<const char> bytes(reinterpret_cast<const char*>(data), size);
-  auto cloud = orthoflow::drivers::read_ply_buffer(bytes, "fuzz");
+  auto cloud = orthoflow::formats::read_ply_buffer(bytes, "fuzz");
   if (!cloud) {
     if (cloud.error().message.empty()) { __builtin_trap(); }
     return 0;

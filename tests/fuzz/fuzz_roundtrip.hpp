@@ -6,7 +6,7 @@
 #include <span>
 #include <string>
 
-#include "drivers/pcd_io.hpp"
+#include "formats/pcd_io.hpp"
 
 namespace orthoflow_fuzz {
 
@@ -44,12 +44,12 @@ constexpr std::size_t MAX_ASCII_CHECK_POINTS = 512;
 
 /// Writes @p cloud in every PCD encoding, reads it back and traps unless the result is identical.
 inline void check_pcd_round_trip(const orthoflow::kernels::PointCloud& cloud) {
-  namespace od = orthoflow::drivers;
-  for (const auto encoding : {od::PcdEncoding::BINARY_COMPRESSED, od::PcdEncoding::BINARY, od::PcdEncoding::ASCII}) {
-    if (encoding == od::PcdEncoding::ASCII && cloud.size() > MAX_ASCII_CHECK_POINTS) { continue; }
-    const std::string bytes = od::encode_pcd(cloud, encoding);
-    auto again = od::read_pcd_buffer(bytes, "fuzz-again");
-    if (!again || !same_cloud(cloud, *again, encoding != od::PcdEncoding::ASCII)) { __builtin_trap(); }
+  namespace ofmt = orthoflow::formats;
+  for (const auto encoding : {ofmt::PcdEncoding::BINARY_COMPRESSED, ofmt::PcdEncoding::BINARY, ofmt::PcdEncoding::ASCII}) {
+    if (encoding == ofmt::PcdEncoding::ASCII && cloud.size() > MAX_ASCII_CHECK_POINTS) { continue; }
+    const std::string bytes = ofmt::encode_pcd(cloud, encoding);
+    auto again = ofmt::read_pcd_buffer(bytes, "fuzz-again");
+    if (!again || !same_cloud(cloud, *again, encoding != ofmt::PcdEncoding::ASCII)) { __builtin_trap(); }
   }
 }
 

@@ -50,7 +50,7 @@ TEST(FrameBlock, TextTruncatesAndTerminates) {
   t.assign("mug");
   EXPECT_EQ(t.view(), "mug");
   t.assign(std::string(200, 'x'));
-  EXPECT_EQ(t.view().size(), LABEL_CHARS - 1);
+  EXPECT_EQ(t.view().size(), core::TEXT_MAX_BYTES);
 }
 
 }  // namespace

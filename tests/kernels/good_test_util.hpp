@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "drivers/pcd_io.hpp"
+#include "formats/pcd_io.hpp"
 #include "kernels/good.hpp"
 
 namespace good_test {
@@ -26,7 +26,7 @@ struct Cloud {
 };
 
 inline Cloud load(const fs::path& path) {
-  auto cloud_result = orthoflow::drivers::read_pcd(path);
+  auto cloud_result = orthoflow::formats::read_pcd(path);
   if (!cloud_result) {
     ADD_FAILURE() << cloud_result.error().to_string();
     return {};

@@ -8,7 +8,7 @@
 #include <limits>
 #include <vector>
 
-#include "kernels/rng.hpp"
+#include "core/rng.hpp"
 
 namespace ok = orthoflow::kernels;
 
@@ -20,7 +20,7 @@ struct Cloud {
 };
 
 /// Approximately standard normal (Irwin-Hall: 12 uniforms minus 6), portable.
-double normal(ok::Rng& rng) {
+double normal(orthoflow::core::Rng& rng) {
   double sum = 0.0;
   for (int i = 0; i < 12; ++i) { sum += static_cast<double>(rng.next() >> 11) * 0x1.0p-53; }
   return sum - 6.0;
@@ -28,7 +28,7 @@ double normal(ok::Rng& rng) {
 
 /// An anisotropic blob: standard deviations 0.3, 0.1, 0.02 along x, y, z, centred at @p c, some NaN.
 Cloud blob(std::size_t n, double c, std::uint64_t seed) {
-  ok::Rng rng(seed);
+  orthoflow::core::Rng rng(seed);
   Cloud out;
   for (std::size_t i = 0; i < n; ++i) {
     const bool nan = i % 11 == 5;

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "bench/vs_pcl/pcl_chain.hpp"
-#include "drivers/pcd_io.hpp"
+#include "formats/pcd_io.hpp"
 #include "kernels/euclidean_cluster.hpp"
 #include "kernels/ransac_plane.hpp"
 #include "kernels/segmentation_chain.hpp"
@@ -24,7 +24,7 @@ namespace {
 class PclAgreement : public ::testing::TestWithParam<const char*> {
  protected:
   void SetUp() override {
-    auto r = orthoflow::drivers::read_pcd(std::string(ORTHOFLOW_SHARED_DIR) + "/data/scenes/" + GetParam());
+    auto r = orthoflow::formats::read_pcd(std::string(ORTHOFLOW_SHARED_DIR) + "/data/scenes/" + GetParam());
     ASSERT_TRUE(r) << r.error().to_string();
     cloud_ = std::move(*r);
     pcl_ = ob::run_pcl_chain(ob::to_pcl(cloud_));

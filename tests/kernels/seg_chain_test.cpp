@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "drivers/pcd_io.hpp"
+#include "formats/pcd_io.hpp"
 #include "kernels/segmentation_chain.hpp"
 #include "seg_quality.hpp"
 
@@ -47,7 +47,7 @@ class SegChainFrames : public ::testing::TestWithParam<Frame> {};
 
 TEST_P(SegChainFrames, FindsTableAndObjects) {
   const Frame f = GetParam();
-  auto cloud_result = orthoflow::drivers::read_pcd(std::string(ORTHOFLOW_SHARED_DIR) + "/data/scenes/" + f.name);
+  auto cloud_result = orthoflow::formats::read_pcd(std::string(ORTHOFLOW_SHARED_DIR) + "/data/scenes/" + f.name);
   ASSERT_TRUE(cloud_result) << cloud_result.error().to_string();
   const ok::PointCloud& cloud = *cloud_result;
   ok::SegmentationChain chain(cloud.size(), ok::SegmentationParams{});
@@ -83,7 +83,7 @@ TEST_P(SegChainFrames, FindsTableAndObjects) {
 TEST(SegChain, OrganizedStrideZeroRunsTheVoxelGrid) {
   // organized_stride = 0 puts the voxel grid (leaf) back in front of RANSAC on organized input; both
   // plane inputs give the same table within the tolerance and the same objects on test31.
-  auto cloud_result = orthoflow::drivers::read_pcd(std::string(ORTHOFLOW_SHARED_DIR) + "/data/scenes/test31.pcd");
+  auto cloud_result = orthoflow::formats::read_pcd(std::string(ORTHOFLOW_SHARED_DIR) + "/data/scenes/test31.pcd");
   ASSERT_TRUE(cloud_result) << cloud_result.error().to_string();
   const ok::PointCloud& cloud = *cloud_result;
   ok::SegmentationParams voxel_params;

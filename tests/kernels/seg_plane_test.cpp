@@ -8,7 +8,7 @@
 
 #include "kernels/polygonal_prism.hpp"
 #include "kernels/ransac_plane.hpp"
-#include "kernels/rng.hpp"
+#include "core/rng.hpp"
 
 namespace ok = orthoflow::kernels;
 
@@ -22,12 +22,12 @@ struct Cloud {
 
 TEST(SegRng, GoldenSequenceIsPortable) {
   // xoshiro256** seeded by splitmix64(0): first outputs computed independently (Python big integers).
-  ok::Rng rng(0);
+  orthoflow::core::Rng rng(0);
   EXPECT_EQ(rng.next(), 0x99EC5F36CB75F2B4ULL);
   EXPECT_EQ(rng.next(), 0xBF6E1F784956452AULL);
-  ok::Rng a(42), b(42);
+  orthoflow::core::Rng a(42), b(42);
   for (int i = 0; i < 1000; ++i) {
-    const std::uint32_t v = a.below(7);
+    const std::uint64_t v = a.below(7);
     EXPECT_LT(v, 7U);
     EXPECT_EQ(v, b.below(7));
   }

@@ -1,0 +1,20 @@
+#pragma once
+/// @file
+/// @brief Whole-file reading and atomic whole-file writing with IoError reporting.
+#include <filesystem>
+#include <string_view>
+#include <vector>
+
+#include "formats/io_error.hpp"
+#include "core/result.hpp"
+
+namespace orthoflow::formats {
+
+/// @brief Reads the whole file. Errors name the path and the reason (errno text).
+[[nodiscard]] Result<std::vector<char>, IoError> read_file_bytes(const std::filesystem::path& path);
+
+/// @brief Writes @p bytes to a temporary file beside @p path, then renames it over @p path,
+/// so that readers never see a half-written file.
+[[nodiscard]] Result<void, IoError> write_file_atomically(const std::filesystem::path& path, std::string_view bytes);
+
+}  // namespace orthoflow::formats
