@@ -16,6 +16,7 @@
 #include "apps/commands.hpp"
 #include "apps/json_numbers.hpp"
 #include "formats/pcd_io.hpp"
+#include "kernels/descriptor_spec.hpp"
 #include "kernels/good.hpp"
 
 namespace orthoflow::apps {
@@ -160,12 +161,15 @@ bool write_png(const std::string& path, const Described& d, std::size_t n) {
 void run_describe(const DescribeOptions& o) {
   auto cloud_result = formats::read_pcd(o.file);
   if (!cloud_result) { fail(cloud_result.error().to_string(), EXIT_BAD_INPUT); }
-  const kernels::GoodConfig cfg{o.bins, o.mode == "reference" ? kernels::GoodMode::REFERENCE : kernels::GoodMode::INVARIANT,
-                                o.threshold};
+  // This command shows GOOD's own details (projections, order, entropies), so it calls compute_good
+  // directly; the length still comes from the one specification.
+  kernels::DescriptorSpec spec = kernels::DescriptorSpec::make_good(
+      o.bins, o.mode == "reference" ? kernels::GoodMode::REFERENCE : kernels::GoodMode::INVARIANT);
+  spec.good.threshold = o.threshold;
   kernels::GoodScratch scratch(std::max<std::size_t>(o.bins, 1));
   Described d;
-  d.descriptor.assign(3 * o.bins * o.bins, 0.0F);
-  auto good_result = kernels::compute_good(cloud_result->points(), cfg, scratch, d.descriptor);
+  d.descriptor.assign(spec.length(), 0.0F);
+  auto good_result = kernels::compute_good(cloud_result->points(), spec.good, scratch, d.descriptor);
   if (!good_result) {
     const bool bad_input = good_result.error() == kernels::GoodError::EMPTY_CLOUD ||
                            good_result.error() == kernels::GoodError::NO_FINITE_POINTS;

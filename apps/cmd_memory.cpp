@@ -12,7 +12,7 @@
 
 #include "apps/commands.hpp"
 #include "formats/pcd_io.hpp"
-#include "kernels/good.hpp"
+#include "kernels/descriptor_spec.hpp"
 #include "learning/calibration.hpp"
 #include "learning/perceptual_memory.hpp"
 
@@ -38,8 +38,8 @@ struct MemoryOptions {
 
 learning::MemoryConfig config_of(const MemoryOptions& o) {
   learning::MemoryConfig cfg;
-  cfg.descriptor.bins = o.bins;
-  cfg.descriptor.mode = o.mode == "reference" ? kernels::GoodMode::REFERENCE : kernels::GoodMode::INVARIANT;
+  cfg.descriptor = kernels::DescriptorSpec::make_good(
+      o.bins, o.mode == "reference" ? kernels::GoodMode::REFERENCE : kernels::GoodMode::INVARIANT);
   cfg.learner = o.learner == "bayes" ? learning::LearnerKind::BAYES : learning::LearnerKind::INSTANCE;
   if (o.ct) { cfg.instance.classification_threshold = *o.ct; }
   return cfg;
@@ -55,17 +55,17 @@ learning::PerceptualMemory open_memory(const MemoryOptions& o) {
   return std::move(memory_result).value();
 }
 
-// The GOOD descriptor of one object PCD as a view record (object frame and bbox from compute_good).
-learning::ViewRecord view_of(const std::string& file, const kernels::GoodConfig& good) {
+// The descriptor of one object PCD under the store's specification, as a view record (object frame and bbox).
+learning::ViewRecord view_of(const std::string& file, const kernels::DescriptorSpec& spec) {
   auto cloud_result = formats::read_pcd(file);
   if (!cloud_result) { fail(cloud_result.error().to_string(), EXIT_BAD_INPUT); }
-  kernels::GoodScratch scratch(good.bins);
+  kernels::Describer describer(spec);
   learning::ViewRecord v;
-  v.descriptor.assign(3 * good.bins * good.bins, 0.0F);
-  auto good_result = kernels::compute_good(cloud_result->points(), good, scratch, v.descriptor);
-  if (!good_result) { fail(file + ": " + kernels::to_string(good_result.error()), EXIT_BAD_INPUT); }
-  v.frame = good_result->frame;
-  v.bbox = good_result->bbox;
+  v.descriptor.assign(spec.length(), 0.0F);
+  auto described = describer.describe(cloud_result->points(), v.descriptor);
+  if (!described) { fail(file + ": " + kernels::to_string(described.error()), EXIT_BAD_INPUT); }
+  v.frame = described->frame;
+  v.bbox = described->bbox;
   v.stamp_ns = cloud_result->info.sensor_stamp_ns;
   return v;
 }

@@ -11,6 +11,7 @@
 #include "apps/scene_snapshot_png.hpp"
 #include "engine/engine.hpp"
 #include "engine/graph.hpp"
+#include "graphs/descriptor_params.hpp"
 #include "graphs/embedded_graphs.hpp"
 #include "graphs/tabletop.hpp"
 
@@ -80,16 +81,10 @@ void override_rate(engine::GraphSpec& spec, const std::string& rate) {
 
 graphs::LearningSettings learning_settings(const engine::GraphSpec& spec, const RunOptions& o) {
   graphs::LearningSettings settings;
-  // The learner must read descriptors of the describe node's shape.
-  for (const auto& node : spec.nodes) {
-    if (node.kind != "describe") continue;
-    auto bins = node.params.integer("bins", 15, 1, graphs::MAX_GOOD_BINS);
-    auto mode = node.params.choice("mode", "invariant", {"invariant", "reference"});
-    if (bins && mode) {
-      settings.memory.descriptor.bins = static_cast<std::size_t>(*bins);
-      settings.memory.descriptor.mode = *mode == "invariant" ? kernels::GoodMode::INVARIANT : kernels::GoodMode::REFERENCE;
-    }
-  }
+  // The learner reads descriptors of the describe node's specification (and a store must have it too).
+  auto descriptor = graphs::descriptor_of_graph(spec);
+  if (!descriptor) fail(descriptor.error(), EXIT_BAD_INPUT);
+  settings.memory.descriptor = *descriptor;
   settings.memory.learner = o.learner == "bayes" ? learning::LearnerKind::BAYES : learning::LearnerKind::INSTANCE;
   settings.memory.instance.classification_threshold = o.ct;
   settings.memory.instance.normalise = o.approach != "nn";

@@ -47,7 +47,7 @@ void finite_points(const kernels::PointCloud& cloud, kernels::PointCloud& out) {
 }
 
 /// Reads, perturbs and describes one view; returns an error sentence, empty on success.
-std::string describe_one(const Dataset& ds, std::size_t v, const DescriptorSpec& spec, kernels::GoodScratch& scratch,
+std::string describe_one(const Dataset& ds, std::size_t v, const ViewDescription& spec, kernels::Describer& describer,
                          std::span<float> out) {
   const std::filesystem::path path = ds.root / ds.views[v].relative;
   auto cloud = formats::read_pcd(path);
@@ -56,18 +56,15 @@ std::string describe_one(const Dataset& ds, std::size_t v, const DescriptorSpec&
   if (!perturb_view(*cloud, spec, ds.views[v].relative, view)) {
     return path.string() + ": the voxel grid refused leaf " + std::to_string(spec.amount_m) + " m";
   }
-  kernels::GoodConfig cfg;
-  cfg.bins = spec.bins;
-  cfg.mode = spec.mode;
-  auto good = kernels::compute_good(view.points(), cfg, scratch, out);
-  if (!good) { return path.string() + ": " + kernels::to_string(good.error()); }
+  auto described = describer.describe(view.points(), out);
+  if (!described) { return path.string() + ": " + kernels::to_string(described.error()); }
   return {};
 }
 
-Result<void, EvalError> check_spec(const DescriptorSpec& spec) {
-  if (spec.bins == 0 || spec.bins > kernels::GOOD_MAX_BINS) {
+Result<void, EvalError> check_spec(const ViewDescription& spec) {
+  if (spec.descriptor.good.bins == 0 || spec.descriptor.good.bins > kernels::GOOD_MAX_BINS) {
     return err(EvalError{EvalError::Code::BAD_CONFIG, "bins must be in 1.." + std::to_string(kernels::GOOD_MAX_BINS) +
-                                                          ", got " + std::to_string(spec.bins)});
+                                                          ", got " + std::to_string(spec.descriptor.good.bins)});
   }
   if (!std::isfinite(spec.amount_m) || spec.amount_m < 0.0 ||
       (spec.perturbation == Perturbation::DOWNSAMPLE && spec.amount_m <= 0.0)) {
@@ -76,7 +73,7 @@ Result<void, EvalError> check_spec(const DescriptorSpec& spec) {
   return {};
 }
 
-std::filesystem::path cache_path(const Dataset& ds, const DescriptorSpec& spec, const std::filesystem::path& dir) {
+std::filesystem::path cache_path(const Dataset& ds, const ViewDescription& spec, const std::filesystem::path& dir) {
   std::error_code ec;
   const std::filesystem::path canonical = std::filesystem::weakly_canonical(ds.root, ec);
   char hash[17];
@@ -109,15 +106,18 @@ std::vector<std::uint8_t> fill_from_cache(const Dataset& ds, const DescriptorCac
 
 }  // namespace
 
-std::string DescriptorSpec::key() const {
-  std::string k = std::string("good-") + (mode == kernels::GoodMode::INVARIANT ? "invariant" : "reference") + "-" +
-                  std::to_string(bins) + "-" + perturbation_name(perturbation);
+std::string ViewDescription::key() const {
+  // "good-invariant-15-none": the same key as before the specification existed, so caches stay valid.
+  const kernels::GoodConfig& good = descriptor.good;
+  std::string k = std::string(kernels::to_string(descriptor.kind)) + "-" +
+                  (good.mode == kernels::GoodMode::INVARIANT ? "invariant" : "reference") + "-" +
+                  std::to_string(good.bins) + "-" + perturbation_name(perturbation);
   if (perturbation != Perturbation::NONE) { k += "-" + std::to_string(std::llround(amount_m * 1e6)) + "um"; }
   if (perturbation == Perturbation::NOISE) { k += "-s" + std::to_string(seed); }
   return k;
 }
 
-bool perturb_view(const kernels::PointCloud& cloud, const DescriptorSpec& spec, std::string_view view_key,
+bool perturb_view(const kernels::PointCloud& cloud, const ViewDescription& spec, std::string_view view_key,
                   kernels::PointCloud& out) {
   finite_points(cloud, out);
   if (spec.perturbation == Perturbation::NOISE && spec.amount_m > 0.0) {
@@ -139,7 +139,7 @@ bool perturb_view(const kernels::PointCloud& cloud, const DescriptorSpec& spec, 
   return true;
 }
 
-Result<DescriptorTable, EvalError> describe_dataset(const Dataset& dataset, const DescriptorSpec& spec,
+Result<DescriptorTable, EvalError> describe_dataset(const Dataset& dataset, const ViewDescription& spec,
                                                     const std::filesystem::path& cache_dir, Progress* progress,
                                                     DescribeStats* stats, std::vector<std::string>* warnings) {
   if (auto ok = check_spec(spec); !ok) { return err(ok.error()); }
@@ -151,10 +151,10 @@ Result<DescriptorTable, EvalError> describe_dataset(const Dataset& dataset, cons
   const std::vector<std::uint8_t> hit = fill_from_cache(dataset, cache, stamps, table);
   std::vector<std::string> errors(n);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 8), [&](const tbb::blocked_range<std::size_t>& r) {
-    kernels::GoodScratch scratch(spec.bins);
+    kernels::Describer describer(spec.descriptor);
     for (std::size_t v = r.begin(); v != r.end(); ++v) {
       if (hit[v] == 0) {
-        errors[v] = describe_one(dataset, v, spec, scratch, std::span<float>(table.values).subspan(v * table.length, table.length));
+        errors[v] = describe_one(dataset, v, spec, describer, std::span<float>(table.values).subspan(v * table.length, table.length));
       }
       if (progress != nullptr) { progress->advance(); }
     }

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "evaluation/dataset.hpp"
-#include "kernels/good.hpp"
+#include "kernels/descriptor_spec.hpp"
 #include "kernels/point_cloud.hpp"
 
 namespace orthoflow::evaluation {
@@ -23,16 +23,16 @@ enum class Perturbation : std::uint8_t {
   DOWNSAMPLE,  ///< voxel-grid centroids with leaf `amount_m` (kernels::voxel_grid)
 };
 
-/// @brief The parameters a descriptor depends on (the cache key with the file's identity).
-struct DescriptorSpec {
-  std::size_t bins = 15;
-  kernels::GoodMode mode = kernels::GoodMode::INVARIANT;
+/// @brief How a dataset view is described: the descriptor specification and what is done to the view
+/// first (with the file's identity, the cache key).
+struct ViewDescription {
+  kernels::DescriptorSpec descriptor{};  ///< the representation (kind, parameters, length)
   Perturbation perturbation = Perturbation::NONE;
   double amount_m = 0.0;    ///< noise sigma or voxel leaf, metres (ignored for NONE)
   std::uint64_t seed = 0;   ///< noise draws (with the view's relative path); ignored otherwise
   /// @brief A file-name-safe key, e.g. "good-invariant-15-noise-5000um-s7".
   [[nodiscard]] std::string key() const;
-  [[nodiscard]] std::size_t length() const noexcept { return 3 * bins * bins; }
+  [[nodiscard]] std::size_t length() const noexcept { return descriptor.length(); }
 };
 
 /// @brief One descriptor per dataset view, row-major (row v = view v).
@@ -54,7 +54,7 @@ struct DescribeStats {
 /// @brief Applies @p spec's perturbation to the finite points of @p cloud, into @p out (x, y, z only).
 /// Noise draws come from a generator seeded by (spec.seed, @p view_key), so a view gets the same noise in
 /// every run, on every thread count and machine. @return false when the voxel grid refuses the leaf.
-[[nodiscard]] bool perturb_view(const kernels::PointCloud& cloud, const DescriptorSpec& spec, std::string_view view_key,
+[[nodiscard]] bool perturb_view(const kernels::PointCloud& cloud, const ViewDescription& spec, std::string_view view_key,
                                 kernels::PointCloud& out);
 
 /// @brief Describes every view of @p dataset under @p spec, in parallel (oneTBB; each view independent, so
@@ -63,7 +63,7 @@ struct DescribeStats {
 /// Errors: BAD_VIEW naming the first failing file (unreadable PCD, no finite point, ...), BAD_CONFIG for
 /// bins outside 1..GOOD_MAX_BINS or a negative or non-finite amount. A cache that cannot be read is
 /// ignored (recomputed); one that cannot be written is reported on @p warnings and otherwise ignored.
-[[nodiscard]] Result<DescriptorTable, EvalError> describe_dataset(const Dataset& dataset, const DescriptorSpec& spec,
+[[nodiscard]] Result<DescriptorTable, EvalError> describe_dataset(const Dataset& dataset, const ViewDescription& spec,
                                                                   const std::filesystem::path& cache_dir,
                                                                   Progress* progress, DescribeStats* stats,
                                                                   std::vector<std::string>* warnings);

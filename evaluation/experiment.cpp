@@ -47,7 +47,7 @@ Result<void, EvalError> check(const Dataset& ds, const EvalOptions& o) {
 class Tables {
  public:
   Tables(const Dataset& ds, const EvalOptions& o, Progress* p, Evaluation& e) : ds_(ds), o_(o), p_(p), e_(e) {}
-  Result<const DescriptorTable*, EvalError> get(const DescriptorSpec& spec) {
+  Result<const DescriptorTable*, EvalError> get(const ViewDescription& spec) {
     const std::string key = spec.key();
     if (const auto it = tables_.find(key); it != tables_.end()) { return &it->second; }
     DescribeStats stats;

@@ -15,12 +15,12 @@ std::string Variant::name() const {
   return n + std::to_string(bins);
 }
 
-DescriptorSpec Variant::descriptor(Perturbation p, double amount_m, std::uint64_t seed) const {
-  return DescriptorSpec{bins, mode, p, amount_m, seed};
+ViewDescription Variant::descriptor(Perturbation p, double amount_m, std::uint64_t seed) const {
+  return ViewDescription{kernels::DescriptorSpec::make_good(bins, mode), p, amount_m, seed};
 }
 
 std::unique_ptr<learning::Learner> Variant::make_learner() const {
-  const std::size_t length = 3 * bins * bins;
+  const std::size_t length = kernels::DescriptorSpec::make_good(bins, mode).length();
   if (learner == LearnerKind::BAYES) {
     learning::BayesConfig cfg;
     cfg.descriptor_length = length;

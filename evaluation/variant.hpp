@@ -26,7 +26,7 @@ struct Variant {
   /// @brief "instance-nn/invariant/15", "bayes/reference/5", ...
   [[nodiscard]] std::string name() const;
   /// @brief The descriptor parameters of this variant with perturbation @p p of @p amount_m.
-  [[nodiscard]] DescriptorSpec descriptor(Perturbation p = Perturbation::NONE, double amount_m = 0.0,
+  [[nodiscard]] ViewDescription descriptor(Perturbation p = Perturbation::NONE, double amount_m = 0.0,
                                           std::uint64_t seed = 0) const;
   /// @brief A fresh, empty learner.
   [[nodiscard]] std::unique_ptr<learning::Learner> make_learner() const;

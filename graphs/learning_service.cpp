@@ -30,8 +30,9 @@ learning::MemoryConfig live_session_memory_config() noexcept {
 Result<std::unique_ptr<LearningService>, std::string> LearningService::open(const LearningSettings& settings) {
   std::unique_ptr<LearningService> s(new LearningService());
   learning::MemoryConfig cfg = settings.memory;
-  s->length_ = 3 * cfg.descriptor.bins * cfg.descriptor.bins;
-  if (s->length_ > MAX_DESCRIPTOR) return err(std::string("learning: more GOOD bins than the graph has room for"));
+  if (auto valid = cfg.descriptor.validate(); !valid) return err("learning: " + valid.error());
+  s->length_ = cfg.descriptor.length();
+  if (s->length_ > MAX_DESCRIPTOR) return err("learning: " + cfg.descriptor.describe() + " does not fit the frame block");
   if (settings.db) {
     auto memory = learning::PerceptualMemory::open(*settings.db, cfg);
     if (!memory) return err("learning: " + memory.error().to_string());

@@ -4,7 +4,8 @@
 
 #include "graphs/node_support.hpp"
 #include "graphs/tracker.hpp"
-#include "kernels/good.hpp"
+#include "graphs/descriptor_params.hpp"
+#include "kernels/descriptor_spec.hpp"
 
 namespace orthoflow::graphs {
 
@@ -62,27 +63,26 @@ class Track final : public engine::Node {
 
 class Describe final : public engine::Node {
  public:
-  Describe(std::size_t capacity, const kernels::GoodConfig& config, std::size_t slots)
-      : capacity_(capacity), config_(config), scratch_(slots * MAX_OBJECTS, kernels::GoodScratch(config.bins)) {}
+  Describe(std::size_t capacity, const kernels::DescriptorSpec& spec, std::size_t slots)
+      : capacity_(capacity), describers_(slots * MAX_OBJECTS, kernels::Describer(spec)) {}
   std::span<const engine::PortSpec> inputs() const noexcept override { return {DESCRIBE_PORTS, 1}; }
   std::span<const engine::PortSpec> outputs() const noexcept override { return {DESCRIBE_PORTS + 1, 1}; }
   bool stateful() const noexcept override { return false; }
 
-  // Runs concurrently for different objects: each (slot, object) has its own scratch and its own
+  // Runs concurrently for different objects: each (slot, object) has its own describer and its own
   // record and descriptor region in the block, so no two calls touch the same memory.
   void process(const Message& in, Emitter& out) noexcept override {
     if (in.object_count > 0 && in.object_index < MAX_OBJECTS) {
       const FrameBlock block = block_of(in, capacity_);
       ObjectRecord& o = block.state().objects[in.object_index];
-      kernels::GoodScratch& scratch = scratch_[in.slot * MAX_OBJECTS + in.object_index];
-      auto good = kernels::compute_good(block.object_view(in.object_index), config_, scratch,
-                                        block.descriptor(in.object_index));
-      o.described = good.has_value();
-      if (good) {
-        o.descriptor_length = static_cast<std::uint32_t>(good->length);
-        o.frame = good->frame;
-        o.bbox = good->bbox;
-        o.good_flags = good->flags;
+      kernels::Describer& describer = describers_[in.slot * MAX_OBJECTS + in.object_index];
+      auto described = describer.describe(block.object_view(in.object_index), block.descriptor(in.object_index));
+      o.described = described.has_value();
+      if (described) {
+        o.descriptor_length = static_cast<std::uint32_t>(described->length);
+        o.frame = described->frame;
+        o.bbox = described->bbox;
+        o.good_flags = described->flags;
       }
     }
     out.emit(0, in);
@@ -90,8 +90,7 @@ class Describe final : public engine::Node {
 
  private:
   std::size_t capacity_;
-  kernels::GoodConfig config_;
-  std::vector<kernels::GoodScratch> scratch_;
+  std::vector<kernels::Describer> describers_;
 };
 
 NodeResult make_track(const ParamMap& params, const engine::NodeContext& context) {
@@ -115,18 +114,9 @@ NodeResult make_track(const ParamMap& params, const engine::NodeContext& context
 NodeResult make_describe(const ParamMap& params, const engine::NodeContext& context) {
   auto capacity = frame_capacity(context);
   if (!capacity) return err(capacity.error());
-  if (auto ok = params.only({"bins", "mode", "threshold"}); !ok) return err(ok.error());
-  kernels::GoodConfig config;  // thesis: 15 bins; invariant frame by default (docs/GOOD.md)
-  std::string e, mode = "invariant";
-  take(params.integer("bins", 15, 1, MAX_GOOD_BINS), config.bins, e);
-  take(params.choice("mode", "invariant", {"invariant", "reference"}), mode, e);
-  if (params.has("threshold")) {
-    float t = 0.0F;
-    if (take(params.number("threshold", 0.0, 0.0, 1.0), t, e)) config.threshold = t;
-  }
-  if (!e.empty()) return err(e);
-  config.mode = mode == "invariant" ? kernels::GoodMode::INVARIANT : kernels::GoodMode::REFERENCE;
-  return std::unique_ptr<engine::Node>(new Describe(*capacity, config, context.max_in_flight));
+  auto spec = parse_describe_params(params);
+  if (!spec) return err(spec.error());
+  return std::unique_ptr<engine::Node>(new Describe(*capacity, *spec, context.max_in_flight));
 }
 
 }  // namespace
@@ -134,7 +124,8 @@ NodeResult make_describe(const ParamMap& params, const engine::NodeContext& cont
 void add_track_describe_nodes(engine::NodeRegistry& registry) {
   registry.add("track", "tracks objects by box overlap, splits the frame into objects: min_share, box_margin (m), "
                "lost_timeout_s, moving_speed (m/s), static_frames", make_track);
-  registry.add("describe", "per object, in parallel: GOOD descriptor and object frame: bins, mode, threshold",
+  registry.add("describe",
+               "per object, in parallel: descriptor and object frame: descriptor (good), bins, mode, threshold",
                make_describe);
 }
 

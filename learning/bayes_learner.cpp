@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "learning/detail/category_writer.hpp"
 #include "learning/detail/learner_common.hpp"
 #include "learning/snapshot_cell.hpp"
 
@@ -81,25 +82,14 @@ BayesLearner::~BayesLearner() = default;
 Result<CategoryId, LearnError> BayesLearner::teach(std::string_view label, DescriptorBatch views) {
   if (auto r = validate_label(label); !r) { return err(r.error()); }
   if (auto r = validate_batch(views, cfg_.descriptor_length, true); !r) { return err(r.error()); }
-  const std::lock_guard lock(writer_);
-  const BayesSnapshot& cur = cell_->writer_view();
-  std::vector<CategoryPtr> next = cur.categories;
-  CategoryId next_id = cur.next_id;
-  auto it = std::find_if(next.begin(), next.end(), [&](const CategoryPtr& c) { return c->label.view() == label; });
-  const bool fresh = it == next.end();
   // Thesis "Category Initialization and Update": N_k <- N_k + views, a_ki <- a_ki + x'_i.
-  std::vector<double> sums = fresh ? std::vector<double>(cfg_.descriptor_length, 0.0) : (*it)->sums;
-  accumulate_views(views, sums);
-  const CategoryId id = fresh ? next_id++ : (*it)->id;
-  const std::uint64_t seen = (fresh ? 0 : (*it)->seen) + views.count();
-  CategoryPtr updated = make_category(id, Label::from(label), seen, std::move(sums), cfg_.count_scale);
-  if (fresh) {
-    next.push_back(std::move(updated));
-  } else {
-    *it = std::move(updated);
-  }
-  cell_->publish(finish(std::move(next), cur.generation + 1, next_id));
-  return id;
+  auto make = [&](const BayesCategory* existing, CategoryId id) {
+    std::vector<double> sums = existing == nullptr ? std::vector<double>(cfg_.descriptor_length, 0.0) : existing->sums;
+    accumulate_views(views, sums);
+    const std::uint64_t seen = (existing == nullptr ? 0 : existing->seen) + views.count();
+    return make_category(id, Label::from(label), seen, std::move(sums), cfg_.count_scale);
+  };
+  return upsert_category(writer_, *cell_, label, make, finish);
 }
 
 Prediction BayesLearner::ask(std::span<const float> descriptor, AskScratch& scratch) const noexcept {
@@ -120,14 +110,7 @@ Prediction BayesLearner::ask(std::span<const float> descriptor, AskScratch& scra
 }
 
 Result<void, LearnError> BayesLearner::forget(std::string_view label) {
-  const std::lock_guard lock(writer_);
-  const BayesSnapshot& cur = cell_->writer_view();
-  std::vector<CategoryPtr> next = cur.categories;
-  const auto it = std::find_if(next.begin(), next.end(), [&](const CategoryPtr& c) { return c->label.view() == label; });
-  if (it == next.end()) { return err(LearnError::UNKNOWN_LABEL); }
-  next.erase(it);
-  cell_->publish(finish(std::move(next), cur.generation + 1, cur.next_id));
-  return {};
+  return erase_category(writer_, *cell_, label, finish);
 }
 
 Result<void, LearnError> BayesLearner::restore(std::span<const RestoredCategory> categories, CategoryId next_id) {
@@ -145,9 +128,7 @@ Result<void, LearnError> BayesLearner::restore(std::span<const RestoredCategory>
                                  cfg_.count_scale));
     next_id = std::max(next_id, rc.id + 1);
   }
-  std::sort(next.begin(), next.end(), [](const CategoryPtr& a, const CategoryPtr& b) { return a->id < b->id; });
-  const std::lock_guard lock(writer_);
-  cell_->publish(finish(std::move(next), cell_->writer_view().generation + 1, next_id));
+  replace_categories(writer_, *cell_, std::move(next), next_id, finish);
   return {};
 }
 

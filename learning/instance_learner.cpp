@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "kernels/distance.hpp"
+#include "learning/detail/category_writer.hpp"
 #include "learning/detail/learner_common.hpp"
 #include "learning/snapshot_cell.hpp"
 
@@ -98,6 +99,13 @@ std::unique_ptr<InstanceSnapshot> finish(std::vector<CategoryPtr> categories, st
   return s;
 }
 
+// finish() with this learner's configuration, in the form the shared writer (category_writer.hpp) calls.
+auto finisher(const InstanceConfig& cfg) {
+  return [&cfg](std::vector<CategoryPtr> categories, std::uint64_t generation, CategoryId next_id) {
+    return finish(std::move(categories), generation, next_id, cfg);
+  };
+}
+
 // Min (approach I) or mean (approach II) of the L2 distances from @p query to the views of @p c, walked
 // in chunks of the scratch size (thesis eq. OCD, approaches I and II). NaN distances propagate.
 float ocd(std::span<const float> query, const InstanceCategory& c, bool mean, std::span<float> buffer) noexcept {
@@ -135,24 +143,13 @@ InstanceLearner::~InstanceLearner() = default;
 Result<CategoryId, LearnError> InstanceLearner::teach(std::string_view label, DescriptorBatch views) {
   if (auto r = validate_label(label); !r) { return err(r.error()); }
   if (auto r = validate_batch(views, cfg_.descriptor_length, false); !r) { return err(r.error()); }
-  const std::lock_guard lock(writer_);
-  const InstanceSnapshot& cur = cell_->writer_view();
-  std::vector<CategoryPtr> next = cur.categories;
-  CategoryId next_id = cur.next_id;
-  auto it = std::find_if(next.begin(), next.end(), [&](const CategoryPtr& c) { return c->label.view() == label; });
-  InstanceCategory fresh;
-  if (it == next.end()) {
-    fresh.id = next_id++;
+  auto make = [&](const InstanceCategory* existing, CategoryId id) {
+    InstanceCategory fresh;
+    fresh.id = id;
     fresh.label = Label::from(label);
-  }
-  const CategoryPtr grown = extend(it == next.end() ? fresh : **it, views, cfg_.descriptor_length);
-  if (it == next.end()) {
-    next.push_back(grown);
-  } else {
-    *it = grown;
-  }
-  cell_->publish(finish(std::move(next), cur.generation + 1, next_id, cfg_));
-  return grown->id;
+    return extend(existing == nullptr ? fresh : *existing, views, cfg_.descriptor_length);
+  };
+  return upsert_category(writer_, *cell_, label, make, finisher(cfg_));
 }
 
 Prediction InstanceLearner::ask(std::span<const float> descriptor, AskScratch& scratch) const noexcept {
@@ -176,14 +173,7 @@ Prediction InstanceLearner::ask(std::span<const float> descriptor, AskScratch& s
 }
 
 Result<void, LearnError> InstanceLearner::forget(std::string_view label) {
-  const std::lock_guard lock(writer_);
-  const InstanceSnapshot& cur = cell_->writer_view();
-  std::vector<CategoryPtr> next = cur.categories;
-  const auto it = std::find_if(next.begin(), next.end(), [&](const CategoryPtr& c) { return c->label.view() == label; });
-  if (it == next.end()) { return err(LearnError::UNKNOWN_LABEL); }
-  next.erase(it);
-  cell_->publish(finish(std::move(next), cur.generation + 1, cur.next_id, cfg_));
-  return {};
+  return erase_category(writer_, *cell_, label, finisher(cfg_));
 }
 
 Result<void, LearnError> InstanceLearner::restore(std::span<const RestoredCategory> categories, CategoryId next_id) {
@@ -199,9 +189,7 @@ Result<void, LearnError> InstanceLearner::restore(std::span<const RestoredCatego
     next.push_back(extend(base, rc.views, cfg_.descriptor_length));
     next_id = std::max(next_id, rc.id + 1);
   }
-  std::sort(next.begin(), next.end(), [](const CategoryPtr& a, const CategoryPtr& b) { return a->id < b->id; });
-  const std::lock_guard lock(writer_);
-  cell_->publish(finish(std::move(next), cell_->writer_view().generation + 1, next_id, cfg_));
+  replace_categories(writer_, *cell_, std::move(next), next_id, finisher(cfg_));
   return {};
 }
 

@@ -84,38 +84,34 @@ std::optional<CategoryId> key_category(std::string_view key) noexcept {
   return id;
 }
 
-std::string StoreParams::describe() const {
-  std::ostringstream s;
-  s << "bins=" << bins << " mode=" << (mode == kernels::GoodMode::INVARIANT ? "invariant" : "reference")
-    << " threshold=" << threshold;
-  return s.str();
-}
-
-StoreParams params_of(const kernels::GoodConfig& cfg) noexcept {
-  return StoreParams{cfg.bins, cfg.mode, cfg.effective_threshold()};
-}
-
-std::string encode_schema(const StoreParams& p) {
+std::string encode_schema(const kernels::DescriptorSpec& spec) {
   const nlohmann::json j{{"schema", MEMORY_SCHEMA_VERSION},
-                         {"bins", p.bins},
-                         {"mode", p.mode == kernels::GoodMode::INVARIANT ? "invariant" : "reference"},
-                         {"threshold", p.threshold}};
+                         {"descriptor", std::string(kernels::to_string(spec.kind))},
+                         {"bins", spec.good.bins},
+                         {"mode", spec.good.mode == kernels::GoodMode::INVARIANT ? "invariant" : "reference"},
+                         {"threshold", spec.good.effective_threshold()}};
   return j.dump();
 }
 
-std::optional<StoreParams> decode_schema(std::string_view json, std::uint32_t& version, std::string& why) {
+std::optional<kernels::DescriptorSpec> decode_schema(std::string_view json, std::uint32_t& version, std::string& why) {
   const nlohmann::json j = nlohmann::json::parse(json, nullptr, false);
   if (j.is_discarded() || !j.is_object()) {
     why = "not a JSON object";
     return std::nullopt;
   }
   const auto schema = j.find("schema");
+  const auto kind = j.find("descriptor");
   const auto bins = j.find("bins");
   const auto mode = j.find("mode");
   const auto threshold = j.find("threshold");
   if (schema == j.end() || !schema->is_number_unsigned() || bins == j.end() || !bins->is_number_unsigned() ||
-      mode == j.end() || !mode->is_string() || threshold == j.end() || !threshold->is_number()) {
-    why = "needs unsigned \"schema\" and \"bins\", string \"mode\", number \"threshold\"";
+      mode == j.end() || !mode->is_string() || threshold == j.end() || !threshold->is_number() ||
+      (kind != j.end() && !kind->is_string())) {
+    why = "needs unsigned \"schema\" and \"bins\", string \"mode\", number \"threshold\" (and a string \"descriptor\")";
+    return std::nullopt;
+  }
+  if (kind != j.end() && kind->get<std::string>() != kernels::to_string(kernels::DescriptorKind::GOOD)) {
+    why = "descriptor \"" + kind->get<std::string>() + "\" is not one this build knows (good)";
     return std::nullopt;
   }
   const std::string m = mode->get<std::string>();
@@ -124,8 +120,10 @@ std::optional<StoreParams> decode_schema(std::string_view json, std::uint32_t& v
     return std::nullopt;
   }
   version = schema->get<std::uint32_t>();
-  return StoreParams{bins->get<std::size_t>(), m == "invariant" ? kernels::GoodMode::INVARIANT : kernels::GoodMode::REFERENCE,
-                     threshold->get<float>()};
+  auto spec = kernels::DescriptorSpec::make_good(
+      bins->get<std::size_t>(), m == "invariant" ? kernels::GoodMode::INVARIANT : kernels::GoodMode::REFERENCE);
+  spec.good.threshold = threshold->get<float>();
+  return spec;
 }
 
 std::string encode_category(const CategoryRecord& c) {
@@ -159,16 +157,18 @@ std::optional<ModelRecord> decode_model(std::string_view bytes) {
   return m;
 }
 
-std::string encode_view(const ViewRecord& v, const StoreParams& p) {
+std::string encode_view(const ViewRecord& v, const kernels::DescriptorSpec& spec) {
   Writer w;
-  w.put(VIEW_MAGIC).put(static_cast<std::uint32_t>(p.bins)).put(static_cast<std::uint8_t>(p.mode)).put(p.threshold);
+  w.put(VIEW_MAGIC).put(static_cast<std::uint32_t>(spec.good.bins)).put(static_cast<std::uint8_t>(spec.good.mode));
+  w.put(spec.good.effective_threshold());
   w.put_all(std::span<const float>(v.frame)).put_all(std::span<const float>(v.bbox));
   w.put(v.track_id).put(v.stamp_ns).put(static_cast<std::uint32_t>(v.descriptor.size()));
   w.put_all(std::span<const float>(v.descriptor));
   return w.take();
 }
 
-std::optional<ViewRecord> decode_view(std::string_view bytes, const StoreParams& expected, std::string& why) {
+std::optional<ViewRecord> decode_view(std::string_view bytes, const kernels::DescriptorSpec& expected,
+                                      std::string& why) {
   Reader r(bytes);
   std::uint32_t magic = 0, bins = 0, n = 0;
   std::uint8_t mode = 0;
@@ -183,8 +183,9 @@ std::optional<ViewRecord> decode_view(std::string_view bytes, const StoreParams&
     why = "view record truncated in its header";
     return std::nullopt;
   }
-  const StoreParams got{bins, static_cast<kernels::GoodMode>(mode), threshold};
-  if (!(got == expected) || n != 3 * expected.bins * expected.bins || r.left() != n * sizeof(float)) {
+  auto got = kernels::DescriptorSpec::make_good(bins, mode == 0 ? kernels::GoodMode::INVARIANT : kernels::GoodMode::REFERENCE);
+  got.good.threshold = threshold;
+  if (mode > 1 || !(got == expected) || n != expected.length() || r.left() != n * sizeof(float)) {
     why = "view record has " + got.describe() + " and " + std::to_string(n) + " values, store has " +
           expected.describe();
     return std::nullopt;

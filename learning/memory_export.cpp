@@ -75,7 +75,7 @@ Result<std::size_t, MemoryError> PerceptualMemory::export_to(const std::filesyst
   const State& s = *state_;
   std::ofstream out(file, std::ios::binary | std::ios::trunc);
   if (!out) { return err(memory_error(Code::FILE_FAILED, file, "cannot open for writing")); }
-  json header = json::parse(encode_schema(s.params));
+  json header = json::parse(encode_schema(s.cfg.descriptor));
   header["format"] = "orthoflow-memory";
   header["categories"] = s.index.size();
   header["views"] = stats().views;
@@ -101,11 +101,11 @@ Result<std::size_t, MemoryError> PerceptualMemory::import_from(const std::filesy
   std::uint32_t version = 0;
   std::string why;
   const auto params = std::getline(in, line) ? decode_schema(line, version, why) : std::nullopt;
-  if (!params || version != MEMORY_SCHEMA_VERSION || !(*params == state_->params)) {
+  if (!params || version != MEMORY_SCHEMA_VERSION || !(*params == state_->cfg.descriptor)) {
     const std::string reason = !params ? (why.empty() ? "empty file" : why)
                                : version != MEMORY_SCHEMA_VERSION ? "schema version " + std::to_string(version)
                                                                   : "file has " + params->describe() + ", store has " +
-                                                                        state_->params.describe();
+                                                                        state_->cfg.descriptor.describe();
     return err(memory_error(Code::BAD_IMPORT, file, "line 1: " + reason));
   }
   // Everything is parsed and checked before the first teach, so a bad line imports nothing.

@@ -53,7 +53,7 @@ Result<CategoryId, MemoryError> PerceptualMemory::teach(std::string_view label, 
   IndexedCategory next = existing != nullptr ? *existing : IndexedCategory{s.next_id, {0, 0, std::string(label)}, {0, {}}};
   if (next.model.sums.empty()) { next.model.sums.assign(length, 0.0); }
   leveldb::WriteBatch batch;
-  for (const ViewRecord& v : views) { batch.Put(view_key(next.id, next.record.next_seq++), encode_view(v, s.params)); }
+  for (const ViewRecord& v : views) { batch.Put(view_key(next.id, next.record.next_seq++), encode_view(v, s.cfg.descriptor)); }
   next.record.views += static_cast<std::uint32_t>(views.size());
   // Thesis Bayes update a_k <- a_k + x' in the same batch as the views, so model and views never disagree.
   const DescriptorBatch batch_views{*flat_result, length};

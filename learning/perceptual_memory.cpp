@@ -12,7 +12,7 @@ namespace {
 using Code = MemoryError::Code;
 
 std::unique_ptr<Learner> make_learner(MemoryConfig& cfg) {
-  const std::size_t length = 3 * cfg.descriptor.bins * cfg.descriptor.bins;
+  const std::size_t length = cfg.descriptor.length();
   cfg.instance.descriptor_length = length;
   cfg.bayes.descriptor_length = length;
   if (cfg.learner == LearnerKind::BAYES) { return std::make_unique<BayesLearner>(cfg.bayes); }
@@ -27,7 +27,7 @@ Result<void, MemoryError> check_schema(PerceptualMemory::State& s) {
     leveldb::WriteOptions sync;
     sync.sync = true;
     leveldb::WriteBatch batch;
-    batch.Put(std::string(KEY_SCHEMA), encode_schema(s.params));
+    batch.Put(std::string(KEY_SCHEMA), encode_schema(s.cfg.descriptor));
     batch.Put(std::string(KEY_NEXT_ID), encode_u32(0));
     if (!s.db->Write(sync, &batch).ok()) { return err(memory_error(Code::WRITE_FAILED, s.dir, "cannot write the schema key")); }
     return {};
@@ -39,9 +39,9 @@ Result<void, MemoryError> check_schema(PerceptualMemory::State& s) {
   if (!stored || version != MEMORY_SCHEMA_VERSION) {
     return err(memory_error(Code::CORRUPT, s.dir, "schema key: " + (stored ? "version " + std::to_string(version) : why)));
   }
-  if (!(*stored == s.params)) {
+  if (!(*stored == s.cfg.descriptor)) {
     return err(memory_error(Code::PARAMS_MISMATCH, s.dir,
-                            "store was created with " + stored->describe() + ", opened with " + s.params.describe()));
+                            "store was created with " + stored->describe() + ", opened with " + s.cfg.descriptor.describe()));
   }
   return {};
 }
@@ -116,7 +116,7 @@ Result<std::vector<ViewRecord>, MemoryError> PerceptualMemory::State::read_views
   std::unique_ptr<leveldb::Iterator> it(s.db->NewIterator(leveldb::ReadOptions()));
   for (it->Seek(prefix); it->Valid() && it->key().starts_with(prefix); it->Next()) {
     std::string why;
-    auto view = decode_view(as_view(it->value()), s.params, why);
+    auto view = decode_view(as_view(it->value()), s.cfg.descriptor, why);
     if (!view) {
       return err(memory_error(Code::CORRUPT, s.dir, "category " + std::to_string(id) + " view " +
                                                         std::to_string(out.size()) + ": " + why));
@@ -128,13 +128,10 @@ Result<std::vector<ViewRecord>, MemoryError> PerceptualMemory::State::read_views
 }
 
 Result<PerceptualMemory, MemoryError> PerceptualMemory::open(const std::filesystem::path& dir, const MemoryConfig& cfg) {
-  if (cfg.descriptor.bins == 0 || cfg.descriptor.bins > kernels::GOOD_MAX_BINS) {
-    return err(memory_error(Code::OPEN_FAILED, dir, "bins must be 1.." + std::to_string(kernels::GOOD_MAX_BINS)));
-  }
+  if (auto valid = cfg.descriptor.validate(); !valid) return err(memory_error(Code::OPEN_FAILED, dir, valid.error()));
   auto s = std::make_unique<State>();
   s->dir = dir;
   s->cfg = cfg;
-  s->params = params_of(cfg.descriptor);
   s->learner = make_learner(s->cfg);
   std::error_code ignored;  // LevelDB creates only the last path component; a failure shows up in Open below
   std::filesystem::create_directories(dir, ignored);

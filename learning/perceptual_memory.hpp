@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "kernels/good.hpp"
+#include "kernels/descriptor_spec.hpp"
 #include "learning/bayes_learner.hpp"
 #include "learning/instance_learner.hpp"
 
@@ -29,15 +29,15 @@ enum class LearnerKind : std::uint8_t { INSTANCE, BAYES };
 
 /// @brief Plain configuration of a memory.
 struct MemoryConfig {
-  kernels::GoodConfig descriptor;  ///< representation; must match the store's (bins, mode, threshold)
+  kernels::DescriptorSpec descriptor;  ///< representation; must match the store's (kind and parameters)
   LearnerKind learner = LearnerKind::INSTANCE;
-  InstanceConfig instance;  ///< descriptor_length is overwritten with 3 n^2
-  BayesConfig bayes;        ///< descriptor_length is overwritten with 3 n^2
+  InstanceConfig instance;  ///< descriptor_length is overwritten with descriptor.length()
+  BayesConfig bayes;        ///< descriptor_length is overwritten with descriptor.length()
 };
 
 /// @brief One object view as stored: descriptor plus where and when it was seen.
 struct ViewRecord {
-  std::vector<float> descriptor;     ///< 3 n^2 GOOD values
+  std::vector<float> descriptor;     ///< MemoryConfig::descriptor.length() values
   std::array<float, 16> frame{};     ///< world -> object transform, row-major (GoodResult::frame)
   std::array<float, 3> bbox{};       ///< object-frame box edges (GoodResult::bbox)
   std::uint64_t track_id = 0;        ///< source track (0 = none)

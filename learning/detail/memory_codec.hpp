@@ -2,7 +2,7 @@
 /// @file
 /// @brief LevelDB keys and binary values of the perceptual memory (schema 1, docs/LEARNING.md).
 /// Keys sort by kind, then category id (big-endian), then view sequence (big-endian):
-///   "s"                     schema JSON {"schema":1,"bins":n,"mode":"invariant","threshold":t}
+///   "s"                     schema JSON {"schema":1,"descriptor":"good","bins":n,"mode":"invariant","threshold":t}
 ///   "n"                     next category id (u32)
 ///   "c" id                  category: u64 next view sequence, u32 live views, label bytes
 ///   "m" id                  Bayes model: u64 N_k, u32 length, length x f64 sums of descriptors
@@ -14,7 +14,7 @@
 #include <string_view>
 #include <vector>
 
-#include "kernels/good.hpp"
+#include "kernels/descriptor_spec.hpp"
 #include "learning/perceptual_memory.hpp"
 
 namespace orthoflow::learning {
@@ -32,21 +32,13 @@ inline constexpr char KIND_VIEW = 'v';
 /// @brief The id in a "c"/"m"/"v" key; nullopt when the key is too short.
 [[nodiscard]] std::optional<CategoryId> key_category(std::string_view key) noexcept;
 
-/// @brief The representation parameters a store was created with.
-struct StoreParams {
-  std::size_t bins = 0;
-  kernels::GoodMode mode = kernels::GoodMode::INVARIANT;
-  float threshold = 0.0F;
-  [[nodiscard]] bool operator==(const StoreParams&) const noexcept = default;
-  /// @brief "bins=15 mode=invariant threshold=0.015".
-  [[nodiscard]] std::string describe() const;
-};
-/// @brief The parameters of @p cfg (threshold = effective threshold).
-[[nodiscard]] StoreParams params_of(const kernels::GoodConfig& cfg) noexcept;
-/// @brief The schema JSON of @p p.
-[[nodiscard]] std::string encode_schema(const StoreParams& p);
-/// @brief Parses a schema JSON (also the export header); nullopt with @p why set when malformed.
-[[nodiscard]] std::optional<StoreParams> decode_schema(std::string_view json, std::uint32_t& version, std::string& why);
+/// @brief The schema JSON of a store written with @p spec: {"schema":1,"descriptor":"good","bins":n,
+/// "mode":...,"threshold":t}.
+[[nodiscard]] std::string encode_schema(const kernels::DescriptorSpec& spec);
+/// @brief Parses a schema JSON (also the export header); nullopt with @p why set when malformed. A header
+/// without "descriptor" (written before the descriptor specification existed) is a GOOD store.
+[[nodiscard]] std::optional<kernels::DescriptorSpec> decode_schema(std::string_view json, std::uint32_t& version,
+                                                                   std::string& why);
 
 /// @brief The category record of the memory's index.
 struct CategoryRecord {
@@ -67,9 +59,10 @@ struct ModelRecord {
 
 /// @brief u32 magic "OFV1", u32 bins, u8 mode, f32 threshold, 16 f32 frame, 3 f32 bbox, u64 track id,
 /// i64 stamp ns, u32 n, n f32 descriptor.
-[[nodiscard]] std::string encode_view(const ViewRecord& v, const StoreParams& p);
+[[nodiscard]] std::string encode_view(const ViewRecord& v, const kernels::DescriptorSpec& spec);
 /// @brief Decodes a view; nullopt with @p why set when the size, magic or parameters are wrong.
-[[nodiscard]] std::optional<ViewRecord> decode_view(std::string_view bytes, const StoreParams& expected, std::string& why);
+[[nodiscard]] std::optional<ViewRecord> decode_view(std::string_view bytes, const kernels::DescriptorSpec& expected,
+                                                    std::string& why);
 
 /// @brief u32 little-endian.
 [[nodiscard]] std::string encode_u32(std::uint32_t v);

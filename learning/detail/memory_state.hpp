@@ -24,7 +24,6 @@ struct IndexedCategory {
 struct PerceptualMemory::State {
   std::filesystem::path dir;
   MemoryConfig cfg;
-  StoreParams params;
   std::unique_ptr<leveldb::DB> db;
   std::unique_ptr<Learner> learner;
   std::vector<IndexedCategory> index;  // by id

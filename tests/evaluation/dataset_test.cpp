@@ -70,14 +70,14 @@ TEST(Descriptors, BadViewIsNamedAndBadSpecRefused) {
   touch(root / "box1" / "inst0" / "view9.pcd", "not a pcd");
   auto ds = scan_dataset(root);
   ASSERT_TRUE(ds);
-  auto t = describe_dataset(*ds, DescriptorSpec{}, {}, nullptr, nullptr, nullptr);
+  auto t = describe_dataset(*ds, ViewDescription{}, {}, nullptr, nullptr, nullptr);
   ASSERT_FALSE(t);
   EXPECT_EQ(t.error().code, EvalError::Code::BAD_VIEW);
   EXPECT_NE(t.error().message.find("view9.pcd"), std::string::npos) << t.error().message;
-  DescriptorSpec zero_bins;
-  zero_bins.bins = 0;
+  ViewDescription zero_bins;
+  zero_bins.descriptor.good.bins = 0;
   EXPECT_EQ(describe_dataset(*ds, zero_bins, {}, nullptr, nullptr, nullptr).error().code, EvalError::Code::BAD_CONFIG);
-  DescriptorSpec nan_noise;
+  ViewDescription nan_noise;
   nan_noise.perturbation = Perturbation::NOISE;
   nan_noise.amount_m = std::nan("");
   EXPECT_EQ(describe_dataset(*ds, nan_noise, {}, nullptr, nullptr, nullptr).error().code, EvalError::Code::BAD_CONFIG);
@@ -91,8 +91,8 @@ TEST(Descriptors, CacheIsReusedAndInvalidatedByAChangedFile) {
   auto ds = scan_dataset(root);
   ASSERT_TRUE(ds);
   DescribeStats first, second, third, fourth;
-  DescriptorSpec spec;
-  spec.bins = 5;
+  ViewDescription spec;
+  spec.descriptor.good.bins = 5;
   auto a = describe_dataset(*ds, spec, cache, nullptr, &first, nullptr);
   auto b = describe_dataset(*ds, spec, cache, nullptr, &second, nullptr);
   ASSERT_TRUE(a && b);
@@ -119,7 +119,7 @@ TEST(Descriptors, CacheIsReusedAndInvalidatedByAChangedFile) {
 
 TEST(Descriptors, PerturbationsAreDeterministicAndDoWhatTheySay) {
   const kernels::PointCloud cloud = testing::box_view(2, 0, 0);
-  DescriptorSpec noise;
+  ViewDescription noise;
   noise.perturbation = Perturbation::NOISE;
   noise.amount_m = 0.005;
   noise.seed = 3;
@@ -133,7 +133,7 @@ TEST(Descriptors, PerturbationsAreDeterministicAndDoWhatTheySay) {
   double sq = 0.0;
   for (std::size_t i = 0; i < cloud.size(); ++i) { sq += (n1.x()[i] - cloud.x()[i]) * (n1.x()[i] - cloud.x()[i]); }
   EXPECT_NEAR(std::sqrt(sq / static_cast<double>(cloud.size())), 0.005, 0.001);
-  DescriptorSpec voxel;
+  ViewDescription voxel;
   voxel.perturbation = Perturbation::DOWNSAMPLE;
   voxel.amount_m = 0.02;
   kernels::PointCloud v;

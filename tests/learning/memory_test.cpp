@@ -77,17 +77,17 @@ TEST(PerceptualMemory, OtherDescriptorParametersAreRejected) {
   const auto dir = fresh_dir();
   { auto m = must_open(dir, small_config()); teach_three(m); }
   MemoryConfig other = small_config();
-  other.descriptor.bins = 6;
+  other.descriptor.good.bins = 6;
   auto bins_result = PerceptualMemory::open(dir, other);
   ASSERT_FALSE(bins_result);
   EXPECT_EQ(bins_result.error().code, Code::PARAMS_MISMATCH);
   EXPECT_NE(bins_result.error().message.find("bins=5"), std::string::npos) << bins_result.error().message;
   EXPECT_NE(bins_result.error().message.find("bins=6"), std::string::npos);
   other = small_config();
-  other.descriptor.mode = kernels::GoodMode::REFERENCE;
+  other.descriptor.good.mode = kernels::GoodMode::REFERENCE;
   EXPECT_EQ(PerceptualMemory::open(dir, other).error().code, Code::PARAMS_MISMATCH);
   other = small_config();
-  other.descriptor.threshold = 0.02F;
+  other.descriptor.good.threshold = 0.02F;
   EXPECT_EQ(PerceptualMemory::open(dir, other).error().code, Code::PARAMS_MISMATCH);
   EXPECT_EQ(must_open(dir, small_config()).stats().views, 5U);  // untouched
 }
@@ -217,7 +217,7 @@ TEST(PerceptualMemory, FailedSyncedWriteIsNotAcknowledged) {
 
 TEST(PerceptualMemory, BadBinsIsAnOpenFailure) {
   MemoryConfig cfg = small_config();
-  cfg.descriptor.bins = 0;
+  cfg.descriptor.good.bins = 0;
   EXPECT_EQ(PerceptualMemory::open(fresh_dir(), cfg).error().code, Code::OPEN_FAILED);
 }
 

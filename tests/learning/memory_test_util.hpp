@@ -23,7 +23,7 @@ inline std::filesystem::path fresh_dir(const std::string& tag = "") {
 /// Memory configuration with small descriptors (bins 5: 75 values).
 inline MemoryConfig small_config(LearnerKind kind = LearnerKind::INSTANCE) {
   MemoryConfig cfg;
-  cfg.descriptor.bins = 5;
+  cfg.descriptor.good.bins = 5;
   cfg.learner = kind;
   return cfg;
 }
