@@ -71,6 +71,8 @@ class SpscRing {
     const std::size_t first = n < capacity_ - start ? n : capacity_ - start;
     return {std::span<const T>(&slots_[start], first), std::span<const T>(&slots_[0], n - first)};
   }
+  /// @brief Consumer: drops everything queued (with no producer pushing at the same time).
+  void clear() noexcept { tail_.store(head_.load(std::memory_order_acquire), std::memory_order_release); }
   /// @brief Consumer: frees the @p n oldest elements. @pre n <= size().
   void release(std::size_t n) noexcept {
     tail_.store(tail_.load(std::memory_order_relaxed) + n, std::memory_order_release);

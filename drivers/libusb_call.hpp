@@ -4,8 +4,8 @@
 /// after iceoryx's IOX_POSIX_CALL): bounded retries on LIBUSB_ERROR_INTERRUPTED, then the native code is
 /// mapped to a UsbError. Also the mappings from libusb's codes and the transfer-length check.
 /// Deliberately free of libusb.h, so the mappings are tested as plain functions over ints; the values
-/// they map are libusb's documented, ABI-stable codes, and libusb_transport.cpp static_asserts the one
-/// constant this header names against libusb.h.
+/// they map are libusb's documented, ABI-stable codes; libusb_call.cpp defines them over libusb.h's own
+/// constants and static_asserts the one constant this header names.
 #include <cstddef>
 #include <string_view>
 #include <type_traits>
@@ -33,21 +33,29 @@ inline constexpr int LIBUSB_CALL_MAX_ATTEMPTS = 8;
 /// @brief Calls @p call (a libusb call returning an int or ssize_t status) until it returns anything
 /// but LIBUSB_ERROR_INTERRUPTED, at most LIBUSB_CALL_MAX_ATTEMPTS times.
 /// @pre @p operation is a string literal naming the libusb function. @p call is safe to repeat after an
-/// interruption (libusb reports INTERRUPTED before any data moved: its synchronous transfers restart
-/// interrupted event waits themselves).
+/// interruption: libusb's synchronous transfers restart interrupted event waits themselves, so an
+/// INTERRUPTED reaching us comes from a call that moved no data (a poll, an open, a submission).
 /// @return the value (>= 0) on success, else the mapped UsbError with native = the libusb code.
 /// @note Never allocates; thread-safety is that of @p call.
 template <class Call>
-[[nodiscard]] auto libusb_call(std::string_view operation, Call&& call) -> Result<std::invoke_result_t<Call&>, UsbError> {
+[[nodiscard]] auto libusb_call(std::string_view operation, Call&& call)
+    -> Result<std::invoke_result_t<Call&>, UsbError> {
   using Value = std::invoke_result_t<Call&>;
   static_assert(std::is_integral_v<Value> && std::is_signed_v<Value>, "libusb_call wraps calls returning a status");
   Value status = Value{LIBUSB_INTERRUPTED_NATIVE};
-  for (int attempt = 0; attempt < LIBUSB_CALL_MAX_ATTEMPTS && status == Value{LIBUSB_INTERRUPTED_NATIVE}; ++attempt) {
+  for (int attempt = 0; attempt < LIBUSB_CALL_MAX_ATTEMPTS && status == Value{LIBUSB_INTERRUPTED_NATIVE};
+       ++attempt) {
     status = call();
   }
   if (status >= 0) return status;
   const int native = static_cast<int>(status);
   return orthoflow::err(UsbError{usb_error_code_from_libusb(native), native, operation});
+}
+
+/// @brief An error the transport raises itself, before calling libusb (native 0).
+/// @pre @p operation is a string literal. @note Pure, never allocates.
+[[nodiscard]] constexpr UsbError refused(UsbError::Code code, std::string_view operation) noexcept {
+  return UsbError{code, 0, operation};
 }
 
 /// @brief The outcome of a synchronous bulk or interrupt transfer: libusb's @p status and the bytes it

@@ -1,9 +1,11 @@
 #pragma once
 /// @file
-/// @brief LibusbTransport: UsbTransport over libusb-1.0, for real devices. libusb.h is included by its .cpp
-/// only (STYLE rule 16); this header merely names the context type. Every libusb call goes through
-/// libusb_call() (libusb_call.hpp). Isochronous streams use libusb's asynchronous transfers, resubmitted
-/// from their completion callback and driven by handle_events(); nothing busy-polls.
+/// @brief LibusbTransport: UsbTransport over libusb-1.0, for real devices (STYLE rule 16).
+/// libusb.h is included only by its implementation files: libusb_transport.cpp (open devices, synchronous
+/// transfers, the event pump), libusb_discovery.cpp (enumeration), libusb_iso.cpp (isochronous streams)
+/// and libusb_call.cpp (code mapping); this header only declares two libusb types. Every libusb call goes
+/// through libusb_call() (libusb_call.hpp). Isochronous streams use libusb's asynchronous transfers,
+/// resubmitted from their completion callback and driven by handle_events(); nothing busy-polls.
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -15,11 +17,23 @@
 #include "drivers/usb_transport.hpp"
 
 struct libusb_context;
+struct libusb_device_handle;
 
 namespace orthoflow::drivers {
 
 struct LibusbOpenDevice;  // defined in libusb_transport.cpp
-struct LibusbIsoStream;   // defined in libusb_transport.cpp
+struct LibusbIsoStream;   // defined in libusb_iso.cpp
+
+/// @brief (internal) Deletes a LibusbOpenDevice; defined beside the type so other files need not see it.
+/// @pre The device's handle is already closed. @note Thread safety: that of LibusbTransport.
+struct LibusbOpenDeviceDeleter {
+  void operator()(LibusbOpenDevice* device) const noexcept;
+};
+/// @brief (internal) Deletes a LibusbIsoStream and frees its transfers; defined beside the type.
+/// @pre None of its transfers is in flight. @note Thread safety: that of LibusbTransport.
+struct LibusbIsoStreamDeleter {
+  void operator()(LibusbIsoStream* stream) const noexcept;
+};
 
 /// @brief The libusb transport: one libusb context, the devices opened through it and their streams.
 /// @note Not thread-safe (UsbTransport's rule): one thread at a time. Movable by its unique_ptr only.
@@ -36,7 +50,8 @@ class LibusbTransport final : public UsbTransport {
 
   /// @brief Stops every stream, closes every device still open, then exits the libusb context.
   /// @pre No UsbDeviceHandle of this transport is still alive (OF_ASSERT): they would close a dead
-  /// transport. Transfers that never came back from cancellation are leaked, never freed.
+  /// transport. Transfers that never came back from cancellation are leaked (with the context), never
+  /// freed.
   ~LibusbTransport() override;
 
   /// @copydoc UsbTransport::enumerate
@@ -92,25 +107,37 @@ class LibusbTransport final : public UsbTransport {
   [[nodiscard]] const MonotonicClock& clock() const noexcept override { return *clock_; }
 
  private:
+  using OpenDevicePtr = std::unique_ptr<LibusbOpenDevice, LibusbOpenDeviceDeleter>;
+  using IsoStreamPtr = std::unique_ptr<LibusbIsoStream, LibusbIsoStreamDeleter>;
+
   LibusbTransport(libusb_context* context, const MonotonicClock* clock) noexcept;
   void close_device(std::uint32_t id) noexcept override;
+  // Defined in libusb_transport.cpp.
   [[nodiscard]] LibusbOpenDevice* find_device(const UsbDeviceHandle& handle) const noexcept;
-  [[nodiscard]] LibusbIsoStream* find_stream(std::uint32_t device_id, std::uint8_t endpoint) const noexcept;
+  [[nodiscard]] libusb_device_handle* native_handle(const UsbDeviceHandle& handle) const noexcept;
   [[nodiscard]] Result<std::size_t, UsbError> sync_transfer(const UsbDeviceHandle& handle, std::uint8_t endpoint,
                                                             std::span<std::byte> data, UsbTimeout timeout,
                                                             bool is_bulk);
-  [[nodiscard]] Result<void, UsbError> stop_stream(LibusbIsoStream& stream) noexcept;
-  void drain(LibusbIsoStream& stream) noexcept;
+  [[nodiscard]] Result<void, UsbError> pump(UsbTimeout timeout, int* completed) noexcept;
   void check_not_in_callback() const noexcept;
+  // Defined in libusb_discovery.cpp.
+  [[nodiscard]] Result<libusb_device_handle*, UsbError> open_native(const UsbDeviceInfo& wanted);
+  // Defined in libusb_iso.cpp, beside the stream type.
+  [[nodiscard]] LibusbIsoStream* find_stream(std::uint32_t device_id, std::uint8_t endpoint) const noexcept;
+  [[nodiscard]] Result<void, UsbError> stop_stream(LibusbIsoStream& stream);
+  void stop_streams_of(std::uint32_t device_id) noexcept;
+  void drain(LibusbIsoStream& stream) noexcept;
+  void collect_abandoned_streams() noexcept;
+  [[nodiscard]] bool release_all_streams() noexcept;
 
   libusb_context* context_ = nullptr;
   SteadyClock steady_clock_;
   const MonotonicClock* clock_ = nullptr;
-  std::vector<std::unique_ptr<LibusbOpenDevice>> devices_;
-  std::vector<std::unique_ptr<LibusbIsoStream>> streams_;
-  std::vector<std::unique_ptr<LibusbIsoStream>> abandoned_streams_;  ///< cancelled, never came back
+  std::vector<OpenDevicePtr> devices_;
+  std::vector<IsoStreamPtr> streams_;
+  std::vector<IsoStreamPtr> abandoned_streams_;  ///< cancelled but not yet back
   std::uint32_t next_id_ = 1;
-  bool in_callback_ = false;  ///< true while an iso callback runs: re-entry is a bug (UsbTransport file comment)
+  bool in_callback_ = false;  ///< true while an iso callback runs: re-entry is a bug (see usb_transport.hpp)
 };
 
 }  // namespace orthoflow::drivers

@@ -4,7 +4,7 @@
 /// USB_TESTING.md 3.1). No libusb type appears here, so protocol code compiles and is tested without it.
 ///
 /// Implementations:
-/// - LibusbTransport (libusb_transport.hpp): real hardware. Its .cpp is the only file including libusb.h.
+/// - LibusbTransport (libusb_transport.hpp): real hardware. Its libusb_*.cpp files alone include libusb.h.
 /// - Planned: FakeTransport (scripted replies), SimTransport (hosts device simulators that implement the
 ///   documented protocols on simulated time, USB_TESTING.md 3.3), RecordingTransport and ReplayTransport
 ///   (decorators that log, then replay, every call made at this seam, USB_TESTING.md 3.4).

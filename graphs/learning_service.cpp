@@ -7,17 +7,20 @@
 namespace orthoflow::graphs {
 
 namespace {
-constexpr std::size_t JOB_VIEWS = 8;  // views one durable teach carries at most
+constexpr std::size_t JOBS = 16;  // durable writes in flight at most
 constexpr auto WORKER_POLL = std::chrono::milliseconds(2);
+using Outcome = LearningAck::Outcome;
 }  // namespace
 
-/// A durable teach waiting for the background writer; fixed size so queueing never allocates.
+/// A durable teach or forget waiting for the background writer; fixed size so queueing never allocates.
 struct LearningService::Job {
+  bool forget = false;
   Text label;
   std::uint32_t track_id = 0;
   std::int64_t stamp_ns = 0;
   std::size_t views = 0;
-  std::array<float, JOB_VIEWS * MAX_DESCRIPTOR> values{};
+  LearningAck ack;  // sent after the write (sequence 0: nobody to tell)
+  std::array<float, MAX_TEACH_VIEWS * MAX_DESCRIPTOR> values{};
 };
 
 learning::MemoryConfig live_session_memory_config() noexcept {
@@ -27,23 +30,25 @@ learning::MemoryConfig live_session_memory_config() noexcept {
   return cfg;
 }
 
+LearningService::LearningService() : jobs_(JOBS) {}
+
 Result<std::unique_ptr<LearningService>, std::string> LearningService::open(const LearningSettings& settings) {
   std::unique_ptr<LearningService> s(new LearningService());
   learning::MemoryConfig cfg = settings.memory;
   if (auto valid = cfg.descriptor.validate(); !valid) return err("learning: " + valid.error());
-  s->length_ = cfg.descriptor.length();
-  if (s->length_ > MAX_DESCRIPTOR) return err("learning: " + cfg.descriptor.describe() + " does not fit the frame block");
+  s->spec_ = cfg.descriptor;
+  const std::size_t length = cfg.descriptor.length();
+  if (length > MAX_DESCRIPTOR) return err("learning: " + cfg.descriptor.describe() + " does not fit the frame block");
   if (settings.db) {
     auto memory = learning::PerceptualMemory::open(*settings.db, cfg);
     if (!memory) return err("learning: " + memory.error().to_string());
     s->memory_ = std::make_unique<learning::PerceptualMemory>(std::move(*memory));
-    s->jobs_ = std::make_unique<Job[]>(JOBS);
     s->worker_ = std::thread([raw = s.get()] { raw->worker_loop(); });
   } else if (cfg.learner == learning::LearnerKind::BAYES) {
-    cfg.bayes.descriptor_length = s->length_;
+    cfg.bayes.descriptor_length = length;
     s->learner_ = std::make_unique<learning::BayesLearner>(cfg.bayes);
   } else {
-    cfg.instance.descriptor_length = s->length_;
+    cfg.instance.descriptor_length = length;
     s->learner_ = std::make_unique<learning::InstanceLearner>(cfg.instance);
   }
   return s;
@@ -58,75 +63,99 @@ const learning::Learner& LearningService::learner() const noexcept {
   return memory_ ? memory_->learner() : *learner_;
 }
 
-bool LearningService::teach(std::string_view label, std::span<const float> views, std::uint32_t track_id,
-                            std::int64_t stamp_ns) noexcept {
-  const std::size_t count = views.size() / length_;
-  if (!learning::validate_label(label) || count == 0) {
+LearningAck LearningService::finish(LearningAck ack, bool ok, Outcome failure) noexcept {
+  ack.outcome = ok ? (memory_ ? Outcome::STORED : Outcome::LEARNED) : failure;
+  if (!ok) {
     refused_.fetch_add(1);
-    return false;
+  } else if (ack.kind != LearningCommand::Kind::FORGET) {
+    teaches_.fetch_add(1);
   }
-  if (!memory_) {
-    auto taught = learner_->teach(label, {views.first(count * length_), length_});
-    (taught ? teaches_ : refused_).fetch_add(1);
-    return taught.has_value();
-  }
-  const std::size_t head = job_head_.load(std::memory_order_relaxed);
-  if (head - job_tail_.load(std::memory_order_acquire) == JOBS) {
-    refused_.fetch_add(1);  // the writer is behind: refuse rather than wait
-    return false;
-  }
-  Job& job = jobs_[head % JOBS];
-  job.label.assign(label);
-  job.track_id = track_id;
-  job.stamp_ns = stamp_ns;
-  job.views = std::min(count, JOB_VIEWS);
-  std::copy_n(views.begin(), job.views * length_, job.values.begin());
-  job_head_.store(head + 1, std::memory_order_release);
-  return true;
+  if (ack.sequence != 0) acknowledge(ack);
+  return ack;
 }
 
-// Background writer of durable teaches: the synced LevelDB batch happens here, off the frame path.
+LearningAck LearningService::teach(std::string_view label, std::span<const float> views, std::uint32_t track_id,
+                                   std::int64_t stamp_ns, LearningAck ack) noexcept {
+  const std::size_t length = descriptor_length();
+  const std::size_t count = std::min(views.size() / length, MAX_TEACH_VIEWS);
+  ack.track_id = track_id;
+  ack.views = static_cast<std::uint32_t>(count);
+  ack.label.assign(label);
+  if (!learning::validate_label(label)) return finish(ack, false, Outcome::BAD_LABEL);
+  if (count == 0) return finish(ack, false, Outcome::REJECTED);
+  if (!memory_) {
+    const bool taught = learner_->teach(label, {views.first(count * length), length}).has_value();
+    return finish(ack, taught, Outcome::REJECTED);
+  }
+  Job* job = jobs_.claim();
+  if (job == nullptr) return finish(ack, false, Outcome::BUSY);  // the writer is behind: refuse, never wait
+  job->forget = false;
+  job->label.assign(label);
+  job->track_id = track_id;
+  job->stamp_ns = stamp_ns;
+  job->views = count;
+  job->ack = ack;
+  std::copy_n(views.begin(), count * length, job->values.begin());
+  jobs_.publish();
+  ack.outcome = Outcome::STORED;  // on its way: the writer acknowledges after the synced write
+  return ack;
+}
+
+LearningAck LearningService::forget(std::string_view label, LearningAck ack) noexcept {
+  ack.label.assign(label);
+  if (!memory_) {
+    const bool forgotten = learner_->forget(label).has_value();
+    return finish(ack, forgotten, Outcome::UNKNOWN_LABEL);
+  }
+  Job* job = jobs_.claim();
+  if (job == nullptr) return finish(ack, false, Outcome::BUSY);
+  job->forget = true;
+  job->label.assign(label);
+  job->views = 0;
+  job->ack = ack;
+  jobs_.publish();
+  ack.outcome = Outcome::STORED;
+  return ack;
+}
+
+// One durable write, then its acknowledgement (only now is the lesson on disk and visible to asks).
+void LearningService::run_job(const Job& job) noexcept {
+  LearningAck ack = job.ack;
+  if (job.forget) {
+    auto forgotten = memory_->forget(job.label.view());
+    const bool unknown = !forgotten && forgotten.error().code == learning::MemoryError::Code::UNKNOWN_LABEL;
+    finish(ack, forgotten.has_value(), unknown ? Outcome::UNKNOWN_LABEL : Outcome::WRITE_FAILED);
+    return;
+  }
+  const std::size_t length = descriptor_length();
+  std::vector<learning::ViewRecord> records(job.views);  // the writer thread may allocate
+  for (std::size_t v = 0; v < job.views; ++v) {
+    records[v].descriptor.assign(job.values.begin() + static_cast<std::ptrdiff_t>(v * length),
+                                 job.values.begin() + static_cast<std::ptrdiff_t>((v + 1) * length));
+    records[v].track_id = job.track_id;
+    records[v].stamp_ns = job.stamp_ns;
+  }
+  auto taught = memory_->teach(job.label.view(), records);
+  const bool rejected = !taught && taught.error().code == learning::MemoryError::Code::REJECTED;
+  finish(ack, taught.has_value(), rejected ? Outcome::REJECTED : Outcome::WRITE_FAILED);
+}
+
+// Background writer of durable lessons: the synced LevelDB batch happens here, off the frame path.
 void LearningService::worker_loop() noexcept {
-  std::vector<learning::ViewRecord> records;
   while (true) {
-    const std::size_t tail = job_tail_.load(std::memory_order_relaxed);
-    if (tail == job_head_.load(std::memory_order_acquire)) {
+    const Job* job = jobs_.peek();
+    if (job == nullptr) {
       if (stop_.load()) return;
       std::this_thread::sleep_for(WORKER_POLL);
       continue;
     }
-    const Job& job = jobs_[tail % JOBS];
-    records.assign(job.views, {});
-    for (std::size_t v = 0; v < job.views; ++v) {
-      records[v].descriptor.assign(job.values.begin() + static_cast<std::ptrdiff_t>(v * length_),
-                                   job.values.begin() + static_cast<std::ptrdiff_t>((v + 1) * length_));
-      records[v].track_id = job.track_id;
-      records[v].stamp_ns = job.stamp_ns;
-    }
-    auto taught = memory_->teach(job.label.view(), records);
-    (taught ? teaches_ : refused_).fetch_add(1);
-    job_tail_.store(tail + 1, std::memory_order_release);
+    run_job(*job);
+    jobs_.release(1);
   }
 }
 
 void LearningService::flush() noexcept {
-  while (memory_ && job_tail_.load() != job_head_.load()) std::this_thread::sleep_for(WORKER_POLL);
-}
-
-bool LearningService::post(const LearningEvent& event) noexcept {
-  const std::size_t head = event_head_.load(std::memory_order_relaxed);
-  if (head - event_tail_.load(std::memory_order_acquire) == EVENTS) return false;
-  events_[head % EVENTS] = event;
-  event_head_.store(head + 1, std::memory_order_release);
-  return true;
-}
-
-bool LearningService::poll(LearningEvent& event) noexcept {
-  const std::size_t tail = event_tail_.load(std::memory_order_relaxed);
-  if (tail == event_head_.load(std::memory_order_acquire)) return false;
-  event = events_[tail % EVENTS];
-  event_tail_.store(tail + 1, std::memory_order_release);
-  return true;
+  while (memory_ && jobs_.size() != 0) std::this_thread::sleep_for(WORKER_POLL);
 }
 
 }  // namespace orthoflow::graphs

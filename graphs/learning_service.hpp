@@ -1,41 +1,42 @@
 #pragma once
 /// @file
 /// @brief LearningService: what the tabletop graph asks and teaches. Wraps an in-memory learner or a
-/// durable PerceptualMemory (LevelDB), and carries the learning events that enter the graph from
-/// outside (a person teaching or correcting by track id or by pointing at a position).
+/// durable PerceptualMemory (LevelDB), and carries the learning channel (graphs/learning_channel.hpp):
+/// commands from any number of connected senders in, acknowledgements back to each sender.
 ///
-/// Real time: ask() is lock-free and allocation-free (the learner's snapshot read). A teach from the
-/// frame path is applied inline for an in-memory learner (a snapshot rebuild: it allocates, once per
-/// teach) and handed to a background thread for a durable memory, so the frame path never waits for a
-/// synced disk write; the teach becomes visible to the asks after that write (a few frames later).
+/// Real time: ask() is lock-free and allocation-free (the learner's snapshot read). A teach, correct or
+/// forget from the frame path is applied inline for an in-memory learner (a snapshot rebuild: it
+/// allocates, once per lesson) and handed to a background thread for a durable memory, so the frame path
+/// never waits for a synced disk write; it becomes visible to the asks, and is acknowledged as STORED,
+/// after that write (a few frames later).
 #include <array>
 #include <atomic>
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <span>
 #include <string>
 #include <string_view>
 #include <thread>
 
+#include "core/spin_lock.hpp"
+#include "core/spsc_ring.hpp"
 #include "graphs/frame_block.hpp"
+#include "graphs/learning_channel.hpp"
 #include "learning/perceptual_memory.hpp"
 
 namespace orthoflow::graphs {
-
-/// @brief A learning event from outside the graph.
-struct LearningEvent {
-  enum class Kind : std::uint8_t { TEACH_TRACK, TEACH_AT } kind = Kind::TEACH_TRACK;
-  std::uint32_t track_id = 0;         ///< TEACH_TRACK: the object with this track id
-  std::array<float, 3> position{};    ///< TEACH_AT: the object whose box holds (or is nearest to) it
-  Text label;
-};
 
 /// @brief The live-session default: plain nearest neighbour over GOOD (L2), Unknown beyond this
 /// distance. A category taught from a few views of one still object has an ICD near zero, which makes
 /// the thesis's NOCD explode for every other instance; docs/TABLETOP.md has the measurements.
 inline constexpr float DEFAULT_NN_THRESHOLD = 0.3F;
+/// @brief Senders that can be connected at once.
+inline constexpr std::size_t MAX_LEARNING_CLIENTS = 8;
+/// @brief Views one teach stores at most (a track's key views and its current view).
+inline constexpr std::size_t MAX_TEACH_VIEWS = 8;
 
 /// @brief The in-memory learner settings `orthoflow run` starts from (instance-based, plain NN).
 [[nodiscard]] learning::MemoryConfig live_session_memory_config() noexcept;
@@ -46,8 +47,31 @@ struct LearningSettings {
   std::optional<std::filesystem::path> db;  ///< durable memory directory; none = in memory only
 };
 
-/// @brief Learning for one graph. @note ask() and drain() are for the recognise node (one thread at a
-/// time); post() is for one other thread (single producer); teach() for the recognise node.
+class LearningService;
+
+/// @brief One sender's end of the learning channel. Thread-compatible: one thread uses a client; other
+/// threads use clients of their own. Disconnects when destroyed. @pre destroyed before its service.
+class LearningClient {
+ public:
+  ~LearningClient();
+  LearningClient(const LearningClient&) = delete;
+  LearningClient& operator=(const LearningClient&) = delete;
+  /// @brief Queues @p command; @return its sequence number (acks carry it), or 0 if the queue is full.
+  std::uint64_t send(LearningCommand command) noexcept;
+  /// @brief Takes the next acknowledgement, if any. Lock-free.
+  bool poll(LearningAck& ack) noexcept;
+  [[nodiscard]] std::uint32_t id() const noexcept { return slot_; }
+
+ private:
+  friend class LearningService;
+  LearningClient(LearningService& service, std::uint32_t slot) noexcept : service_(service), slot_(slot) {}
+  LearningService& service_;
+  std::uint32_t slot_;
+  std::uint64_t next_sequence_ = 1;
+};
+
+/// @brief Learning for one graph. @note connect() and LearningClient::send are thread-safe; poll(),
+/// ask(), teach(), correct(), forget() and acknowledge() are for the recognise node (one thread at a time).
 class LearningService {
  public:
   /// @brief Opens the memory (or makes an in-memory learner). Errors name the store and the reason.
@@ -57,34 +81,58 @@ class LearningService {
   LearningService& operator=(const LearningService&) = delete;
 
   [[nodiscard]] const learning::Learner& learner() const noexcept;
-  [[nodiscard]] std::size_t descriptor_length() const noexcept { return length_; }
-  /// @brief Teaches @p views (row-major, descriptor_length() each) under @p label.
-  /// @return false if refused (bad label or view) or the background queue is full (counted).
-  bool teach(std::string_view label, std::span<const float> views, std::uint32_t track_id, std::int64_t stamp_ns) noexcept;
-  /// @brief Queues an outside event; false if the queue is full. Lock-free.
-  bool post(const LearningEvent& event) noexcept;
-  /// @brief Takes the next queued event, if any. Lock-free.
-  bool poll(LearningEvent& event) noexcept;
-  /// @brief Waits until every queued durable teach is written (tests, shutdown).
+  [[nodiscard]] const kernels::DescriptorSpec& descriptor() const noexcept { return spec_; }
+  [[nodiscard]] std::size_t descriptor_length() const noexcept { return spec_.length(); }
+  [[nodiscard]] bool durable() const noexcept { return memory_ != nullptr; }
+
+  /// @brief A new sender, or nullptr when MAX_LEARNING_CLIENTS are connected. Thread-safe.
+  [[nodiscard]] std::unique_ptr<LearningClient> connect();
+  /// @brief Takes the next queued command, if any. Lock-free.
+  bool poll(LearningCommand& command) noexcept;
+  /// @brief Delivers @p ack to its sender (dropped if the sender has gone).
+  void acknowledge(const LearningAck& ack) noexcept;
+
+  /// @brief Stores @p views (row-major, descriptor_length() each, at most MAX_TEACH_VIEWS) under @p label.
+  /// In memory: learned now, @p ack completed (LEARNED or the error) and returned. Durable: queued,
+  /// acknowledged (STORED or WRITE_FAILED) by the writer after the synced write; returns the ack as
+  /// queued (outcome STORED means "on its way") or BUSY / BAD_LABEL / REJECTED when refused at once.
+  /// With @p ack.sequence == 0 (the scripted instructor) nothing is acknowledged.
+  LearningAck teach(std::string_view label, std::span<const float> views, std::uint32_t track_id,
+                    std::int64_t stamp_ns, LearningAck ack) noexcept;
+  /// @brief Forgets @p label; same acknowledgement rules as teach().
+  LearningAck forget(std::string_view label, LearningAck ack) noexcept;
+
+  /// @brief Waits until every queued durable write is done (tests, shutdown).
   void flush() noexcept;
   [[nodiscard]] std::uint64_t teaches() const noexcept { return teaches_.load(); }
   [[nodiscard]] std::uint64_t refused() const noexcept { return refused_.load(); }
+  [[nodiscard]] std::uint64_t commands_dropped() const noexcept { return commands_dropped_.load(); }
+  [[nodiscard]] std::uint64_t acks_dropped() const noexcept { return acks_dropped_.load(); }
 
  private:
+  friend class LearningClient;
   struct Job;
-  LearningService() = default;
+  struct ClientSlot {
+    core::SpinLock lock;  // producers of acks: the recognise node and the durable writer
+    core::SpscRing<LearningAck> acks{64};
+    std::atomic<bool> active{false};
+  };
+  LearningService();
   void worker_loop() noexcept;
+  void run_job(const Job& job) noexcept;
+  std::uint64_t enqueue(LearningCommand command) noexcept;
+  void disconnect(std::uint32_t slot) noexcept;
+  LearningAck finish(LearningAck ack, bool ok, LearningAck::Outcome failure) noexcept;
 
-  std::unique_ptr<learning::Learner> learner_;               // in memory
-  std::unique_ptr<learning::PerceptualMemory> memory_;       // durable
-  std::size_t length_ = 0;
-  static constexpr std::size_t EVENTS = 64, JOBS = 16;
-  std::array<LearningEvent, EVENTS> events_{};
-  std::atomic<std::size_t> event_head_{0}, event_tail_{0};
-  std::unique_ptr<Job[]> jobs_;
-  std::atomic<std::size_t> job_head_{0}, job_tail_{0};
+  std::unique_ptr<learning::Learner> learner_;          // in memory
+  std::unique_ptr<learning::PerceptualMemory> memory_;  // durable
+  kernels::DescriptorSpec spec_{};
+  std::mutex senders_;                           // serialises the command producers
+  core::SpscRing<LearningCommand> commands_{64};
+  std::array<ClientSlot, MAX_LEARNING_CLIENTS> clients_{};
+  core::SpscRing<Job> jobs_;                     // recognise node -> durable writer
   std::atomic<bool> stop_{false};
-  std::atomic<std::uint64_t> teaches_{0}, refused_{0};
+  std::atomic<std::uint64_t> teaches_{0}, refused_{0}, commands_dropped_{0}, acks_dropped_{0};
   std::thread worker_;
 };
 

@@ -1,6 +1,7 @@
 #include "graphs/tabletop.hpp"
 
 #include "engine/ipc_nodes.hpp"
+#include "graphs/objects_output.hpp"
 #include "graphs/recognise_node.hpp"
 #include "graphs/segment_nodes.hpp"
 #include "graphs/source_nodes.hpp"
@@ -8,7 +9,7 @@
 
 namespace orthoflow::graphs {
 
-engine::NodeRegistry make_tabletop_registry(LearningService& learning, SessionLog& log) {
+engine::NodeRegistry make_tabletop_registry(LearningService& learning, SessionLog& log, ObjectsHub* objects) {
   engine::NodeRegistry registry;
   engine::add_generic_nodes(registry);
   engine::add_ipc_nodes(registry);  // ipc_subscribe / ipc_publish: graphs split across processes
@@ -16,6 +17,7 @@ engine::NodeRegistry make_tabletop_registry(LearningService& learning, SessionLo
   add_segment_nodes(registry);
   add_track_describe_nodes(registry);
   add_recognise_node(registry, learning);
+  add_objects_output_node(registry, objects);
   add_session_log_node(registry, log);
   return registry;
 }

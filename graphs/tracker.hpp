@@ -7,7 +7,7 @@
 /// time before matching. Key views (thesis Table 3.1): the first view of a track, and the first view
 /// after a moving object has been static for static_frames frames.
 ///
-/// Limits against the thesis's particle filter (docs/TRACKING.md): no colour or shape likelihood, so
+/// Limits against the thesis's particle filter (docs/TABLETOP.md, "Tracking, and its limits"): no colour or shape likelihood, so
 /// two touching objects that merge into one cluster continue only one track, and a fast object (more
 /// than its own size per frame, beyond what the velocity predicts) starts a new track.
 #include <array>

@@ -27,8 +27,8 @@ TEST(TabletopAllocations, SteadyStateAllocatesNothingPerFrame) {
   // A learner that knows categories, so every ask walks real stored views.
   std::vector<float> views(3 * 675, 0.0F);
   for (std::size_t i = 0; i < views.size(); ++i) views[i] = static_cast<float>(i % 7) / 675.0F;
-  ASSERT_TRUE(learning->teach("thing", std::span<const float>(views).first(2 * 675), 0, 0));
-  ASSERT_TRUE(learning->teach("other", std::span<const float>(views).last(675), 0, 0));
+  ASSERT_TRUE(learning->teach("thing", std::span<const float>(views).first(2 * 675), 0, 0, {}).ok());
+  ASSERT_TRUE(learning->teach("other", std::span<const float>(views).last(675), 0, 0, {}).ok());
   // a JSON sink too: its writer thread writes to /dev/null
   auto json = LineWriter::open("/dev/null");
   ASSERT_TRUE(json);

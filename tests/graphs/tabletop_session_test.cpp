@@ -100,14 +100,23 @@ TEST(TabletopSession, SameOutputWhateverTheThreadCount) {
 
 TEST(TabletopSession, OutsideTeachEventTeachesTheTrackedObject) {
   auto learning = test::in_memory_learning();
-  LearningEvent event;
-  event.kind = LearningEvent::Kind::TEACH_TRACK;
-  event.track_id = 1;  // the first object the tracker sees
-  event.label.assign("my-thing");
-  ASSERT_TRUE(learning->post(event));
+  auto client = learning->connect();
+  ASSERT_TRUE(client);
+  LearningCommand teach;
+  teach.kind = LearningCommand::Kind::TEACH;
+  teach.track_id = 1;  // the first object the tracker sees
+  teach.label.assign("my-thing");
+  const std::uint64_t sequence = client->send(teach);
+  ASSERT_NE(sequence, 0U);
   const auto r = run_graph({{"source", {{"frames", "10"}}}, {"recognise", {{"instructor", "0"}}}}, 2, *learning);
   EXPECT_EQ(r.summary.taught, (std::vector<std::string>{"my-thing"}));
   EXPECT_EQ(learning->teaches(), 1U);
+  LearningAck ack;
+  ASSERT_TRUE(client->poll(ack));
+  EXPECT_EQ(ack.sequence, sequence);
+  EXPECT_EQ(ack.outcome, LearningAck::Outcome::LEARNED);
+  EXPECT_EQ(ack.track_id, 1U);
+  EXPECT_EQ(ack.label.view(), "my-thing");
   int recognised = 0;
   for (const auto& f : r.frames) {
     for (const auto& o : f["objects"]) recognised += o["track"] == 1 && o["label"] == "my-thing" ? 1 : 0;
