@@ -1,5 +1,6 @@
 // `orthoflow run`: the tabletop graph end to end on the embedded synthetic session (or a source
 // given on the command line), with learning, and a summary of what it saw, learned and how fast.
+#include <algorithm>
 #include <atomic>
 #include <csignal>
 #include <cstdio>
@@ -11,6 +12,7 @@
 #include "apps/scene_snapshot_png.hpp"
 #include "engine/engine.hpp"
 #include "engine/graph.hpp"
+#include "engine/object_list_payload.hpp"
 #include "graphs/descriptor_params.hpp"
 #include "graphs/embedded_graphs.hpp"
 #include "graphs/tabletop.hpp"
@@ -37,6 +39,7 @@ struct RunOptions {
   std::string json_out;
   std::string snapshot;
   std::string telemetry_json;
+  bool publish_objects = false;  // every frame's objects to orthoflow/<graph>/objects over iceoryx
   int threads = 0;
 };
 
@@ -73,6 +76,22 @@ void override_source(engine::GraphSpec& spec, const RunOptions& o) {
   if (o.frames > 0 && src->kind == "synthetic_source") src->params.assign("frames", std::to_string(o.frames));
 }
 
+// --publish-objects: an ipc_publish node on the objects_output node's objects port, topic
+// orthoflow/<graph>/objects (the graph then needs a running RouDi, like every IPC graph).
+void add_objects_publisher(engine::GraphSpec& spec) {
+  const auto output = std::find_if(spec.nodes.begin(), spec.nodes.end(),
+                                   [](const engine::NodeSpec& n) { return n.kind == "objects_output"; });
+  if (output == spec.nodes.end()) fail("--publish-objects needs a graph with an objects_output node", EXIT_USAGE);
+  engine::NodeSpec publish;
+  publish.name = "publish_objects";
+  publish.kind = "ipc_publish";
+  publish.params.assign("topic", "orthoflow/" + spec.name + "/objects");
+  publish.params.assign("type", "objects");
+  publish.params.assign("max_bytes", std::to_string(sizeof(engine::ObjectListPayload)));
+  spec.edges.push_back(engine::EdgeSpec{output->name, "objects", publish.name, "in", 0});
+  spec.nodes.push_back(std::move(publish));
+}
+
 // --rate: the engine paces the source at the graph period, which is also each frame's deadline.
 void override_rate(engine::GraphSpec& spec, const std::string& rate) {
   if (rate.empty()) return;
@@ -104,7 +123,7 @@ std::string percent(const graphs::Score& s) {
 void print_summary(const graphs::SessionSummary& s, const engine::GraphStats& stats, const graphs::LearningService& l) {
   std::cout << "frames:      " << s.frames << " processed, " << stats.total_drops() << " dropped ("
             << stats.source_drops.load() << " at the source), " << s.frames_with_table << " with a table, "
-            << stats.deadline_misses.load() << " over the period\n";
+            << stats.deadline_misses.load() << " over the period, " << s.frames_with_error << " with an error\n";
   std::cout << "objects:     " << s.object_views << " object views, " << s.tracks_started << " tracks, " << s.key_views
             << " key views\n";
   std::cout << "recognition: " << s.recognitions << " answers; " << l.teaches() << " views taught";
@@ -128,6 +147,7 @@ void run(const RunOptions& o) {
   if (!spec) fail(engine::to_string(spec.error()), EXIT_BAD_INPUT);
   override_source(*spec, o);
   override_rate(*spec, o.rate);
+  if (o.publish_objects) add_objects_publisher(*spec);
   auto learning = graphs::LearningService::open(learning_settings(*spec, o));
   if (!learning) fail(learning.error(), EXIT_FAILURE_GENERIC);
   std::unique_ptr<graphs::LineWriter> json;
@@ -193,6 +213,8 @@ void add_run_command(CLI::App& app) {
   cmd->add_option("--json-out", o->json_out, "one JSON line per frame to FILE ('-' = stdout)");
   cmd->add_option("--snapshot", o->snapshot, "PNG of the last frame with objects, seen from above the table");
   cmd->add_option("--telemetry-json", o->telemetry_json, "engine telemetry as JSON to FILE");
+  cmd->add_flag("--publish-objects", o->publish_objects,
+                "publish every frame's objects on the iceoryx topic orthoflow/<graph>/objects (needs RouDi)");
   cmd->add_option("--threads", o->threads, "arena threads (0 = all cores)")->check(CLI::Range(0, 1024));
   cmd->callback([o] { run(*o); });
 }

@@ -85,6 +85,8 @@ struct FrameError {
   Text stage;   ///< the node that reported it
   Text detail;  ///< FILE_UNREADABLE: the reader's message (truncated)
   [[nodiscard]] bool empty() const noexcept { return code == Code::NONE; }
+  /// @brief The code's name, e.g. "SEGMENTATION". Never allocates.
+  [[nodiscard]] static std::string_view name(Code code) noexcept;
   /// @brief Records an error unless the frame already has one. @return true if recorded.
   bool set(Code c, std::string_view node, std::uint8_t why = 0, double number = 0.0) noexcept;
   /// @brief Records a segmentation stage's error (same first-error rule).

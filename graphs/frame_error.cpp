@@ -5,8 +5,7 @@
 
 namespace orthoflow::graphs {
 
-namespace {
-std::string_view code_name(FrameError::Code code) noexcept {
+std::string_view FrameError::name(Code code) noexcept {
   switch (code) {
     case FrameError::Code::NONE: return "NONE";
     case FrameError::Code::FRAME_TOO_LARGE: return "FRAME_TOO_LARGE";
@@ -16,7 +15,6 @@ std::string_view code_name(FrameError::Code code) noexcept {
   }
   return "UNKNOWN";
 }
-}  // namespace
 
 bool FrameError::set(Code c, std::string_view node, std::uint8_t why, double number) noexcept {
   if (!empty() || c == Code::NONE) return false;
@@ -34,7 +32,7 @@ bool FrameError::set(std::string_view node, const kernels::SegmentationError& e)
 }
 
 std::string FrameError::to_string() const {
-  std::string out = std::string(stage.view()) + ": " + std::string(code_name(code));
+  std::string out = std::string(stage.view()) + ": " + std::string(name(code));
   switch (code) {
     case Code::NONE: return "no error";
     case Code::SEGMENTATION: return out + ": " + segmentation.to_string();

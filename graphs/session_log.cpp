@@ -104,7 +104,20 @@ void SessionLog::write_json(const FrameBlock& block, std::uint64_t frame_id) noe
     }
     n += static_cast<std::size_t>(std::snprintf(out + n, cap - n, "]}"));
   }
-  n += static_cast<std::size_t>(std::snprintf(out + n, cap - n, "]}"));
+  n += static_cast<std::size_t>(std::snprintf(out + n, cap - n, "]"));
+  if (!s.error.empty() && n + 256 < cap) {  // the frame's first error: node, code and the stage's reason
+    const std::string_view stage = s.error.stage.view(), code = FrameError::name(s.error.code);
+    const std::string_view reason = s.error.code == FrameError::Code::SEGMENTATION
+                                        ? kernels::to_string(s.error.segmentation.code)
+                                        : std::string_view{};
+    const bool plain = stage.find_first_of("\"\\") == std::string_view::npos;
+    n += static_cast<std::size_t>(std::snprintf(out + n, cap - n, R"(,"error":"%.*s%s%.*s%s%.*s")",
+                                                plain ? static_cast<int>(stage.size()) : 0, stage.data(),
+                                                plain ? ": " : "", static_cast<int>(code.size()), code.data(),
+                                                reason.empty() ? "" : ": ", static_cast<int>(reason.size()),
+                                                reason.data()));
+  }
+  n += static_cast<std::size_t>(std::snprintf(out + n, cap - n, "}"));
   json_->write({out, std::min(n, cap - 1)});
 }
 

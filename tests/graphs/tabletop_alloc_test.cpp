@@ -1,7 +1,8 @@
 // Proves that the tabletop graph, after warm-up, performs no operator new per frame: sources,
 // segmentation, tracking, GOOD, recognition (asking a learner that knows categories) and the session
-// log. Learning events are excluded: a teach rebuilds the learner's snapshot (it allocates, once per
-// lesson, by design; docs/TABLETOP.md). oneTBB's own task allocations do not go through operator new
+// log, the objects output with an in-process consumer that asks over the learning channel. Teaching is
+// excluded: a teach rebuilds the learner's snapshot (it allocates, once per lesson, by design;
+// docs/TABLETOP.md). oneTBB's own task allocations do not go through operator new
 // (see tests/engine/engine_alloc_test.cpp).
 #include <gtest/gtest.h>
 
@@ -33,7 +34,10 @@ TEST(TabletopAllocations, SteadyStateAllocatesNothingPerFrame) {
   auto json = LineWriter::open("/dev/null");
   ASSERT_TRUE(json);
   SessionLog log(std::move(*json));
-  const auto registry = make_tabletop_registry(*learning, log);
+  ObjectsHub hub;  // an in-process consumer of the objects output, asking over the learning channel
+  auto objects = hub.subscribe(16);
+  auto client = learning->connect();
+  const auto registry = make_tabletop_registry(*learning, log, &hub);
   // random scene with 5 objects, instructor off (teaching allocates by design)
   auto spec = test::tabletop_spec({{"source", {{"objects", "5"}, {"frames", "60"}}}, {"recognise", {{"instructor", "0"}}}});
   auto graph = engine::build_graph(spec, registry);
@@ -45,10 +49,31 @@ TEST(TabletopAllocations, SteadyStateAllocatesNothingPerFrame) {
     while (log.summary().frames < 20 && !stop.load()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
     g_counting.store(true);
   });
+  std::uint64_t lists = 0, answers = 0;
+  std::thread consumer([&] {
+    engine::ObjectListPayload list;
+    LearningAck ack;
+    while (!stop.load()) {
+      while (objects->poll(list)) {
+        ++lists;
+        if (list.count > 0) {
+          LearningCommand ask;
+          ask.kind = LearningCommand::Kind::ASK;
+          ask.track_id = static_cast<std::uint32_t>(list.objects[0].track_id);
+          (void)client->send(ask);
+        }
+      }
+      while (client->poll(ack)) answers += ack.outcome == LearningAck::Outcome::ANSWERED ? 1 : 0;
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+  });
   engine.run({});
   g_counting.store(false);
   stop.store(true);
   arm.join();
+  consumer.join();
+  EXPECT_GT(lists, 40U);
+  EXPECT_GT(answers, 20U);
   EXPECT_EQ(log.summary().frames, 60U);
   EXPECT_GT(log.summary().object_views, 100U);
   EXPECT_GT(log.summary().recognitions, 100U);
