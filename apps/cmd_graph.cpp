@@ -36,13 +36,18 @@ engine::NodeRegistry make_registry() {
   return graphs::make_tabletop_registry(**learning, log);
 }
 
-std::unique_ptr<engine::Graph> load_or_throw(const std::string& file, const engine::NodeRegistry& registry) {
+// `graph check` and `graph dot` build with BuildMode::CHECK: every error a file can hold is
+// reported with the same message and exit code as `graph run`, but no node connects (no RouDi
+// needed).
+std::unique_ptr<engine::Graph> load_or_throw(const std::string& file,
+                                             const engine::NodeRegistry& registry,
+                                             engine::BuildMode mode) {
   auto spec_result = engine::load_graph_file(file);
   if (!spec_result) {
     std::cerr << engine::to_string(spec_result.error()) << "\n";
     throw CLI::RuntimeError(EXIT_BAD_INPUT);
   }
-  auto graph_result = engine::build_graph(*spec_result, registry);
+  auto graph_result = engine::build_graph(*spec_result, registry, mode);
   if (!graph_result) {
     std::cerr << engine::to_string(graph_result.error()) << "\n";
     throw CLI::RuntimeError(EXIT_BAD_INPUT);
@@ -59,7 +64,7 @@ struct RunArgs {
 
 void run_graph(const RunArgs& args) {
   const auto registry = make_registry();
-  auto graph = load_or_throw(args.file, registry);
+  auto graph = load_or_throw(args.file, registry, engine::BuildMode::RUN);
   g_stop_requested.store(false);
   auto previous_int = std::signal(SIGINT, on_stop_signal);
   auto previous_term = std::signal(SIGTERM, on_stop_signal);
@@ -96,11 +101,12 @@ void add_graph_command(CLI::App& app) {
   graph->require_subcommand(1);
 
   auto check_file = std::make_shared<std::string>();
-  auto* check = graph->add_subcommand("check", "Validate a graph file; errors name file and line");
+  auto* check = graph->add_subcommand(
+      "check", "Validate a graph file (no RouDi needed); errors name file and line");
   check->add_option("FILE", *check_file, "graph file")->required();
   check->callback([check_file] {
     const auto registry = make_registry();
-    auto built = load_or_throw(*check_file, registry);
+    auto built = load_or_throw(*check_file, registry, engine::BuildMode::CHECK);
     std::cout << *check_file << ": ok (" << built->nodes.size() << " nodes, " << built->edges.size()
               << " edges, " << built->max_in_flight << " frames in flight)\n";
   });
@@ -110,7 +116,7 @@ void add_graph_command(CLI::App& app) {
   dot->add_option("FILE", *dot_file, "graph file")->required();
   dot->callback([dot_file] {
     const auto registry = make_registry();
-    std::cout << engine::to_dot(*load_or_throw(*dot_file, registry));
+    std::cout << engine::to_dot(*load_or_throw(*dot_file, registry, engine::BuildMode::CHECK));
   });
 
   auto args = std::make_shared<RunArgs>();

@@ -18,7 +18,8 @@ function(orthoflow_target_defaults tgt)
 endfunction()
 
 # orthoflow_add_library(folder SOURCES ... [PUBLIC_LIBS ...] [PRIVATE_LIBS ...])
-# One library per top-level folder, aliased orthoflow::<folder>, installed and exported.
+# One library per top-level folder, aliased orthoflow::<folder>, installed and exported as the
+# package component <folder>.
 function(orthoflow_add_library folder)
   cmake_parse_arguments(ARG "" "" "SOURCES;PUBLIC_LIBS;PRIVATE_LIBS" ${ARGN})
   set(tgt orthoflow_${folder})
@@ -39,9 +40,11 @@ function(orthoflow_add_library folder)
   endif()
   set_target_properties(${tgt} PROPERTIES EXPORT_NAME ${folder})
   add_library(orthoflow::${folder} ALIAS ${tgt})
-  install(TARGETS ${tgt} EXPORT orthoflowTargets
+  # One export set per library: the package component `folder` (cmake/OrthoflowPackage.cmake).
+  install(TARGETS ${tgt} EXPORT orthoflow_${folder}Targets
     ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
     LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
+  set_property(GLOBAL APPEND PROPERTY ORTHOFLOW_LIBRARY_FOLDERS ${folder})
   install(DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/
     DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/orthoflow/${folder}
     FILES_MATCHING PATTERN "*.hpp" PATTERN "*.inl")

@@ -13,6 +13,8 @@
 #include <thread>
 #include <vector>
 
+#include "core/assert.hpp"
+
 namespace orthoflow::engine {
 
 namespace flow = tbb::flow;
@@ -291,7 +293,11 @@ struct Engine::Impl {
   }
 };
 
-Engine::Engine(Graph& graph, const EngineConfig& config) : impl_(std::make_unique<Impl>(graph, config)) {}
+Engine::Engine(Graph& graph, const EngineConfig& config) {
+  OF_ENFORCE(graph.mode == BuildMode::RUN,
+             "Engine: a graph built with BuildMode::CHECK cannot run");
+  impl_ = std::make_unique<Impl>(graph, config);
+}
 
 Engine::~Engine() = default;
 

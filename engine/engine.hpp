@@ -29,7 +29,8 @@ struct RunOptions {
 enum class StopReason { SOURCE_END, FRAME_LIMIT, STOP_REQUESTED };
 
 /// @brief Owns the TBB flow graph and arena for one Graph.
-/// @pre `graph` outlives the engine. run() is called at most once (a finished flow graph cannot
+/// @pre `graph` outlives the engine and was built with BuildMode::RUN (OF_ENFORCE: a CHECK graph's
+/// nodes are connected to nothing). run() is called at most once (a finished flow graph cannot
 /// restart its source); request_stop() may be called from any thread, including signal-driven ones
 /// through RunOptions::stop.
 class Engine {

@@ -88,12 +88,16 @@ struct Graph {
   std::vector<std::size_t> topo_order;           // sources first
   std::size_t source = 0;
   std::size_t max_in_flight = 1;
+  BuildMode mode = BuildMode::RUN;  // CHECK: validated only; the Engine refuses it
 };
 
 /// @brief Validates `spec` against `registry` and instantiates it: unknown kind/node/port, type
 /// mismatch, unconnected required input, cycle, bad parameter, source count and pool errors.
-[[nodiscard]] Result<std::unique_ptr<Graph>, GraphError> build_graph(const GraphSpec& spec,
-                                                                     const NodeRegistry& registry);
+/// @param mode RUN (default): ready for the Engine; IPC kinds register with RouDi here. CHECK: the
+/// same checks and errors, but no node connects to anything outside this process (no RouDi needed);
+/// the result can be inspected and drawn, not run.
+[[nodiscard]] Result<std::unique_ptr<Graph>, GraphError> build_graph(
+    const GraphSpec& spec, const NodeRegistry& registry, BuildMode mode = BuildMode::RUN);
 
 /// @brief Graphviz text of a validated graph (ports as edge labels, policies as node labels).
 [[nodiscard]] std::string to_dot(const Graph& graph);

@@ -41,7 +41,7 @@ std::optional<GraphError> make_nodes(Graph& graph, const NodeRegistry& registry)
       return error_at(spec, Code::UNKNOWN_KIND, node.line,
                       "node '" + node.name + "': unknown kind '" + node.kind + "' (known: " + known + ")");
     }
-    const NodeContext context{node.name, graph.pool.get(), graph.max_in_flight};
+    const NodeContext context{node.name, graph.pool.get(), graph.max_in_flight, graph.mode};
     auto node_result = (*factory)(node.params, context);
     if (!node_result) {
       return error_at(spec, Code::BAD_PARAMETER, node.line, "node '" + node.name + "': " + node_result.error());
@@ -165,9 +165,10 @@ std::string to_string(const GraphError& error) {
   return error.file + ":" + std::to_string(error.line) + ": error [" + to_string(error.code) + "]: " + error.message;
 }
 
-Built build_graph(const GraphSpec& spec, const NodeRegistry& registry) {
+Built build_graph(const GraphSpec& spec, const NodeRegistry& registry, BuildMode mode) {
   auto graph = std::make_unique<Graph>();
   graph->spec = spec;
+  graph->mode = mode;
   graph->max_in_flight = spec.max_in_flight == 0 ? spec.blocks : spec.max_in_flight;
   if (graph->max_in_flight > spec.blocks) {
     return err(error_at(spec, Code::POOL, 0,

@@ -4,11 +4,13 @@
 
 #include <chrono>
 #include <cstring>
+#include <optional>
 #include <thread>
 #include <vector>
 
 #include "engine/frame_payload.hpp"
 #include "engine/ipc_frame_ref.hpp"
+#include "engine/ipc_node_params.hpp"
 #include "engine/object_list_payload.hpp"
 
 namespace orthoflow::engine {
@@ -67,15 +69,14 @@ class IpcPublishNode final : public IpcNode {
 /// Source: one frame per received chunk; the frame's block holds a FrameRef to the chunk.
 class IpcSubscribeNode final : public IpcNode {
  public:
-  struct Settings {
-    std::int64_t frames = 0;    // END after this many frames (0 = endless)
-    std::int64_t idle_ms = 0;   // END after this long without data (0 = never)
-    std::int64_t wait_ms = 100; // longest wait inside produce() before an idle tombstone
-  };
-  IpcSubscribeNode(std::unique_ptr<IpcSubscriber> subscriber, const std::string& type, const Settings& settings,
+  IpcSubscribeNode(std::unique_ptr<IpcSubscriber> subscriber, const IpcSubscribeParams& settings,
                    const NodeContext& context)
-      : subscriber_(std::move(subscriber)), outputs_{{"out", type, false}}, settings_(settings), context_(context),
-        held_(context.pool->block_count()), last_data_ms_(now_ms()) {}
+      : subscriber_(std::move(subscriber)),
+        outputs_{{"out", settings.type, false}},
+        settings_(settings),
+        context_(context),
+        held_(context.pool->block_count()),
+        last_data_ms_(now_ms()) {}
   ~IpcSubscribeNode() override {
     for (Held& held : held_) held.sample.reset();  // chunks back to iceoryx before the subscriber goes
   }
@@ -97,7 +98,7 @@ class IpcSubscribeNode final : public IpcNode {
 
   std::unique_ptr<IpcSubscriber> subscriber_;
   std::vector<PortSpec> outputs_;
-  Settings settings_;
+  IpcSubscribeParams settings_;
   NodeContext context_;
   std::vector<Held> held_;  // by block index; sized once at start-up
   std::int64_t produced_ = 0;
@@ -156,86 +157,75 @@ SourceStatus IpcSubscribeNode::produce(Message& out) noexcept {
   }
 }
 
-// ParamMap has typed getters for numbers and choices only; topics and paths are free text.
-std::string text_param(const ParamMap& params, const std::string& key, const std::string& fallback) {
-  for (const auto& entry : params.entries()) {
-    if (entry.key == key) return entry.value;
-  }
-  return fallback;
-}
+/// BuildMode::CHECK: an IPC kind's ports, topic and serial flag, attached to nothing. The Engine
+/// refuses CHECK graphs, so process() and produce() never run.
+class IpcCheckedNode final : public IpcNode {
+ public:
+  IpcCheckedNode(std::string topic, std::vector<PortSpec> inputs, std::vector<PortSpec> outputs)
+      : topic_(std::move(topic)), inputs_(std::move(inputs)), outputs_(std::move(outputs)) {}
+  std::span<const PortSpec> inputs() const noexcept override { return inputs_; }
+  std::span<const PortSpec> outputs() const noexcept override { return outputs_; }
+  bool stateful() const noexcept override { return true; }
+  void process(const Message& /*in*/, Emitter& /*out*/) noexcept override {}
+  const std::string& topic() const noexcept override { return topic_; }
+  const IpcCounters& ipc_counters() const noexcept override { return counters_; }
 
-Result<IpcPools, std::string> pools_for(const ParamMap& params) {
-  const std::string path = text_param(params, "roudi_config", "");
-  auto pools_result = path.empty() ? query_roudi_pools(std::chrono::milliseconds(2000)) : load_roudi_pools(path);
-  if (!pools_result) return err(to_string(pools_result.error()));
-  return *pools_result;
-}
+ private:
+  std::string topic_;
+  std::vector<PortSpec> inputs_, outputs_;
+  IpcCounters counters_;
+};
 
-Result<IpcTopic, std::string> start(const ParamMap& params) {
-  auto topic_result = parse_topic(text_param(params, "topic", ""));
-  if (!topic_result) return err(to_string(topic_result.error()));
+Result<void, std::string> connect_runtime() {
   if (auto init = init_ipc_runtime("orthoflow_" + std::to_string(::getpid())); !init) {
     return err(to_string(init.error()));
   }
-  return *topic_result;
+  return {};
+}
+
+// A RouDi TOML file named by roudi_config is read and checked in both modes, before connecting: it
+// must parse and hold a chunk for max_bytes (iceoryx aborts on a loan larger than every pool).
+// Without it RouDi's live pools are known only once connected, so that check waits for RUN.
+Result<std::optional<IpcPools>, std::string> named_pools(const IpcPublishParams& parsed) {
+  if (parsed.roudi_config.empty()) return std::optional<IpcPools>{};
+  auto pools_result = load_roudi_pools(parsed.roudi_config);
+  if (!pools_result) return err(to_string(pools_result.error()));
+  auto fits = check_pool_fits(*pools_result, parsed.config.max_payload_bytes, PAYLOAD_ALIGNMENT,
+                              "publisher " + parsed.topic.str());
+  if (!fits) return err(to_string(fits.error()));
+  return std::optional<IpcPools>(std::move(*pools_result));
 }
 
 Made make_publish(const ParamMap& params, const NodeContext& context) {
-  if (auto ok = params.only({"topic", "type", "history", "lossless", "max_bytes", "roudi_config"}); !ok) {
-    return err(ok.error());
+  auto parsed = parse_ipc_publish_params(params, context);
+  if (!parsed) return err(parsed.error());
+  auto maybe_pools_result = named_pools(*parsed);
+  if (!maybe_pools_result) return err(maybe_pools_result.error());
+  if (context.mode == BuildMode::CHECK) {
+    return std::unique_ptr<Node>(
+        new IpcCheckedNode(parsed->topic.str(), {{"in", parsed->type, true}}, {}));
   }
-  auto type_result = params.choice("type", "frame", {"frame", "objects"});
-  if (!type_result) return err(type_result.error());
-  IpcPublisherConfig config;
-  config.type = *ipc_payload_type(*type_result);
-  auto history = params.integer("history", 0, 0, 16);
-  auto lossless = params.integer("lossless", 0, 0, 1);
-  const auto block = static_cast<std::int64_t>(context.pool ? context.pool->block_bytes() : 4096);
-  auto max_bytes = params.integer("max_bytes", block, 56, std::int64_t{1} << 30);
-  if (!history) return err(history.error());
-  if (!lossless) return err(lossless.error());
-  if (!max_bytes) return err(max_bytes.error());
-  config.history = static_cast<std::uint64_t>(*history);
-  config.lossless = *lossless == 1;
-  config.max_payload_bytes = static_cast<std::uint64_t>(*max_bytes);
-  auto topic = start(params);
-  if (!topic) return err(topic.error());
-  auto pools = pools_for(params);
-  if (!pools) return err(pools.error());
-  auto publisher = IpcPublisher::create(*topic, config, *pools);
+  if (auto connected = connect_runtime(); !connected) return err(connected.error());
+  auto pools_result = maybe_pools_result->has_value()
+                          ? Result<IpcPools, IpcError>(**maybe_pools_result)
+                          : query_roudi_pools(std::chrono::milliseconds(2000));
+  if (!pools_result) return err(to_string(pools_result.error()));
+  auto publisher = IpcPublisher::create(parsed->topic, parsed->config, *pools_result);
   if (!publisher) return err(to_string(publisher.error()));
-  return std::unique_ptr<Node>(new IpcPublishNode(std::move(*publisher), *type_result));
+  return std::unique_ptr<Node>(new IpcPublishNode(std::move(*publisher), parsed->type));
 }
 
 Made make_subscribe(const ParamMap& params, const NodeContext& context) {
-  if (auto ok = params.only({"topic", "type", "policy", "depth", "history", "frames", "idle_ms", "wait_ms"}); !ok) {
-    return err(ok.error());
+  auto parsed = parse_ipc_subscribe_params(params, context);
+  if (!parsed) return err(parsed.error());
+  if (context.mode == BuildMode::CHECK) {
+    return std::unique_ptr<Node>(
+        new IpcCheckedNode(parsed->topic.str(), {}, {{"out", parsed->type, false}}));
   }
-  auto type_result = params.choice("type", "frame", {"frame", "objects"});
-  auto policy = params.choice("policy", "latest", {"latest", "queue", "lossless"});
-  if (!type_result) return err(type_result.error());
-  if (!policy) return err(policy.error());
-  const auto blocks = static_cast<std::int64_t>(context.pool ? context.pool->block_count() : 0);
-  // iceoryx lets a subscriber hold 256 chunks: one per pool block plus the queue must fit.
-  auto depth = params.integer("depth", 1, 1, std::max<std::int64_t>(1, 256 - blocks));
-  auto history = params.integer("history", 0, 0, 16);
-  auto frames = params.integer("frames", 0, 0, std::int64_t{1} << 40);
-  auto idle = params.integer("idle_ms", 0, 0, 86'400'000);
-  auto wait = params.integer("wait_ms", 100, 1, 10'000);
-  for (const auto* r : {&depth, &history, &frames, &idle, &wait}) {
-    if (!*r) return err(r->error() + (r == &depth ? " (256 minus the pool's blocks)" : ""));
-  }
-  if (context.pool == nullptr || blocks > 255) return err(std::string("ipc_subscribe: needs a pool of 1..255 blocks"));
-  IpcSubscriberConfig config{*ipc_payload_type(*type_result),
-                             *policy == "latest" ? IpcPolicy::LATEST
-                                                 : (*policy == "queue" ? IpcPolicy::QUEUE : IpcPolicy::LOSSLESS),
-                             static_cast<std::uint64_t>(*depth), static_cast<std::uint64_t>(*history)};
-  auto topic = start(params);
-  if (!topic) return err(topic.error());
-  auto subscriber = IpcSubscriber::create(*topic, config);
+  if (auto connected = connect_runtime(); !connected) return err(connected.error());
+  auto subscriber = IpcSubscriber::create(parsed->topic, parsed->config);
   if (!subscriber) return err(to_string(subscriber.error()));
-  return std::unique_ptr<Node>(new IpcSubscribeNode(std::move(*subscriber), *type_result,
-                                                    IpcSubscribeNode::Settings{*frames, *idle, *wait}, context));
+  return std::unique_ptr<Node>(new IpcSubscribeNode(std::move(*subscriber), *parsed, context));
 }
 
 }  // namespace

@@ -6,7 +6,9 @@
 /// - `ipc_subscribe` (source): hands each received chunk downstream without copying: the frame's
 ///   pool block holds a FrameRef (ipc_frame_ref.hpp) to the chunk, which the node keeps until the
 ///   block is released by every reader.
-/// Both register the process with RouDi when the graph is built (an error if none runs).
+/// Built for running (BuildMode::RUN), both register the process with RouDi (an error if none
+/// runs); built with BuildMode::CHECK they validate every parameter (ipc_node_params.hpp) and
+/// connect to nothing.
 #include <string>
 
 #include "engine/ipc_pubsub.hpp"

@@ -17,11 +17,18 @@ struct PortSpec {
   bool required = true;  ///< an input that must have at least one incoming edge
 };
 
+/// @brief What a graph is built for. RUN: nodes are ready to run, so kinds that talk to another
+/// process or a device connect in their factories (and fail there if it is absent). CHECK: every
+/// parameter is validated exactly as for RUN, but nothing outside this process is touched; the
+/// nodes have their ports and cannot run (`graph check`, `graph dot`).
+enum class BuildMode { RUN, CHECK };
+
 /// @brief What a node can use while it runs; owned by the engine and alive as long as the node.
 struct NodeContext {
   std::string_view name;                    ///< the node's instance name (for pool error messages)
   memory_pool::BlockPool* pool = nullptr;   ///< the graph's frame pool
   std::size_t max_in_flight = 1;            ///< frames that can be in flight at once (limiter size)
+  BuildMode mode = BuildMode::RUN;          ///< CHECK: validate only, connect to nothing
 };
 
 /// @brief Where a node puts its results during process(). Implemented by the engine.

@@ -14,6 +14,8 @@
 namespace orthoflow::engine {
 
 /// @brief Builds a node from its parameters; returns a message (without file/line) on bad ones.
+/// With NodeContext::mode == BuildMode::CHECK a factory validates exactly as for RUN but connects
+/// to nothing outside the process (daemons, devices); the node only has to report its ports.
 using NodeFactory = std::function<Result<std::unique_ptr<Node>, std::string>(const ParamMap&, const NodeContext&)>;
 
 /// @brief Maps kind names to factories. Filled at start-up, then only read (thread-safe to read).

@@ -4,6 +4,7 @@
 #include <signal.h>
 
 #include <cstdio>
+#include <fstream>
 #include <thread>
 
 #include "engine/frame_payload.hpp"
@@ -38,6 +39,8 @@ long long number_after(const std::string& text, const std::string& key) {
   }
   return -1;
 }
+
+void write_file(const std::string& path, const std::string& text) { std::ofstream(path) << text; }
 
 std::vector<std::string> send_args(std::uint64_t frames, double period_ms) {
   return {"ipc", "send", TOPIC, "--frames", std::to_string(frames), "--period-ms", std::to_string(period_ms),
@@ -127,6 +130,56 @@ TEST(IpcCli, RouDiAbsentIsAnErrorWithinOneSecond) {
       box.check(p.seconds < 1.0, "ipc " + args[1] + " without RouDi fails within 1 s (took " +
                                      std::to_string(p.seconds) + " s)");
     }
+  });
+}
+
+// BuildMode::CHECK: with no RouDi in the namespace `graph check` validates the two-process graph
+// files completely; `graph run` still registers with RouDi and so fails, naming it.
+TEST(IpcCli, GraphCheckNeedsNoRouDiGraphRunDoes) {
+  RUN_ISOLATED([](Sandbox& box) {
+    const std::string graphs = ORTHOFLOW_SOURCE_DIR "/graphs/";
+    for (const std::string file : {"perception.yaml", "sensor.yaml"}) {
+      const ProcResult p =
+          box.wait(box.spawn_orthoflow("check", {"graph", "check", graphs + file}), 5s);
+      box.check(p.exit_code == 0 && p.out.find(file + ": ok (") != std::string::npos,
+                "graph check " + file + " without RouDi: exit 0, ok", p);
+    }
+    const ProcResult run =
+        box.wait(box.spawn_orthoflow("run", {"graph", "run", graphs + "perception.yaml"}), 5s);
+    box.check(
+        run.exit_code == 2 && run.err.find("node 'frames': ROUDI_UNREACHABLE") != std::string::npos,
+        "graph run perception.yaml without RouDi: exit 2, ROUDI_UNREACHABLE", run);
+  });
+}
+
+// BuildMode::RUN: `graph run` connects its IPC nodes: a subscriber graph takes 5 frames from `ipc
+// send`, a publisher graph whose roudi_config names the RouDi TOML file offers its topic.
+TEST(IpcCli, GraphRunConnectsItsIpcNodes) {
+  RUN_ISOLATED([](Sandbox& box) {
+    if (box.start_roudi() < 0) return;
+    const std::string header = "graph:\n  pool: {block_bytes: 4096, blocks: 4}\nnodes:\n";
+    write_file("/tmp/sub.yaml",
+               header + "  - {name: frames, kind: ipc_subscribe, params: {topic: " + TOPIC +
+                   ", policy: queue, depth: 16, frames: 5, idle_ms: 5000}}\n"
+                   "  - {name: sink, kind: pass}\nedges:\n  - frames.out -> sink.in\n");
+    write_file("/tmp/pub.yaml",
+               header +
+                   "  - {name: src, kind: ticker, params: {frames: 3}}\n"
+                   "  - {name: out, kind: ipc_publish, params: {topic: orthoflow/test/ticks, "
+                   "roudi_config: " +
+                   CONFIG + "}}\nedges:\n  - src.out -> out.in\n");
+    const pid_t sub = box.spawn_orthoflow("graph_sub", {"graph", "run", "/tmp/sub.yaml"});
+    const pid_t send = box.spawn_orthoflow("send", send_args(50, 5));
+    const ProcResult r = box.wait(sub, 10s), s = box.wait(send, 10s);
+    // The source ends after its 5 frames; without data it would end only after idle_ms (5 s).
+    box.check(
+        r.exit_code == 0 && r.out.find("source ended") != std::string::npos && r.seconds < 4.0,
+        "graph run of a subscriber graph: 5 frames, then the source ends", r);
+    box.check(s.exit_code == 0, "send exits 0", s);
+    const ProcResult p =
+        box.wait(box.spawn_orthoflow("graph_pub", {"graph", "run", "/tmp/pub.yaml"}), 10s);
+    box.check(p.exit_code == 0 && p.out.find("source ended") != std::string::npos,
+              "graph run of a publisher graph with roudi_config", p);
   });
 }
 
