@@ -1,6 +1,7 @@
 // `orthoflow describe FILE.pcd [--bins N] [--mode invariant|reference] [--threshold T] [--json]
-// [--png OUT.png]`: the GOOD descriptor of one object cloud (kernels/good.hpp, docs/GOOD.md), with its
-// object frame, bounding box, projection order and flags; --png draws the three projections side by side.
+// [--png OUT.png]`: the GOOD descriptor of one object cloud (kernels/good.hpp, docs/GOOD.md), with
+// its object frame, bounding box, projection order and flags; --png draws the three projections
+// side by side.
 #include <cairo.h>
 
 #include <algorithm>
@@ -35,7 +36,6 @@ struct Described {
   std::vector<float> descriptor;
   kernels::GoodResult result;
 };
-
 
 nlohmann::json flags_json(std::uint32_t flags) {
   static const std::array<std::pair<std::uint32_t, const char*>, 7> NAMES{{
@@ -73,8 +73,9 @@ nlohmann::json to_json(const DescribeOptions& o, const Described& d) {
 }
 
 void print_text(const nlohmann::json& j) {
-  std::cout << "file:        " << j["file"].get<std::string>() << "\nmode:        " << j["mode"].get<std::string>()
-            << " (" << j["bins"] << " bins, " << j["descriptor"].size() << " values)\npoints used: " << j["points_used"]
+  std::cout << "file:        " << j["file"].get<std::string>()
+            << "\nmode:        " << j["mode"].get<std::string>() << " (" << j["bins"] << " bins, "
+            << j["descriptor"].size() << " values)\npoints used: " << j["points_used"]
             << "\norder:       " << j["order"].dump() << "\nbbox:        " << j["bbox"].dump()
             << "\nflags:       " << j["flags"].dump() << "\nframe:       " << j["frame"].dump()
             << "\ndescriptor:  " << j["descriptor"].dump() << '\n';
@@ -90,7 +91,8 @@ struct AxisStyle {
   const char* name;
   double r, g, b;
 };
-constexpr std::array<AxisStyle, 3> AXES{{{"X", 0.85, 0.1, 0.1}, {"Y", 0.1, 0.6, 0.1}, {"Z", 0.1, 0.2, 0.9}}};
+constexpr std::array<AxisStyle, 3> AXES{
+    {{"X", 0.85, 0.1, 0.1}, {"Y", 0.1, 0.6, 0.1}, {"Z", 0.1, 0.2, 0.9}}};
 
 // Row and column axis of each canonical view (GOOD_REFERENCE.md section 5).
 constexpr std::array<std::array<std::size_t, 2>, 3> VIEW_AXES{{{1, 2}, {0, 2}, {0, 1}}};
@@ -105,8 +107,8 @@ void draw_arrow(cairo_t* cr, double x0, double y0, double dx, double dy, const A
   cairo_show_text(cr, s.name);
 }
 
-void draw_panel(cairo_t* cr, double left, std::span<const float> block, std::size_t n, kernels::GoodView view,
-                std::size_t rank) {
+void draw_panel(cairo_t* cr, double left, std::span<const float> block, std::size_t n,
+                kernels::GoodView view, std::size_t rank) {
   const float peak = std::max(*std::max_element(block.begin(), block.end()), 1e-12F);
   const double cell = PANEL / static_cast<double>(n);
   for (std::size_t row = 0; row < n; ++row) {
@@ -114,8 +116,8 @@ void draw_panel(cairo_t* cr, double left, std::span<const float> block, std::siz
       const double shade = 1.0 - static_cast<double>(block[row * n + col] / peak);
       cairo_set_source_rgb(cr, shade, shade, shade);
       // Column to the right, row upwards, so each view is drawn as seen with its two axes.
-      cairo_rectangle(cr, left + static_cast<double>(col) * cell, TITLE + PANEL - static_cast<double>(row + 1) * cell,
-                      cell, cell);
+      cairo_rectangle(cr, left + static_cast<double>(col) * cell,
+                      TITLE + PANEL - static_cast<double>(row + 1) * cell, cell, cell);
       cairo_fill(cr);
     }
   }
@@ -146,8 +148,8 @@ bool write_png(const std::string& path, const Described& d, std::size_t n) {
   cairo_set_font_size(cr.get(), 16.0);
   const std::size_t nn = n * n;
   for (std::size_t k = 0; k < 3; ++k) {
-    draw_panel(cr.get(), GAP + static_cast<double>(k) * (PANEL + GAP), std::span<const float>(d.descriptor).subspan(k * nn, nn),
-               n, d.result.order[k], k);
+    draw_panel(cr.get(), GAP + static_cast<double>(k) * (PANEL + GAP),
+               std::span<const float>(d.descriptor).subspan(k * nn, nn), n, d.result.order[k], k);
   }
   cairo_surface_flush(surface.get());
   return cairo_surface_write_to_png(surface.get(), path.c_str()) == CAIRO_STATUS_SUCCESS;
@@ -169,11 +171,13 @@ void run_describe(const DescribeOptions& o) {
   kernels::GoodScratch scratch(std::max<std::size_t>(o.bins, 1));
   Described d;
   d.descriptor.assign(spec.length(), 0.0F);
-  auto good_result = kernels::compute_good(cloud_result->points(), spec.good, scratch, d.descriptor);
+  auto good_result =
+      kernels::compute_good(cloud_result->points(), spec.good, scratch, d.descriptor);
   if (!good_result) {
     const bool bad_input = good_result.error() == kernels::GoodError::EMPTY_CLOUD ||
                            good_result.error() == kernels::GoodError::NO_FINITE_POINTS;
-    fail(o.file + ": " + kernels::to_string(good_result.error()), bad_input ? EXIT_BAD_INPUT : EXIT_FAILURE_GENERIC);
+    fail(o.file + ": " + kernels::to_string(good_result.error()),
+         bad_input ? EXIT_BAD_INPUT : EXIT_FAILURE_GENERIC);
   }
   d.result = *good_result;
   const nlohmann::json j = to_json(o, d);
@@ -182,24 +186,30 @@ void run_describe(const DescribeOptions& o) {
   } else {
     print_text(j);
   }
-  if (!o.png.empty() && !write_png(o.png, d, o.bins)) { fail("cannot write " + o.png, EXIT_FAILURE_GENERIC); }
+  if (!o.png.empty() && !write_png(o.png, d, o.bins)) {
+    fail("cannot write " + o.png, EXIT_FAILURE_GENERIC);
+  }
 }
 
 }  // namespace
 
 void add_describe_command(CLI::App& app) {
-  auto* cmd = app.add_subcommand("describe", "GOOD descriptor, object frame and projections of an object cloud");
+  auto* cmd = app.add_subcommand(
+      "describe", "GOOD descriptor, object frame and projections of an object cloud");
   auto o = std::make_shared<DescribeOptions>();
   cmd->add_option("file", o->file, "object PCD file")->required();
   cmd->add_option("--bins", o->bins, "bins per projection side (15 thesis default, 5 compact)")
       ->check(CLI::Range(std::size_t{1}, kernels::GOOD_MAX_BINS));
-  cmd->add_option("--mode", o->mode, "invariant (pose-invariant frame) or reference (reproduces the reference code)")
+  cmd->add_option("--mode", o->mode,
+                  "invariant (pose-invariant frame) or reference (reproduces the reference code)")
       ->check(CLI::IsMember({"invariant", "reference"}));
   cmd->add_option("--threshold", o->threshold,
                   "sign threshold t in metres (default 0.015 invariant, 0.0015 reference)")
       ->check(CLI::Range(0.0F, 1e3F));
-  cmd->add_flag("--json", o->json, "print one JSON object: descriptor, frame, bbox, order, points_used, flags");
-  cmd->add_option("--png", o->png, "draw the three projections with the frame axes into this PNG file");
+  cmd->add_flag("--json", o->json,
+                "print one JSON object: descriptor, frame, bbox, order, points_used, flags");
+  cmd->add_option("--png", o->png,
+                  "draw the three projections with the frame axes into this PNG file");
   cmd->callback([o] { run_describe(*o); });
 }
 

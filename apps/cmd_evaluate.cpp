@@ -1,8 +1,9 @@
 // `orthoflow evaluate --dataset DIR --protocol cv10|teacher|teacher-context|noise|downsample
-// [--learner instance,bayes] [--approach nn,1,2] [--good-mode invariant,reference] [--bins 5,15] [--runs R]
+// [--learner instance,bayes] [--approach nn,1,2] [--good-mode invariant,reference] [--bins 5,15]
+// [--runs R]
 // [--seed S] [--folds K] [--levels MM,...] [--tau T] [--breakpoint N] [--threads N] [--out DIR]
-// [--cache DIR | --no-cache]`: the thesis's evaluations (evaluation/, docs/EVALUATION.md). Comma lists
-// give every combination as one variant, all evaluated on the same folds, orders and views.
+// [--cache DIR | --no-cache]`: the thesis's evaluations (evaluation/, docs/EVALUATION.md). Comma
+// lists give every combination as one variant, all evaluated on the same folds, orders and views.
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
@@ -11,10 +12,10 @@
 #include <vector>
 
 #include "apps/commands.hpp"
-#include "formats/pcd_io.hpp"
 #include "evaluation/derived_views.hpp"
 #include "evaluation/progress.hpp"
 #include "evaluation/report.hpp"
+#include "formats/pcd_io.hpp"
 
 namespace orthoflow::apps {
 namespace {
@@ -63,7 +64,9 @@ std::vector<evaluation::Variant> variants_of(const EvaluateOptions& o) {
         for (const std::size_t b : o.bins) {
           evaluation::Variant v;
           v.learner = bayes ? evaluation::LearnerKind::BAYES : evaluation::LearnerKind::INSTANCE;
-          v.rule = a == "1" ? evaluation::InstanceRule::APPROACH_1 : a == "2" ? evaluation::InstanceRule::APPROACH_2 : evaluation::InstanceRule::NEAREST;
+          v.rule = a == "1"   ? evaluation::InstanceRule::APPROACH_1
+                   : a == "2" ? evaluation::InstanceRule::APPROACH_2
+                              : evaluation::InstanceRule::NEAREST;
           v.mode = m == "reference" ? kernels::GoodMode::REFERENCE : kernels::GoodMode::INVARIANT;
           v.bins = b;
           out.push_back(v);
@@ -75,17 +78,24 @@ std::vector<evaluation::Variant> variants_of(const EvaluateOptions& o) {
 }
 
 std::filesystem::path default_cache() {
-  if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg != nullptr && *xdg != '\0') { return std::filesystem::path(xdg) / "orthoflow/descriptors"; }
-  if (const char* home = std::getenv("HOME"); home != nullptr && *home != '\0') { return std::filesystem::path(home) / ".cache/orthoflow/descriptors"; }
+  if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg != nullptr && *xdg != '\0') {
+    return std::filesystem::path(xdg) / "orthoflow/descriptors";
+  }
+  if (const char* home = std::getenv("HOME"); home != nullptr && *home != '\0') {
+    return std::filesystem::path(home) / ".cache/orthoflow/descriptors";
+  }
   return {};
 }
 
 int exit_code_of(const evaluation::EvalError& e) {
   using Code = evaluation::EvalError::Code;
   switch (e.code) {
-    case Code::BAD_CONFIG: return EXIT_USAGE;
-    case Code::WRITE_FAILED: return EXIT_FAILURE_GENERIC;
-    default: return EXIT_BAD_INPUT;
+    case Code::BAD_CONFIG:
+      return EXIT_USAGE;
+    case Code::WRITE_FAILED:
+      return EXIT_FAILURE_GENERIC;
+    default:
+      return EXIT_BAD_INPUT;
   }
 }
 
@@ -102,22 +112,30 @@ void run_evaluate(const EvaluateOptions& o) {
   eo.teacher.tau = o.tau;
   eo.teacher.breakpoint = o.breakpoint;
   eo.threads = o.threads;
-  eo.cache_dir = o.no_cache ? std::filesystem::path{} : o.cache.empty() ? default_cache() : std::filesystem::path(o.cache);
+  eo.cache_dir = o.no_cache        ? std::filesystem::path{}
+                 : o.cache.empty() ? default_cache()
+                                   : std::filesystem::path(o.cache);
   std::unique_ptr<evaluation::Progress> progress;
   if (!o.quiet) {
-    progress = std::make_unique<evaluation::Progress>("evaluate " + o.protocol, evaluation::evaluation_work(*dataset, eo), stderr,
-                                                      evaluation::Progress::is_terminal(stderr));
+    progress = std::make_unique<evaluation::Progress>(
+        "evaluate " + o.protocol, evaluation::evaluation_work(*dataset, eo), stderr,
+        evaluation::Progress::is_terminal(stderr));
   }
   auto result = evaluation::evaluate(*dataset, eo, progress.get());
   if (progress) { progress->finish(); }
   if (!result) { fail(result.error().to_string(), exit_code_of(result.error())); }
-  for (const std::string& w : result->warnings) { std::cerr << "orthoflow evaluate: warning: " << w << '\n'; }
+  for (const std::string& w : result->warnings) {
+    std::cerr << "orthoflow evaluate: warning: " << w << '\n';
+  }
   std::cout << evaluation::summary_markdown(*result);
-  const std::filesystem::path out = o.out.empty() ? std::filesystem::path("evaluation-" + o.protocol) : std::filesystem::path(o.out);
+  const std::filesystem::path out = o.out.empty()
+                                        ? std::filesystem::path("evaluation-" + o.protocol)
+                                        : std::filesystem::path(o.out);
   auto written = evaluation::write_report(*result, out);
   if (!written) { fail(written.error().to_string(), EXIT_FAILURE_GENERIC); }
-  std::cout << "\n" << result->describe.computed << " descriptors computed, " << result->describe.cached << " from the cache; "
-            << result->seconds << " s\nwrote";
+  std::cout << "\n"
+            << result->describe.computed << " descriptors computed, " << result->describe.cached
+            << " from the cache; " << result->seconds << " s\nwrote";
   for (const auto& f : *written) { std::cout << ' ' << f.string(); }
   std::cout << '\n';
 }
@@ -144,7 +162,8 @@ void run_derive(const DeriveOptions& o) {
     for (std::uint32_t v = 0; v < o.views; ++v) {
       char name[32];
       std::snprintf(name, sizeof name, "view_%03u.pcd", v);
-      auto written = formats::write_pcd(evaluation::derive_view(*cloud, v, o.seed), dir / name, formats::PcdEncoding::BINARY);
+      auto written = formats::write_pcd(evaluation::derive_view(*cloud, v, o.seed), dir / name,
+                                        formats::PcdEncoding::BINARY);
       if (!written) {
         std::cerr << "orthoflow derive-views: " << written.error().to_string() << '\n';
         throw CLI::RuntimeError(EXIT_FAILURE_GENERIC);
@@ -156,10 +175,13 @@ void run_derive(const DeriveOptions& o) {
 
 void add_derive_command(CLI::App& app) {
   auto o = std::make_shared<DeriveOptions>();
-  CLI::App* cmd = app.add_subcommand("derive-views", "Lay single views out as DIR/<file stem>/<stem>_0/view_NNN.pcd with random partial crops");
+  CLI::App* cmd = app.add_subcommand(
+      "derive-views",
+      "Lay single views out as DIR/<file stem>/<stem>_0/view_NNN.pcd with random partial crops");
   cmd->add_option("files", o->files, "object view PCD files (one category each)")->required();
   cmd->add_option("--out", o->out, "output dataset directory")->required();
-  cmd->add_option("--views", o->views, "views per file (view 0 is the file itself)")->check(CLI::Range(1, 10000));
+  cmd->add_option("--views", o->views, "views per file (view 0 is the file itself)")
+      ->check(CLI::Range(1, 10000));
   cmd->add_option("--seed", o->seed, "seed of the crops and noise");
   cmd->callback([o] { run_derive(*o); });
 }
@@ -168,25 +190,43 @@ void add_derive_command(CLI::App& app) {
 
 void add_evaluate_command(CLI::App& app) {
   auto o = std::make_shared<EvaluateOptions>();
-  CLI::App* cmd = app.add_subcommand("evaluate", "Evaluate learners on a dataset DIR/<category>/<instance>/<view>.pcd (docs/EVALUATION.md)");
+  CLI::App* cmd = app.add_subcommand(
+      "evaluate",
+      "Evaluate learners on a dataset DIR/<category>/<instance>/<view>.pcd (docs/EVALUATION.md)");
   cmd->add_option("--dataset", o->dataset, "dataset directory")->required();
   cmd->add_option("--protocol", o->protocol, "cv10, teacher, teacher-context, noise or downsample")
       ->check(CLI::IsMember({"cv10", "teacher", "teacher-context", "noise", "downsample"}));
-  cmd->add_option("--learner", o->learners, "instance and/or bayes (comma list)")->delimiter(',')->check(CLI::IsMember({"instance", "bayes"}));
-  cmd->add_option("--approach", o->approaches, "instance rule(s): nn (nearest neighbour), 1, 2 (thesis NOCD approaches)")
-      ->delimiter(',')->check(CLI::IsMember({"nn", "1", "2"}));
-  cmd->add_option("--good-mode", o->modes, "invariant and/or reference (comma list)")->delimiter(',')->check(CLI::IsMember({"invariant", "reference"}));
-  cmd->add_option("--bins", o->bins, "GOOD bins per side (comma list)")->delimiter(',')->check(CLI::Range(1, 256));
-  cmd->add_option("--runs", o->runs, "repetitions (category orders / fold splits)")->check(CLI::Range(1, 1000));
+  cmd->add_option("--learner", o->learners, "instance and/or bayes (comma list)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"instance", "bayes"}));
+  cmd->add_option("--approach", o->approaches,
+                  "instance rule(s): nn (nearest neighbour), 1, 2 (thesis NOCD approaches)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"nn", "1", "2"}));
+  cmd->add_option("--good-mode", o->modes, "invariant and/or reference (comma list)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"invariant", "reference"}));
+  cmd->add_option("--bins", o->bins, "GOOD bins per side (comma list)")
+      ->delimiter(',')
+      ->check(CLI::Range(1, 256));
+  cmd->add_option("--runs", o->runs, "repetitions (category orders / fold splits)")
+      ->check(CLI::Range(1, 1000));
   cmd->add_option("--seed", o->seed, "seed of every random choice");
   cmd->add_option("--folds", o->folds, "folds of the cross-validation")->check(CLI::Range(2, 1000));
-  cmd->add_option("--levels", o->levels_mm, "noise sigmas or voxel sizes in mm (comma list; default thesis 6.4.3)")
-      ->delimiter(',')->check(CLI::Range(0.001, 1000.0));
-  cmd->add_option("--tau", o->tau, "teacher: protocol accuracy threshold")->check(CLI::Range(0.0, 0.999));
-  cmd->add_option("--breakpoint", o->breakpoint, "teacher: iterations without reaching tau before giving up")->check(CLI::Range(1, 1000000));
-  cmd->add_option("--threads", o->threads, "worker threads (0: all cores); results do not depend on it");
+  cmd->add_option("--levels", o->levels_mm,
+                  "noise sigmas or voxel sizes in mm (comma list; default thesis 6.4.3)")
+      ->delimiter(',')
+      ->check(CLI::Range(0.001, 1000.0));
+  cmd->add_option("--tau", o->tau, "teacher: protocol accuracy threshold")
+      ->check(CLI::Range(0.0, 0.999));
+  cmd->add_option("--breakpoint", o->breakpoint,
+                  "teacher: iterations without reaching tau before giving up")
+      ->check(CLI::Range(1, 1000000));
+  cmd->add_option("--threads", o->threads,
+                  "worker threads (0: all cores); results do not depend on it");
   cmd->add_option("--out", o->out, "output directory (default evaluation-<protocol>)");
-  cmd->add_option("--cache", o->cache, "descriptor cache directory (default $XDG_CACHE_HOME/orthoflow/descriptors)");
+  cmd->add_option("--cache", o->cache,
+                  "descriptor cache directory (default $XDG_CACHE_HOME/orthoflow/descriptors)");
   cmd->add_flag("--no-cache", o->no_cache, "compute every descriptor, read and write no cache");
   cmd->add_flag("--quiet", o->quiet, "no progress bar");
   cmd->callback([o] { run_evaluate(*o); });

@@ -21,11 +21,14 @@ namespace {
 std::atomic<bool> g_stop_requested{false};
 static_assert(std::atomic<bool>::is_always_lock_free);
 
-extern "C" void on_stop_signal(int /*signal*/) { g_stop_requested.store(true, std::memory_order_relaxed); }
+extern "C" void on_stop_signal(int /*signal*/) {
+  g_stop_requested.store(true, std::memory_order_relaxed);
+}
 
 // Every kind a graph file may name: generic, IPC and tabletop. The tabletop kinds recognise and
 // session_log bind to a learner and a log that live as long as the process (in memory: `graph run`
-// is for running and timing graphs; `orthoflow run` is the command with a durable memory and a summary).
+// is for running and timing graphs; `orthoflow run` is the command with a durable memory and a
+// summary).
 engine::NodeRegistry make_registry() {
   static auto learning = graphs::LearningService::open({});
   static graphs::SessionLog log;
@@ -120,9 +123,11 @@ void add_graph_command(CLI::App& app) {
   });
 
   auto args = std::make_shared<RunArgs>();
-  auto* run = graph->add_subcommand("run", "Run a graph; SIGINT/SIGTERM drain and stop; prints telemetry");
+  auto* run =
+      graph->add_subcommand("run", "Run a graph; SIGINT/SIGTERM drain and stop; prints telemetry");
   run->add_option("FILE", args->file, "graph file")->required();
-  run->add_option("--frames", args->frames, "stop after N frames (0 = until the source ends or a signal)");
+  run->add_option("--frames", args->frames,
+                  "stop after N frames (0 = until the source ends or a signal)");
   run->add_option("--threads", args->threads, "arena threads including this one (0 = all cores)")
       ->check(CLI::Range(0, 1024));
   run->add_option("--json", args->json, "also write telemetry JSON to this file ('-' = stdout)");

@@ -1,6 +1,7 @@
-// `orthoflow info FILE [--json]`: what a .pcd or .ply file holds (fields, size, layout, finite points,
-// bounding box, viewpoint, encoding). The file is read whole with the same readers the engine uses, so
-// a file `info` accepts is a file the pipeline accepts; any reader error is reported as bad input.
+// `orthoflow info FILE [--json]`: what a .pcd or .ply file holds (fields, size, layout, finite
+// points, bounding box, viewpoint, encoding). The file is read whole with the same readers the
+// engine uses, so a file `info` accepts is a file the pipeline accepts; any reader error is
+// reported as bad input.
 #include <array>
 #include <charconv>
 #include <cstdint>
@@ -35,10 +36,10 @@ struct FileSummary {
 /// PCD-style type letter and size, e.g. "F4", "U1" (PLY properties are reported the same way).
 std::string type_name(formats::ScalarType type) {
   using formats::ScalarType;
-  const char letter = type == ScalarType::FLOAT32 || type == ScalarType::FLOAT64 ? 'F'
-                      : type == ScalarType::INT8 || type == ScalarType::INT16 || type == ScalarType::INT32
-                          ? 'I'
-                          : 'U';
+  const char letter =
+      type == ScalarType::FLOAT32 || type == ScalarType::FLOAT64                           ? 'F'
+      : type == ScalarType::INT8 || type == ScalarType::INT16 || type == ScalarType::INT32 ? 'I'
+                                                                                           : 'U';
   return std::string(1, letter) + std::to_string(formats::scalar_size(type));
 }
 
@@ -52,7 +53,10 @@ FileSummary summarize_pcd(std::span<const char> bytes, const std::string& name) 
   if (!header_result) { bad_input(header_result.error()); }
   auto cloud_result = formats::read_pcd_buffer(bytes, name);
   if (!cloud_result) { bad_input(cloud_result.error()); }
-  FileSummary s{"pcd", header_result->version, formats::to_string(header_result->encoding), {},
+  FileSummary s{"pcd",
+                header_result->version,
+                formats::to_string(header_result->encoding),
+                {},
                 std::move(*cloud_result)};
   for (const formats::PointField& f : header_result->fields) {
     s.fields.push_back({{"name", f.name}, {"type", type_name(f.type)}, {"count", f.count}});
@@ -65,17 +69,23 @@ FileSummary summarize_ply(std::span<const char> bytes, const std::string& name) 
   if (!header_result) { bad_input(header_result.error()); }
   auto cloud_result = formats::read_ply_buffer(bytes, name);
   if (!cloud_result) { bad_input(cloud_result.error()); }
-  constexpr std::array<const char*, 3> FORMATS{"ascii", "binary_little_endian", "binary_big_endian"};
-  FileSummary s{"ply", "1.0", FORMATS[static_cast<std::size_t>(header_result->format)], {}, std::move(*cloud_result)};
+  constexpr std::array<const char*, 3> FORMATS{"ascii", "binary_little_endian",
+                                               "binary_big_endian"};
+  FileSummary s{"ply",
+                "1.0",
+                FORMATS[static_cast<std::size_t>(header_result->format)],
+                {},
+                std::move(*cloud_result)};
   for (const formats::PlyElement& e : header_result->elements) {
     if (e.name != "vertex") { continue; }  // faces and other elements are skipped by the reader
     for (const formats::PlyProperty& p : e.properties) {
-      s.fields.push_back({{"name", p.name}, {"type", (p.is_list ? "list " : "") + type_name(p.type)}, {"count", 1}});
+      s.fields.push_back({{"name", p.name},
+                          {"type", (p.is_list ? "list " : "") + type_name(p.type)},
+                          {"count", 1}});
     }
   }
   return s;
 }
-
 
 /// JSON numbers cannot be inf; an empty box (no finite point) is reported as null.
 nlohmann::json box_json(const kernels::CloudStats& stats) {
@@ -86,18 +96,20 @@ nlohmann::json box_json(const kernels::CloudStats& stats) {
 nlohmann::json summary_json(const std::string& path, const FileSummary& s) {
   const kernels::CloudStats stats = kernels::cloud_stats(s.cloud.points());
   const kernels::Viewpoint& vp = s.cloud.info.viewpoint;
-  return {{"file", path},
-          {"format", s.format},
-          {"version", s.version},
-          {"encoding", s.encoding},
-          {"fields", s.fields},
-          {"points", s.cloud.size()},
-          {"width", s.cloud.width()},
-          {"height", s.cloud.height()},
-          {"organized", s.cloud.organized()},
-          {"finite_points", stats.finite},
-          {"bounding_box", box_json(stats)},
-          {"viewpoint", {{"origin", floats_json(vp.origin)}, {"orientation_wxyz", floats_json(vp.orientation)}}}};
+  return {
+      {"file", path},
+      {"format", s.format},
+      {"version", s.version},
+      {"encoding", s.encoding},
+      {"fields", s.fields},
+      {"points", s.cloud.size()},
+      {"width", s.cloud.width()},
+      {"height", s.cloud.height()},
+      {"organized", s.cloud.organized()},
+      {"finite_points", stats.finite},
+      {"bounding_box", box_json(stats)},
+      {"viewpoint",
+       {{"origin", floats_json(vp.origin)}, {"orientation_wxyz", floats_json(vp.orientation)}}}};
 }
 
 std::string list3(const nlohmann::json& values) {
@@ -108,24 +120,24 @@ std::string list3(const nlohmann::json& values) {
 
 void print_text(const nlohmann::json& j) {
   std::cout << "file:        " << j["file"].get<std::string>() << '\n'
-            << "format:      " << j["format"].get<std::string>() << ' ' << j["version"].get<std::string>() << " ("
-            << j["encoding"].get<std::string>() << ")\n"
+            << "format:      " << j["format"].get<std::string>() << ' '
+            << j["version"].get<std::string>() << " (" << j["encoding"].get<std::string>() << ")\n"
             << "fields:     ";
   for (const auto& f : j["fields"]) {
     std::cout << ' ' << f["name"].get<std::string>() << ':' << f["type"].get<std::string>()
               << (f["count"].get<std::uint32_t>() > 1 ? "x" + f["count"].dump() : "");
   }
-  std::cout << "\npoints:      " << j["points"] << "\nlayout:      " << j["width"] << " x " << j["height"]
-            << (j["organized"].get<bool>() ? " (organized)" : " (unorganized)") << "\nfinite:      "
-            << j["finite_points"] << '\n';
+  std::cout << "\npoints:      " << j["points"] << "\nlayout:      " << j["width"] << " x "
+            << j["height"] << (j["organized"].get<bool>() ? " (organized)" : " (unorganized)")
+            << "\nfinite:      " << j["finite_points"] << '\n';
   if (j["bounding_box"].is_null()) {
     std::cout << "bbox:        none (no finite point)\n";
   } else {
-    std::cout << "bbox:        min " << list3(j["bounding_box"]["min"]) << " max " << list3(j["bounding_box"]["max"])
-              << '\n';
+    std::cout << "bbox:        min " << list3(j["bounding_box"]["min"]) << " max "
+              << list3(j["bounding_box"]["max"]) << '\n';
   }
-  std::cout << "viewpoint:   origin " << list3(j["viewpoint"]["origin"]) << " orientation (w x y z) "
-            << list3(j["viewpoint"]["orientation_wxyz"]) << '\n';
+  std::cout << "viewpoint:   origin " << list3(j["viewpoint"]["origin"])
+            << " orientation (w x y z) " << list3(j["viewpoint"]["orientation_wxyz"]) << '\n';
 }
 
 void run_info(const std::string& path, bool as_json) {
@@ -147,7 +159,8 @@ void run_info(const std::string& path, bool as_json) {
 }  // namespace
 
 void add_info_command(CLI::App& app) {
-  auto* cmd = app.add_subcommand("info", "Describe a .pcd or .ply file: fields, size, layout, bounding box");
+  auto* cmd = app.add_subcommand(
+      "info", "Describe a .pcd or .ply file: fields, size, layout, bounding box");
   auto path = std::make_shared<std::string>();
   auto as_json = std::make_shared<bool>(false);
   cmd->add_option("file", *path, "PCD or PLY file")->required();

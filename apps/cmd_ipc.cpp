@@ -1,8 +1,8 @@
 // `orthoflow ipc ...`: operate the iceoryx transport (docs/IPC.md). Exit codes beyond commands.hpp:
 // 20 RouDi unreachable, 21 RouDi's pools do not fit the topics, 22 RouDi lost while running.
+#include <unistd.h>
 #include <csignal>
 #include <cstring>
-#include <unistd.h>
 #include <iostream>
 #include <map>
 #include <thread>
@@ -32,10 +32,14 @@ extern "C" void on_signal(int /*sig*/) { stop_flag.store(true); }
 
 int exit_code_of(const engine::IpcError& error) {
   switch (error.code) {
-    case engine::IpcError::Code::ROUDI_UNREACHABLE: return EXIT_NO_ROUDI;
-    case engine::IpcError::Code::ROUDI_LOST: return EXIT_ROUDI_LOST;
-    case engine::IpcError::Code::NO_FITTING_POOL: return EXIT_POOLS;
-    default: return EXIT_FAILURE_GENERIC;
+    case engine::IpcError::Code::ROUDI_UNREACHABLE:
+      return EXIT_NO_ROUDI;
+    case engine::IpcError::Code::ROUDI_LOST:
+      return EXIT_ROUDI_LOST;
+    case engine::IpcError::Code::NO_FITTING_POOL:
+      return EXIT_POOLS;
+    default:
+      return EXIT_FAILURE_GENERIC;
   }
 }
 
@@ -46,7 +50,8 @@ T value_or_fail(Result<T, engine::IpcError>&& result) {
 }
 
 void start_runtime(const char* role) {
-  auto init = engine::init_ipc_runtime(std::string("orthoflow_") + role + "_" + std::to_string(::getpid()));
+  auto init =
+      engine::init_ipc_runtime(std::string("orthoflow_") + role + "_" + std::to_string(::getpid()));
   if (!init) fail(exit_code_of(init.error()), to_string(init.error()));
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);  // RouDi SIGTERMs its apps when it shuts down
@@ -71,7 +76,9 @@ std::vector<Demand> demands_of(const std::string& file) {
   if (!spec) fail(EXIT_BAD_INPUT, engine::to_string(spec.error()));
   std::vector<Demand> demands;
   for (const auto& node : spec->nodes) {
-    auto get = [&](const char* key, std::int64_t fallback) { return node.params.integer(key, fallback, 0, INT64_MAX); };
+    auto get = [&](const char* key, std::int64_t fallback) {
+      return node.params.integer(key, fallback, 0, INT64_MAX);
+    };
     std::string topic;
     for (const auto& e : node.params.entries()) topic = e.key == "topic" ? e.value : topic;
     if (node.kind == "ipc_publish") {
@@ -79,7 +86,8 @@ std::vector<Demand> demands_of(const std::string& file) {
       const auto bytes = get("max_bytes", static_cast<std::int64_t>(spec->block_bytes));
       const auto history = get("history", 0);
       if (!bytes || !history) fail(EXIT_BAD_INPUT, file + ": bad ipc_publish parameter");
-      demands.push_back({topic, static_cast<std::uint64_t>(*bytes), 8 + static_cast<std::uint64_t>(*history)});
+      demands.push_back(
+          {topic, static_cast<std::uint64_t>(*bytes), 8 + static_cast<std::uint64_t>(*history)});
     } else if (node.kind == "ipc_subscribe") {
       // One chunk per pool block (FrameRef) plus the queue.
       const auto depth = get("depth", 1);
@@ -92,12 +100,15 @@ std::vector<Demand> demands_of(const std::string& file) {
 
 void run_config(const std::vector<std::string>& files) {
   std::uint64_t held = 0;
-  std::map<std::uint64_t, std::uint64_t> pools;  // payload bytes (64-byte multiple + alignment slack) -> count
+  std::map<std::uint64_t, std::uint64_t>
+      pools;  // payload bytes (64-byte multiple + alignment slack) -> count
   std::vector<Demand> publishers;
   for (const auto& file : files) {
     for (auto& d : demands_of(file)) {
-      if (d.bytes > 0) publishers.push_back(d);
-      else held += d.chunks;  // subscribers hold chunks of every publisher they listen to
+      if (d.bytes > 0)
+        publishers.push_back(d);
+      else
+        held += d.chunks;  // subscribers hold chunks of every publisher they listen to
     }
   }
   for (const auto& p : publishers) {
@@ -105,24 +116,29 @@ void run_config(const std::vector<std::string>& files) {
     const std::uint64_t size = (p.bytes + 63) / 64 * 64 + 64;
     pools[size] += p.chunks + (held > 0 ? held : 16);
   }
-  std::cout << "# RouDi pools for " << files.size() << " graph file(s); start: iox-roudi -c THIS_FILE\n"
+  std::cout << "# RouDi pools for " << files.size()
+            << " graph file(s); start: iox-roudi -c THIS_FILE\n"
             << "[general]\nversion = 1\n\n[[segment]]\n\n";
   std::cout << "[[segment.mempool]]\nsize = 1024\ncount = 64\n";
-  for (const auto& [size, count] : pools) std::cout << "\n[[segment.mempool]]\nsize = " << size << "\ncount = " << count << "\n";
+  for (const auto& [size, count] : pools)
+    std::cout << "\n[[segment.mempool]]\nsize = " << size << "\ncount = " << count << "\n";
 }
 
 void run_doctor(const std::string& config, const std::vector<std::string>& files) {
   if (auto probe = engine::probe_roudi(); !probe) fail(EXIT_NO_ROUDI, to_string(probe.error()));
   std::cout << "RouDi: reachable on " << engine::ROUDI_SOCKET_PATH << "\n";
   start_runtime("doctor");
-  auto pools = value_or_fail(config.empty() ? engine::query_roudi_pools(std::chrono::milliseconds(3000))
-                                            : engine::load_roudi_pools(config));
-  for (const auto& pool : pools) std::cout << "pool: " << pool.payload_bytes << " B x " << pool.count << "\n";
+  auto pools =
+      value_or_fail(config.empty() ? engine::query_roudi_pools(std::chrono::milliseconds(3000))
+                                   : engine::load_roudi_pools(config));
+  for (const auto& pool : pools)
+    std::cout << "pool: " << pool.payload_bytes << " B x " << pool.count << "\n";
   bool ok = true;
   for (const auto& file : files) {
     for (const auto& d : demands_of(file)) {
       if (d.bytes == 0) continue;
-      auto fits = engine::check_pool_fits(pools, d.bytes, engine::PAYLOAD_ALIGNMENT, file + " " + d.topic);
+      auto fits =
+          engine::check_pool_fits(pools, d.bytes, engine::PAYLOAD_ALIGNMENT, file + " " + d.topic);
       std::cout << (fits ? "ok:   " : "FAIL: ") << d.topic << " " << d.bytes << " B"
                 << (fits ? "" : " (" + fits.error().message + ")") << "\n";
       ok = ok && fits;
@@ -131,7 +147,8 @@ void run_doctor(const std::string& config, const std::vector<std::string>& files
   if (!ok) throw CLI::RuntimeError(EXIT_POOLS);
 }
 
-void print_sample(std::span<const std::byte> bytes, std::uint64_t sequence, const std::string& type) {
+void print_sample(std::span<const std::byte> bytes, std::uint64_t sequence,
+                  const std::string& type) {
   std::cout << "seq " << sequence << " bytes " << bytes.size() << " type " << type;
   if (type == "frame") {
     auto frame = engine::view_frame(bytes);
@@ -140,8 +157,8 @@ void print_sample(std::span<const std::byte> bytes, std::uint64_t sequence, cons
       return;
     }
     const auto& h = *frame->header;
-    std::cout << " frame " << h.frame_id << " " << h.width << "x" << h.height << " sensor_ns " << h.sensor_stamp_ns
-              << " host_ns " << h.host_stamp_ns << "\n";
+    std::cout << " frame " << h.frame_id << " " << h.width << "x" << h.height << " sensor_ns "
+              << h.sensor_stamp_ns << " host_ns " << h.host_stamp_ns << "\n";
     return;
   }
   engine::ObjectListPayload list;
@@ -150,8 +167,8 @@ void print_sample(std::span<const std::byte> bytes, std::uint64_t sequence, cons
   std::cout << " frame " << list.frame_id << " objects " << count << "\n";
   for (std::uint32_t i = 0; i < count; ++i) {
     const auto& o = list.objects[i];
-    std::cout << "  track " << o.track_id << " label " << o.label.view()
-              << " score " << o.score << (o.unknown ? " unknown" : "") << " centroid " << o.centroid[0] << " "
+    std::cout << "  track " << o.track_id << " label " << o.label.view() << " score " << o.score
+              << (o.unknown ? " unknown" : "") << " centroid " << o.centroid[0] << " "
               << o.centroid[1] << " " << o.centroid[2] << " points " << o.point_count << "\n";
   }
 }
@@ -159,7 +176,8 @@ void print_sample(std::span<const std::byte> bytes, std::uint64_t sequence, cons
 struct EchoArgs {
   std::string topic, type = "frame", policy = "queue";
   std::uint64_t count = 0, depth = 16;
-  std::int64_t timeout_ms = 0, process_ms = 0;  ///< process_ms: simulated work per sample (slow consumer)
+  std::int64_t timeout_ms = 0,
+               process_ms = 0;  ///< process_ms: simulated work per sample (slow consumer)
 };
 
 void run_echo(const EchoArgs& a) {
@@ -171,8 +189,9 @@ void run_echo(const EchoArgs& a) {
   auto payload_type = engine::ipc_payload_type(type);
   if (!payload_type) fail(EXIT_USAGE, payload_type.error());
   start_runtime("echo");
-  engine::IpcSubscriberConfig config{*payload_type, a.policy == "latest" ? engine::IpcPolicy::LATEST : engine::IpcPolicy::QUEUE,
-                                     a.depth, 0};
+  engine::IpcSubscriberConfig config{
+      *payload_type, a.policy == "latest" ? engine::IpcPolicy::LATEST : engine::IpcPolicy::QUEUE,
+      a.depth, 0};
   auto subscriber = value_or_fail(engine::IpcSubscriber::create(topic, config));
   std::uint64_t seen = 0;
   auto last = std::chrono::steady_clock::now();
@@ -188,11 +207,13 @@ void run_echo(const EchoArgs& a) {
       continue;
     }
     if (!engine::probe_roudi()) fail(EXIT_ROUDI_LOST, "RouDi lost while echoing " + topic_text);
-    if (timeout_ms > 0 && std::chrono::steady_clock::now() - last > std::chrono::milliseconds(timeout_ms)) break;
+    if (timeout_ms > 0 &&
+        std::chrono::steady_clock::now() - last > std::chrono::milliseconds(timeout_ms))
+      break;
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
-  std::cout << "received " << seen << " dropped " << subscriber->counters().dropped.load() << " rejected "
-            << subscriber->counters().rejected.load() << std::endl;
+  std::cout << "received " << seen << " dropped " << subscriber->counters().dropped.load()
+            << " rejected " << subscriber->counters().rejected.load() << std::endl;
 }
 
 }  // namespace
@@ -201,31 +222,41 @@ void add_ipc_send(CLI::App& ipc);
 void run_ipc_graph(const std::string& file, std::uint64_t frames);
 
 void add_ipc_command(CLI::App& app) {
-  auto* ipc = app.add_subcommand("ipc", "iceoryx transport: config, doctor, echo, send, run (docs/IPC.md)");
+  auto* ipc =
+      app.add_subcommand("ipc", "iceoryx transport: config, doctor, echo, send, run (docs/IPC.md)");
   ipc->require_subcommand(1);
-  auto* config = ipc->add_subcommand("config", "print a RouDi TOML with pools sized for the graphs' topics");
+  auto* config =
+      ipc->add_subcommand("config", "print a RouDi TOML with pools sized for the graphs' topics");
   static std::vector<std::string> files;
   config->add_option("graphs", files, "graph YAML files")->required()->check(CLI::ExistingFile);
   config->callback([] { run_config(files); });
-  auto* doctor = ipc->add_subcommand("doctor", "RouDi reachable? pools fit the graphs' topics? (exit 20/21)");
+  auto* doctor =
+      ipc->add_subcommand("doctor", "RouDi reachable? pools fit the graphs' topics? (exit 20/21)");
   static std::string roudi_config;
   static std::vector<std::string> doctor_files;
-  doctor->add_option("--config", roudi_config, "RouDi TOML (default: ask RouDi)")->check(CLI::ExistingFile);
+  doctor->add_option("--config", roudi_config, "RouDi TOML (default: ask RouDi)")
+      ->check(CLI::ExistingFile);
   doctor->add_option("graphs", doctor_files, "graph YAML files")->check(CLI::ExistingFile);
   doctor->callback([] { run_doctor(roudi_config, doctor_files); });
   auto* echo = ipc->add_subcommand("echo", "print what flows on TOPIC");
   static EchoArgs echo_args;
   echo->add_option("topic", echo_args.topic, "service/instance/event")->required();
-  echo->add_option("--type", echo_args.type, "frame|objects")->check(CLI::IsMember({"frame", "objects"}));
+  echo->add_option("--type", echo_args.type, "frame|objects")
+      ->check(CLI::IsMember({"frame", "objects"}));
   echo->add_option("--count", echo_args.count, "stop after N samples (0 = endless)");
-  echo->add_option("--timeout-ms", echo_args.timeout_ms, "stop after this long without data (0 = never)");
-  echo->add_option("--policy", echo_args.policy, "latest|queue")->check(CLI::IsMember({"latest", "queue"}));
-  echo->add_option("--depth", echo_args.depth, "queue depth (policy queue)")->check(CLI::Range(1, 256));
-  echo->add_option("--process-ms", echo_args.process_ms, "pause after each sample (simulates a slow consumer)")
+  echo->add_option("--timeout-ms", echo_args.timeout_ms,
+                   "stop after this long without data (0 = never)");
+  echo->add_option("--policy", echo_args.policy, "latest|queue")
+      ->check(CLI::IsMember({"latest", "queue"}));
+  echo->add_option("--depth", echo_args.depth, "queue depth (policy queue)")
+      ->check(CLI::Range(1, 256));
+  echo->add_option("--process-ms", echo_args.process_ms,
+                   "pause after each sample (simulates a slow consumer)")
       ->check(CLI::Range(0, 10000));
   echo->callback([] { run_echo(echo_args); });
   add_ipc_send(*ipc);
-  auto* run = ipc->add_subcommand("run", "run a graph with the IPC node kinds; exit 22 if RouDi is lost");
+  auto* run =
+      ipc->add_subcommand("run", "run a graph with the IPC node kinds; exit 22 if RouDi is lost");
   static std::string graph_file;
   static std::uint64_t frames = 0;
   run->add_option("graph", graph_file, "graph YAML")->required()->check(CLI::ExistingFile);
@@ -249,9 +280,9 @@ void run_ipc_graph(const std::string& file, std::uint64_t frames) {
     const auto* ipc = dynamic_cast<const engine::IpcNode*>(engine.node(node.name));
     if (ipc == nullptr) continue;
     const auto& c = ipc->ipc_counters();
-    std::cout << "ipc " << node.name << " " << ipc->topic() << " samples " << c.samples.load() << " dropped "
-              << c.dropped.load() << " rejected " << c.rejected.load() << " loan_failures " << c.loan_failures.load()
-              << "\n";
+    std::cout << "ipc " << node.name << " " << ipc->topic() << " samples " << c.samples.load()
+              << " dropped " << c.dropped.load() << " rejected " << c.rejected.load()
+              << " loan_failures " << c.loan_failures.load() << "\n";
   }
   std::cout.flush();
   if (engine::ipc_roudi_lost() || (engine::ipc_runtime_ready() && !engine::probe_roudi())) {

@@ -19,9 +19,10 @@ struct SendArgs {
   double period_ms = 10;
   int version = engine::FRAME_VERSION;  ///< override to simulate another build (mismatch tests)
   std::uint64_t history = 0;
-  std::uint64_t max_bytes = 0;          ///< 0 = this frame's size
-  std::string roudi_config;             ///< RouDi TOML; empty = ask RouDi
-  std::int64_t wait_subscribers_ms = 0; ///< wait this long for a subscriber before sending (0 = no wait)
+  std::uint64_t max_bytes = 0;  ///< 0 = this frame's size
+  std::string roudi_config;     ///< RouDi TOML; empty = ask RouDi
+  std::int64_t wait_subscribers_ms =
+      0;  ///< wait this long for a subscriber before sending (0 = no wait)
 };
 
 std::atomic<bool> send_stop{false};
@@ -33,8 +34,9 @@ void fill_frame(std::span<std::byte> chunk, const SendArgs& a, std::uint64_t k) 
   if (!span) return;
   span->header->frame_id = k;
   span->header->sensor_stamp_ns = static_cast<std::int64_t>(k) * 1000;
-  span->header->host_stamp_ns =
-      std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
+  span->header->host_stamp_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                    std::chrono::steady_clock::now().time_since_epoch())
+                                    .count();
   span->header->version = static_cast<std::uint16_t>(a.version);
   for (std::size_t i = 0; i < span->points.x.size(); ++i) {
     span->points.x[i] = static_cast<float>(k + i);
@@ -48,17 +50,19 @@ void wait_for_subscribers(const engine::IpcPublisher& publisher, std::int64_t wa
   const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(wait_ms);
   while (wait_ms > 0 && !publisher.has_subscribers() && !send_stop.load()) {
     if (std::chrono::steady_clock::now() > until) {
-      std::cerr << "orthoflow ipc send: no subscriber on " << publisher.topic() << " within " << wait_ms << " ms\n";
+      std::cerr << "orthoflow ipc send: no subscriber on " << publisher.topic() << " within "
+                << wait_ms << " ms\n";
       throw CLI::RuntimeError(EXIT_FAILURE_GENERIC);
     }
-    if (!engine::probe_roudi()) throw (std::cerr << "orthoflow ipc send: RouDi lost\n", CLI::RuntimeError(22));
+    if (!engine::probe_roudi())
+      throw(std::cerr << "orthoflow ipc send: RouDi lost\n", CLI::RuntimeError(22));
     std::this_thread::sleep_for(std::chrono::milliseconds(2));
   }
 }
 
 int send(const SendArgs& a) {
   auto topic = engine::parse_topic(a.topic);
-  if (!topic) throw (std::cerr << to_string(topic.error()) << "\n", CLI::RuntimeError(EXIT_USAGE));
+  if (!topic) throw(std::cerr << to_string(topic.error()) << "\n", CLI::RuntimeError(EXIT_USAGE));
   const std::size_t bytes = engine::frame_payload_bytes(a.width, a.height, 0);
   if (auto init = engine::init_ipc_runtime("orthoflow_send_" + std::to_string(::getpid())); !init) {
     std::cerr << "orthoflow ipc send: " << to_string(init.error()) << "\n";
@@ -68,13 +72,17 @@ int send(const SendArgs& a) {
   std::signal(SIGTERM, on_send_signal);
   auto pools = a.roudi_config.empty() ? engine::query_roudi_pools(std::chrono::milliseconds(3000))
                                       : engine::load_roudi_pools(a.roudi_config);
-  if (!pools) throw (std::cerr << to_string(pools.error()) << "\n", CLI::RuntimeError(EXIT_FAILURE_GENERIC));
+  if (!pools)
+    throw(std::cerr << to_string(pools.error()) << "\n", CLI::RuntimeError(EXIT_FAILURE_GENERIC));
   engine::IpcPublisherConfig config{{engine::FRAME_TYPE_ID, static_cast<std::uint16_t>(a.version)},
-                                    a.max_bytes > 0 ? a.max_bytes : bytes, a.history, false};
+                                    a.max_bytes > 0 ? a.max_bytes : bytes,
+                                    a.history,
+                                    false};
   auto publisher = engine::IpcPublisher::create(*topic, config, *pools);
   if (!publisher) {
     std::cerr << "orthoflow ipc send: " << to_string(publisher.error()) << "\n";
-    throw CLI::RuntimeError(publisher.error().code == engine::IpcError::Code::NO_FITTING_POOL ? 21 : 1);
+    throw CLI::RuntimeError(publisher.error().code == engine::IpcError::Code::NO_FITTING_POOL ? 21
+                                                                                              : 1);
   }
   wait_for_subscribers(**publisher, a.wait_subscribers_ms);
   std::uint64_t failures = 0;
@@ -90,9 +98,11 @@ int send(const SendArgs& a) {
       fill_frame(*chunk, a, k);
       if (auto sent = (*publisher)->publish(*chunk); !sent) ++failures;
     }
-    std::this_thread::sleep_for(std::chrono::microseconds(static_cast<std::int64_t>(a.period_ms * 1000)));
+    std::this_thread::sleep_for(
+        std::chrono::microseconds(static_cast<std::int64_t>(a.period_ms * 1000)));
   }
-  std::cout << "sent " << (*publisher)->counters().samples.load() << " failed " << failures << std::endl;
+  std::cout << "sent " << (*publisher)->counters().samples.load() << " failed " << failures
+            << std::endl;
   return 0;
 }
 
@@ -100,18 +110,23 @@ int send(const SendArgs& a) {
 
 void add_ipc_send(CLI::App& ipc) {
   static SendArgs args;
-  auto* cmd = ipc.add_subcommand("send", "publish synthetic frames (loaned, filled in place) on TOPIC");
+  auto* cmd =
+      ipc.add_subcommand("send", "publish synthetic frames (loaned, filled in place) on TOPIC");
   cmd->add_option("topic", args.topic, "service/instance/event")->required();
   cmd->add_option("--frames", args.frames, "frames to send");
   cmd->add_option("--width", args.width, "points per row")->check(CLI::Range(1, 4096));
   cmd->add_option("--height", args.height, "rows")->check(CLI::Range(1, 4096));
-  cmd->add_option("--period-ms", args.period_ms, "pause between frames")->check(CLI::Range(0.0, 10000.0));
+  cmd->add_option("--period-ms", args.period_ms, "pause between frames")
+      ->check(CLI::Range(0.0, 10000.0));
   cmd->add_option("--version", args.version, "payload version to write (default: this build's)")
       ->check(CLI::Range(0, 65535));
-  cmd->add_option("--history", args.history, "samples kept for late subscribers")->check(CLI::Range(0, 16));
+  cmd->add_option("--history", args.history, "samples kept for late subscribers")
+      ->check(CLI::Range(0, 16));
   cmd->add_option("--max-bytes", args.max_bytes, "largest payload to check against the pools");
-  cmd->add_option("--config", args.roudi_config, "RouDi TOML the pools come from (default: ask RouDi)");
-  cmd->add_option("--wait-subscribers-ms", args.wait_subscribers_ms, "wait for a subscriber first (exit 1 on timeout)")
+  cmd->add_option("--config", args.roudi_config,
+                  "RouDi TOML the pools come from (default: ask RouDi)");
+  cmd->add_option("--wait-subscribers-ms", args.wait_subscribers_ms,
+                  "wait for a subscriber first (exit 1 on timeout)")
       ->check(CLI::Range(0, 60000));
   cmd->callback([] { send(args); });
 }

@@ -1,7 +1,8 @@
-// `orthoflow memory --db DIR [--learner instance|bayes] [--bins N] [--mode M] [--ct X] <action>`: the
-// perceptual memory (learning/perceptual_memory.hpp, docs/LEARNING.md) from the command line. Actions:
-// teach LABEL FILE.pcd..., ask FILE.pcd [--json], correct LABEL FILE.pcd, list, stats, forget LABEL,
-// export FILE, import FILE, calibrate. Descriptors are GOOD (kernels::compute_good) of each PCD.
+// `orthoflow memory --db DIR [--learner instance|bayes] [--bins N] [--mode M] [--ct X] <action>`:
+// the perceptual memory (learning/perceptual_memory.hpp, docs/LEARNING.md) from the command line.
+// Actions: teach LABEL FILE.pcd..., ask FILE.pcd [--json], correct LABEL FILE.pcd, list, stats,
+// forget LABEL, export FILE, import FILE, calibrate. Descriptors are GOOD (kernels::compute_good)
+// of each PCD.
 #include <cmath>
 #include <iostream>
 #include <memory>
@@ -40,7 +41,8 @@ learning::MemoryConfig config_of(const MemoryOptions& o) {
   learning::MemoryConfig cfg;
   cfg.descriptor = kernels::DescriptorSpec::make_good(
       o.bins, o.mode == "reference" ? kernels::GoodMode::REFERENCE : kernels::GoodMode::INVARIANT);
-  cfg.learner = o.learner == "bayes" ? learning::LearnerKind::BAYES : learning::LearnerKind::INSTANCE;
+  cfg.learner =
+      o.learner == "bayes" ? learning::LearnerKind::BAYES : learning::LearnerKind::INSTANCE;
   if (o.ct) { cfg.instance.classification_threshold = *o.ct; }
   return cfg;
 }
@@ -48,14 +50,16 @@ learning::MemoryConfig config_of(const MemoryOptions& o) {
 learning::PerceptualMemory open_memory(const MemoryOptions& o) {
   auto memory_result = learning::PerceptualMemory::open(o.db, config_of(o));
   if (!memory_result) {
-    const bool bad_input = memory_result.error().code == learning::MemoryError::Code::PARAMS_MISMATCH ||
-                           memory_result.error().code == learning::MemoryError::Code::CORRUPT;
+    const bool bad_input =
+        memory_result.error().code == learning::MemoryError::Code::PARAMS_MISMATCH ||
+        memory_result.error().code == learning::MemoryError::Code::CORRUPT;
     fail(memory_result.error().to_string(), bad_input ? EXIT_BAD_INPUT : EXIT_FAILURE_GENERIC);
   }
   return std::move(memory_result).value();
 }
 
-// The descriptor of one object PCD under the store's specification, as a view record (object frame and bbox).
+// The descriptor of one object PCD under the store's specification, as a view record (object frame
+// and bbox).
 learning::ViewRecord view_of(const std::string& file, const kernels::DescriptorSpec& spec) {
   auto cloud_result = formats::read_pcd(file);
   if (!cloud_result) { fail(cloud_result.error().to_string(), EXIT_BAD_INPUT); }
@@ -71,7 +75,8 @@ learning::ViewRecord view_of(const std::string& file, const kernels::DescriptorS
 }
 
 void check_write(const learning::MemoryError& e) {
-  fail(e.to_string(), e.code == learning::MemoryError::Code::REJECTED || e.code == learning::MemoryError::Code::BAD_IMPORT
+  fail(e.to_string(), e.code == learning::MemoryError::Code::REJECTED ||
+                              e.code == learning::MemoryError::Code::BAD_IMPORT
                           ? EXIT_BAD_INPUT
                           : EXIT_FAILURE_GENERIC);
 }
@@ -82,11 +87,13 @@ void run_teach(const MemoryOptions& o, bool correct) {
   for (const std::string& f : o.files) { views.push_back(view_of(f, memory.config().descriptor)); }
   auto id_result = correct ? memory.correct(o.label, views.front()) : memory.teach(o.label, views);
   if (!id_result) { check_write(id_result.error()); }
-  std::cout << (correct ? "corrected " : "taught ") << o.label << " (category " << *id_result << "): " << views.size()
-            << " view" << (views.size() == 1 ? "" : "s") << ", synced\n";
+  std::cout << (correct ? "corrected " : "taught ") << o.label << " (category " << *id_result
+            << "): " << views.size() << " view" << (views.size() == 1 ? "" : "s") << ", synced\n";
 }
 
-nlohmann::json number_or_null(float v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+nlohmann::json number_or_null(float v) {
+  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
+}
 
 void run_ask(const MemoryOptions& o) {
   const auto memory = open_memory(o);
@@ -104,29 +111,35 @@ void run_ask(const MemoryOptions& o) {
     std::cout << j.dump() << '\n';
     return;
   }
-  std::cout << (p.unknown ? "unknown" : std::string(p.label.view())) << " (score " << p.score << ", best "
-            << p.label.view() << ", runner-up " << p.runner_up.view() << " " << p.runner_up_score << ")\n";
+  std::cout << (p.unknown ? "unknown" : std::string(p.label.view())) << " (score " << p.score
+            << ", best " << p.label.view() << ", runner-up " << p.runner_up.view() << " "
+            << p.runner_up_score << ")\n";
 }
 
 void run_list(const MemoryOptions& o) {
   const auto memory = open_memory(o);
-  for (const learning::CategoryEntry& c : memory.list()) { std::cout << c.id << '\t' << c.label << '\t' << c.views << '\n'; }
+  for (const learning::CategoryEntry& c : memory.list()) {
+    std::cout << c.id << '\t' << c.label << '\t' << c.views << '\n';
+  }
 }
 
 void run_stats(const MemoryOptions& o) {
   const auto memory = open_memory(o);
   const learning::MemoryStats s = memory.stats();
-  const nlohmann::json j{{"categories", s.categories}, {"views", s.views},
+  const nlohmann::json j{{"categories", s.categories},
+                         {"views", s.views},
                          {"descriptor_length", memory.learner().descriptor_length()},
-                         {"learner", memory.learner().kind()}, {"stored_floats", s.learner.stored_floats}};
+                         {"learner", memory.learner().kind()},
+                         {"stored_floats", s.learner.stored_floats}};
   std::cout << j.dump() << '\n';
 }
 
 void run_forget(const MemoryOptions& o) {
   auto memory = open_memory(o);
   if (auto r = memory.forget(o.label); !r) {
-    fail(r.error().to_string(), r.error().code == learning::MemoryError::Code::UNKNOWN_LABEL ? EXIT_BAD_INPUT
-                                                                                             : EXIT_FAILURE_GENERIC);
+    fail(r.error().to_string(), r.error().code == learning::MemoryError::Code::UNKNOWN_LABEL
+                                    ? EXIT_BAD_INPUT
+                                    : EXIT_FAILURE_GENERIC);
   }
   std::cout << "forgot " << o.label << '\n';
 }
@@ -149,12 +162,18 @@ void run_calibrate(const MemoryOptions& o) {
     auto views_result = memory.views_of(c.id);
     if (!views_result) { fail(views_result.error().to_string(), EXIT_BAD_INPUT); }
     std::vector<float>& f = flat.emplace_back();
-    for (const auto& v : *views_result) { f.insert(f.end(), v.descriptor.begin(), v.descriptor.end()); }
+    for (const auto& v : *views_result) {
+      f.insert(f.end(), v.descriptor.begin(), v.descriptor.end());
+    }
   }
-  for (std::size_t k = 0; k < list.size(); ++k) { cats.push_back({list[k].id, list[k].label, {flat[k], length}, {}, 0}); }
+  for (std::size_t k = 0; k < list.size(); ++k) {
+    cats.push_back({list[k].id, list[k].label, {flat[k], length}, {}, 0});
+  }
   learning::InstanceConfig cfg = memory.config().instance;
   const auto calibration_result = learning::calibrate_threshold(cats, cfg);
-  if (!calibration_result) { fail(learning::to_string(calibration_result.error()), EXIT_FAILURE_GENERIC); }
+  if (!calibration_result) {
+    fail(learning::to_string(calibration_result.error()), EXIT_FAILURE_GENERIC);
+  }
   std::cout << nlohmann::json{{"ct", calibration_result->threshold},
                               {"balanced_accuracy", calibration_result->balanced_accuracy},
                               {"known_samples", calibration_result->known_samples},
@@ -166,25 +185,32 @@ void run_calibrate(const MemoryOptions& o) {
 }  // namespace
 
 void add_memory_command(CLI::App& app) {
-  auto* cmd = app.add_subcommand("memory", "Perceptual memory (LevelDB): teach, ask, correct, list, forget, export");
+  auto* cmd = app.add_subcommand(
+      "memory", "Perceptual memory (LevelDB): teach, ask, correct, list, forget, export");
   auto o = std::make_shared<MemoryOptions>();
   cmd->add_option("--db", o->db, "memory directory (created if missing)")->required();
   cmd->add_option("--learner", o->learner, "instance (NOCD, approach I) or bayes (naive Bayes)")
       ->check(CLI::IsMember({"instance", "bayes"}));
   cmd->add_option("--bins", o->bins, "GOOD bins per side; must match the store (default 15)")
       ->check(CLI::Range(std::size_t{1}, kernels::GOOD_MAX_BINS));
-  cmd->add_option("--mode", o->mode, "GOOD frame mode; must match the store")->check(CLI::IsMember({"invariant", "reference"}));
-  cmd->add_option("--ct", o->ct, "classification threshold CT (instance learner; default: never unknown)")
+  cmd->add_option("--mode", o->mode, "GOOD frame mode; must match the store")
+      ->check(CLI::IsMember({"invariant", "reference"}));
+  cmd->add_option("--ct", o->ct,
+                  "classification threshold CT (instance learner; default: never unknown)")
       ->check(CLI::Range(0.0F, 1e9F));
   cmd->require_subcommand(1);
   cmd->fallthrough();
-  auto* teach = cmd->add_subcommand("teach", "Store the views of FILE.pcd... under LABEL (one synced write)");
+  auto* teach =
+      cmd->add_subcommand("teach", "Store the views of FILE.pcd... under LABEL (one synced write)");
   teach->add_option("label", o->label, "category label (1-63 bytes)")->required();
   teach->add_option("files", o->files, "object PCD files")->required()->check(CLI::ExistingFile);
   teach->callback([o] { run_teach(*o, false); });
   auto* correct = cmd->add_subcommand("correct", "Store one view after a wrong answer");
   correct->add_option("label", o->label, "the right label")->required();
-  correct->add_option("file", o->files, "object PCD file")->required()->expected(1)->check(CLI::ExistingFile);
+  correct->add_option("file", o->files, "object PCD file")
+      ->required()
+      ->expected(1)
+      ->check(CLI::ExistingFile);
   correct->callback([o] { run_teach(*o, true); });
   auto* ask = cmd->add_subcommand("ask", "Recognise the object in FILE.pcd");
   ask->add_option("file", o->file, "object PCD file")->required();

@@ -25,15 +25,16 @@ std::atomic<bool> g_run_stop{false};
 extern "C" void on_run_signal(int /*signal*/) { g_run_stop.store(true, std::memory_order_relaxed); }
 
 struct RunOptions {
-  std::string graph;        // empty: the embedded tabletop graph
-  std::string source;       // synthetic:SEED | pcd:DIR
+  std::string graph;   // empty: the embedded tabletop graph
+  std::string source;  // synthetic:SEED | pcd:DIR
   std::uint64_t frames = 0;
   std::string rate;  // empty: the graph's period (30 Hz for tabletop.yaml)
   std::string db;
   std::string learner = "instance";
   // Plain nearest neighbour with an absolute L2 threshold: in a live session a category starts from
-  // a few views of one still object, whose ICD is near zero, which makes NOCD explode for every other
-  // instance (docs/TABLETOP.md measures it). NOCD (--approach 1|2) suits memories of many instances.
+  // a few views of one still object, whose ICD is near zero, which makes NOCD explode for every
+  // other instance (docs/TABLETOP.md measures it). NOCD (--approach 1|2) suits memories of many
+  // instances.
   float ct = graphs::DEFAULT_NN_THRESHOLD;
   std::string approach = "nn";
   std::string json_out;
@@ -60,7 +61,8 @@ void override_source(engine::GraphSpec& spec, const RunOptions& o) {
   engine::NodeSpec* src = find_kind(spec, "synthetic_source");
   if (src == nullptr) src = find_kind(spec, "pcd_source");
   if (src == nullptr) {
-    if (!o.source.empty()) fail("--source needs a graph whose source is synthetic_source or pcd_source", EXIT_USAGE);
+    if (!o.source.empty())
+      fail("--source needs a graph whose source is synthetic_source or pcd_source", EXIT_USAGE);
     return;
   }
   if (o.source.rfind("pcd:", 0) == 0) {
@@ -73,15 +75,18 @@ void override_source(engine::GraphSpec& spec, const RunOptions& o) {
   } else if (!o.source.empty()) {
     fail("--source must be synthetic:SEED or pcd:DIR, not '" + o.source + "'", EXIT_USAGE);
   }
-  if (o.frames > 0 && src->kind == "synthetic_source") src->params.assign("frames", std::to_string(o.frames));
+  if (o.frames > 0 && src->kind == "synthetic_source")
+    src->params.assign("frames", std::to_string(o.frames));
 }
 
 // --publish-objects: an ipc_publish node on the objects_output node's objects port, topic
 // orthoflow/<graph>/objects (the graph then needs a running RouDi, like every IPC graph).
 void add_objects_publisher(engine::GraphSpec& spec) {
-  const auto output = std::find_if(spec.nodes.begin(), spec.nodes.end(),
-                                   [](const engine::NodeSpec& n) { return n.kind == "objects_output"; });
-  if (output == spec.nodes.end()) fail("--publish-objects needs a graph with an objects_output node", EXIT_USAGE);
+  const auto output =
+      std::find_if(spec.nodes.begin(), spec.nodes.end(),
+                   [](const engine::NodeSpec& n) { return n.kind == "objects_output"; });
+  if (output == spec.nodes.end())
+    fail("--publish-objects needs a graph with an objects_output node", EXIT_USAGE);
   engine::NodeSpec publish;
   publish.name = "publish_objects";
   publish.kind = "ipc_publish";
@@ -100,32 +105,36 @@ void override_rate(engine::GraphSpec& spec, const std::string& rate) {
 
 graphs::LearningSettings learning_settings(const engine::GraphSpec& spec, const RunOptions& o) {
   graphs::LearningSettings settings;
-  // The learner reads descriptors of the describe node's specification (and a store must have it too).
+  // The learner reads descriptors of the describe node's specification (and a store must have it
+  // too).
   auto descriptor = graphs::descriptor_of_graph(spec);
   if (!descriptor) fail(descriptor.error(), EXIT_BAD_INPUT);
   settings.memory.descriptor = *descriptor;
-  settings.memory.learner = o.learner == "bayes" ? learning::LearnerKind::BAYES : learning::LearnerKind::INSTANCE;
+  settings.memory.learner =
+      o.learner == "bayes" ? learning::LearnerKind::BAYES : learning::LearnerKind::INSTANCE;
   settings.memory.instance.classification_threshold = o.ct;
   settings.memory.instance.normalise = o.approach != "nn";
-  settings.memory.instance.approach =
-      o.approach == "2" ? learning::NocdApproach::MEAN_DISTANCE : learning::NocdApproach::MIN_DISTANCE;
+  settings.memory.instance.approach = o.approach == "2" ? learning::NocdApproach::MEAN_DISTANCE
+                                                        : learning::NocdApproach::MIN_DISTANCE;
   if (!o.db.empty()) settings.db = o.db;
   return settings;
 }
 
 std::string percent(const graphs::Score& s) {
   char text[64];
-  std::snprintf(text, sizeof text, "%5.1f%% (%llu/%llu)", 100.0 * s.rate(), static_cast<unsigned long long>(s.right),
-                static_cast<unsigned long long>(s.asked));
+  std::snprintf(text, sizeof text, "%5.1f%% (%llu/%llu)", 100.0 * s.rate(),
+                static_cast<unsigned long long>(s.right), static_cast<unsigned long long>(s.asked));
   return text;
 }
 
-void print_summary(const graphs::SessionSummary& s, const engine::GraphStats& stats, const graphs::LearningService& l) {
+void print_summary(const graphs::SessionSummary& s, const engine::GraphStats& stats,
+                   const graphs::LearningService& l) {
   std::cout << "frames:      " << s.frames << " processed, " << stats.total_drops() << " dropped ("
-            << stats.source_drops.load() << " at the source), " << s.frames_with_table << " with a table, "
-            << stats.deadline_misses.load() << " over the period, " << s.frames_with_error << " with an error\n";
-  std::cout << "objects:     " << s.object_views << " object views, " << s.tracks_started << " tracks, " << s.key_views
-            << " key views\n";
+            << stats.source_drops.load() << " at the source), " << s.frames_with_table
+            << " with a table, " << stats.deadline_misses.load() << " over the period, "
+            << s.frames_with_error << " with an error\n";
+  std::cout << "objects:     " << s.object_views << " object views, " << s.tracks_started
+            << " tracks, " << s.key_views << " key views\n";
   std::cout << "recognition: " << s.recognitions << " answers; " << l.teaches() << " views taught";
   if (!s.taught.empty()) {
     std::cout << " (";
@@ -135,14 +144,18 @@ void print_summary(const graphs::SessionSummary& s, const engine::GraphStats& st
   std::cout << "\n";
   if (s.before_teaching.asked + s.after_teaching.asked > 0) {
     std::cout << "accuracy against the ground truth:\n"
-              << "  category not taught yet (Unknown is right): " << percent(s.before_teaching) << "\n"
-              << "  category taught (its label is right):        " << percent(s.after_teaching) << "\n"
-              << "    on instances never taught themselves:      " << percent(s.new_instances) << "\n";
+              << "  category not taught yet (Unknown is right): " << percent(s.before_teaching)
+              << "\n"
+              << "  category taught (its label is right):        " << percent(s.after_teaching)
+              << "\n"
+              << "    on instances never taught themselves:      " << percent(s.new_instances)
+              << "\n";
   }
 }
 
 void run(const RunOptions& o) {
-  auto spec = o.graph.empty() ? engine::parse_graph(std::string(graphs::embedded_tabletop_yaml()), "embedded:tabletop.yaml")
+  auto spec = o.graph.empty() ? engine::parse_graph(std::string(graphs::embedded_tabletop_yaml()),
+                                                    "embedded:tabletop.yaml")
                               : engine::load_graph_file(o.graph);
   if (!spec) fail(engine::to_string(spec.error()), EXIT_BAD_INPUT);
   override_source(*spec, o);
@@ -183,7 +196,8 @@ void run(const RunOptions& o) {
     (*writer)->write(engine::to_json(engine.stats()));
   }
   if (!o.snapshot.empty()) {
-    if (auto drawn = write_scene_snapshot_png(log.snapshot(), o.snapshot); !drawn) fail(drawn.error(), EXIT_FAILURE_GENERIC);
+    if (auto drawn = write_scene_snapshot_png(log.snapshot(), o.snapshot); !drawn)
+      fail(drawn.error(), EXIT_FAILURE_GENERIC);
     std::cout << "snapshot: " << o.snapshot << "\n";
   }
 }
@@ -192,30 +206,41 @@ void run(const RunOptions& o) {
 
 void add_run_command(CLI::App& app) {
   auto o = std::make_shared<RunOptions>();
-  auto* cmd = app.add_subcommand("run", "Run the tabletop graph (default: the embedded synthetic session) and summarise");
+  auto* cmd = app.add_subcommand(
+      "run", "Run the tabletop graph (default: the embedded synthetic session) and summarise");
   cmd->add_option("--graph", o->graph, "graph file (default: the embedded graphs/tabletop.yaml)");
   cmd->add_option("--source", o->source, "synthetic:SEED or pcd:DIR (default: the graph's source)");
   cmd->add_option("--frames", o->frames, "stop after N frames (synthetic: session length)");
-  cmd->add_option("--rate", o->rate, "source rate in Hz, or max (no pacing, no deadline); default: the graph's period")->check([](const std::string& v) {
-    if (v == "max") return std::string();
-    try {
-      return std::stod(v) > 0.0 && std::stod(v) <= 1000.0 ? std::string() : std::string("rate must be in (0, 1000] or max");
-    } catch (...) {
-      return std::string("rate must be a number or max");
-    }
-  });
-  cmd->add_option("--db", o->db, "perceptual memory directory (LevelDB); default: learn in memory only");
-  cmd->add_option("--learner", o->learner, "instance or bayes")->check(CLI::IsMember({"instance", "bayes"}));
-  cmd->add_option("--ct", o->ct, "classification threshold (L2 distance for nn, NOCD for 1|2; docs/TABLETOP.md)")
+  cmd->add_option("--rate", o->rate,
+                  "source rate in Hz, or max (no pacing, no deadline); default: the graph's period")
+      ->check([](const std::string& v) {
+        if (v == "max") return std::string();
+        try {
+          return std::stod(v) > 0.0 && std::stod(v) <= 1000.0
+                     ? std::string()
+                     : std::string("rate must be in (0, 1000] or max");
+        } catch (...) { return std::string("rate must be a number or max"); }
+      });
+  cmd->add_option("--db", o->db,
+                  "perceptual memory directory (LevelDB); default: learn in memory only");
+  cmd->add_option("--learner", o->learner, "instance or bayes")
+      ->check(CLI::IsMember({"instance", "bayes"}));
+  cmd->add_option("--ct", o->ct,
+                  "classification threshold (L2 distance for nn, NOCD for 1|2; docs/TABLETOP.md)")
       ->check(CLI::PositiveNumber);
-  cmd->add_option("--approach", o->approach, "instance learner: 1 (NOCD, min), 2 (NOCD, mean) or nn (plain nearest neighbour, CT on L2)")
+  cmd->add_option("--approach", o->approach,
+                  "instance learner: 1 (NOCD, min), 2 (NOCD, mean) or nn (plain nearest neighbour, "
+                  "CT on L2)")
       ->check(CLI::IsMember({"1", "2", "nn"}));
   cmd->add_option("--json-out", o->json_out, "one JSON line per frame to FILE ('-' = stdout)");
-  cmd->add_option("--snapshot", o->snapshot, "PNG of the last frame with objects, seen from above the table");
+  cmd->add_option("--snapshot", o->snapshot,
+                  "PNG of the last frame with objects, seen from above the table");
   cmd->add_option("--telemetry-json", o->telemetry_json, "engine telemetry as JSON to FILE");
-  cmd->add_flag("--publish-objects", o->publish_objects,
-                "publish every frame's objects on the iceoryx topic orthoflow/<graph>/objects (needs RouDi)");
-  cmd->add_option("--threads", o->threads, "arena threads (0 = all cores)")->check(CLI::Range(0, 1024));
+  cmd->add_flag(
+      "--publish-objects", o->publish_objects,
+      "publish every frame's objects on the iceoryx topic orthoflow/<graph>/objects (needs RouDi)");
+  cmd->add_option("--threads", o->threads, "arena threads (0 = all cores)")
+      ->check(CLI::Range(0, 1024));
   cmd->callback([o] { run(*o); });
 }
 

@@ -1,25 +1,25 @@
 // `orthoflow segment FILE.pcd`: the tabletop chain (kernels/segmentation_chain.hpp) on one frame:
 // the table plane, its inlier count, the clusters, the objects (the clusters that pass C_size and
 // C_edge: what the tabletop graph tracks) and the per-stage timings (median over --repeat runs).
-// Defaults are the PCL baseline's (specs/BASELINES.md); --graph FILE|tabletop takes every segmentation
-// parameter from a graph file's preprocess, table and objects nodes instead, so that the objects are the
-// ones `orthoflow run` finds with that graph. The flags, applied after --graph, mean what the PCL
-// parameters mean: --leaf is VoxelGrid's leaf, --plane-tau/--plane-iters SACSegmentation's distance
-// threshold and max iterations, --cluster-tol and --min-cluster EuclideanClusterExtraction's tolerance
-// and minimum size.
+// Defaults are the PCL baseline's (specs/BASELINES.md); --graph FILE|tabletop takes every
+// segmentation parameter from a graph file's preprocess, table and objects nodes instead, so that
+// the objects are the ones `orthoflow run` finds with that graph. The flags, applied after --graph,
+// mean what the PCL parameters mean: --leaf is VoxelGrid's leaf, --plane-tau/--plane-iters
+// SACSegmentation's distance threshold and max iterations, --cluster-tol and --min-cluster
+// EuclideanClusterExtraction's tolerance and minimum size.
 #include <algorithm>
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <span>
-#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
 #include "apps/commands.hpp"
-#include "formats/pcd_io.hpp"
 #include "engine/graph.hpp"
+#include "formats/pcd_io.hpp"
 #include "graphs/embedded_graphs.hpp"
 #include "graphs/segment_params.hpp"
 #include "kernels/segmentation_chain.hpp"
@@ -64,7 +64,9 @@ nlohmann::json median_timings(const std::vector<kernels::SegmentationTimings>& r
 nlohmann::json stats_json(std::span<const kernels::ClusterStats> list) {
   nlohmann::json out = nlohmann::json::array();
   for (const kernels::ClusterStats& s : list) {
-    out.push_back({{"points", s.points}, {"centroid", triple(s.centroid)}, {"bbox_min", triple(s.bbox_min)},
+    out.push_back({{"points", s.points},
+                   {"centroid", triple(s.centroid)},
+                   {"bbox_min", triple(s.bbox_min)},
                    {"bbox_max", triple(s.bbox_max)}});
   }
   return out;
@@ -76,28 +78,36 @@ nlohmann::json to_json(const kernels::SegmentationResult& seg, const nlohmann::j
           {"inliers", seg.plane.inliers},
           {"clusters", stats_json(seg.clusters)},
           {"objects", stats_json(seg.candidates)},
-          {"rejected", {{"size", c.rejected_size}, {"edge", c.rejected_edge}, {"capacity", c.over_capacity}}},
+          {"rejected",
+           {{"size", c.rejected_size}, {"edge", c.rejected_edge}, {"capacity", c.over_capacity}}},
           {"timings_ms", timings}};
 }
 
 void print_text(const nlohmann::json& j) {
   const auto& n = j["plane"]["normal"];
-  std::printf("plane: normal (%.5f, %.5f, %.5f) d %.5f, %zu inliers\n", n[0].get<double>(), n[1].get<double>(),
-              n[2].get<double>(), j["plane"]["d"].get<double>(), j["inliers"].get<std::size_t>());
-  std::printf("clusters: %zu; objects (C_size, C_edge): %zu\n", j["clusters"].size(), j["objects"].size());
+  std::printf("plane: normal (%.5f, %.5f, %.5f) d %.5f, %zu inliers\n", n[0].get<double>(),
+              n[1].get<double>(), n[2].get<double>(), j["plane"]["d"].get<double>(),
+              j["inliers"].get<std::size_t>());
+  std::printf("clusters: %zu; objects (C_size, C_edge): %zu\n", j["clusters"].size(),
+              j["objects"].size());
   for (std::size_t k = 0; k < j["objects"].size(); ++k) {
     const auto& o = j["objects"][k];
-    std::printf("  %zu: %zu points, centroid (%.4f, %.4f, %.4f), bbox (%.4f, %.4f, %.4f)..(%.4f, %.4f, %.4f)\n", k,
-                o["points"].get<std::size_t>(), o["centroid"][0].get<double>(), o["centroid"][1].get<double>(),
-                o["centroid"][2].get<double>(), o["bbox_min"][0].get<double>(), o["bbox_min"][1].get<double>(),
-                o["bbox_min"][2].get<double>(), o["bbox_max"][0].get<double>(), o["bbox_max"][1].get<double>(),
-                o["bbox_max"][2].get<double>());
+    std::printf(
+        "  %zu: %zu points, centroid (%.4f, %.4f, %.4f), bbox (%.4f, %.4f, %.4f)..(%.4f, %.4f, "
+        "%.4f)\n",
+        k, o["points"].get<std::size_t>(), o["centroid"][0].get<double>(),
+        o["centroid"][1].get<double>(), o["centroid"][2].get<double>(),
+        o["bbox_min"][0].get<double>(), o["bbox_min"][1].get<double>(),
+        o["bbox_min"][2].get<double>(), o["bbox_max"][0].get<double>(),
+        o["bbox_max"][1].get<double>(), o["bbox_max"][2].get<double>());
   }
   const auto& t = j["timings_ms"];
   std::printf(
-      "timings (ms, median): filter %.3f voxel %.3f plane %.3f prism %.3f cluster %.3f candidates %.3f total %.3f\n",
-      t["filter"].get<double>(), t["voxel"].get<double>(), t["plane"].get<double>(), t["prism"].get<double>(),
-      t["cluster"].get<double>(), t["candidates"].get<double>(), t["total"].get<double>());
+      "timings (ms, median): filter %.3f voxel %.3f plane %.3f prism %.3f cluster %.3f candidates "
+      "%.3f total %.3f\n",
+      t["filter"].get<double>(), t["voxel"].get<double>(), t["plane"].get<double>(),
+      t["prism"].get<double>(), t["cluster"].get<double>(), t["candidates"].get<double>(),
+      t["total"].get<double>());
 }
 
 [[noreturn]] void fail(const std::string& message, int code) {
@@ -109,8 +119,10 @@ void print_text(const nlohmann::json& j) {
 /// then the flags given.
 void resolve_params(SegmentOptions& opt) {
   if (!opt.graph.empty()) {
-    auto spec = opt.graph == "tabletop" ? engine::parse_graph(std::string(graphs::embedded_tabletop_yaml()), "tabletop.yaml")
-                                        : engine::load_graph_file(opt.graph);
+    auto spec =
+        opt.graph == "tabletop"
+            ? engine::parse_graph(std::string(graphs::embedded_tabletop_yaml()), "tabletop.yaml")
+            : engine::load_graph_file(opt.graph);
     if (!spec) fail(engine::to_string(spec.error()), EXIT_BAD_INPUT);
     auto seg = graphs::segmentation_of_graph(*spec);
     if (!seg) fail(seg.error(), EXIT_BAD_INPUT);
@@ -154,18 +166,25 @@ void run_segment(SegmentOptions& opt) {
 
 void add_segment_command(CLI::App& app) {
   auto opt = std::make_shared<SegmentOptions>();
-  CLI::App* cmd = app.add_subcommand("segment", "Tabletop segmentation of one PCD frame: plane, objects, timings");
+  CLI::App* cmd = app.add_subcommand(
+      "segment", "Tabletop segmentation of one PCD frame: plane, objects, timings");
   cmd->add_option("FILE", opt->file, "Input .pcd file")->required()->check(CLI::ExistingFile);
   cmd->add_flag("--json", opt->json, "Print one JSON object (plane, inliers, objects, timings_ms)");
-  cmd->add_option("--repeat", opt->repeat, "Runs; timings are the median")->check(CLI::Range(1, 100000));
-  cmd->add_option("--graph", opt->graph,
-                  "Take the segmentation parameters from this graph file ('tabletop': the embedded one)");
-  cmd->add_option("--leaf", opt->leaf, "Voxel leaf in metres (0: no voxel grid)")->check(CLI::Range(0.0, 1e6));
-  cmd->add_option("--plane-tau", opt->plane_tau, "RANSAC inlier distance, metres")->check(CLI::Range(0.0, 1e6));
-  cmd->add_option("--plane-iters", opt->plane_iters, "RANSAC iterations")->check(CLI::Range(1, 100000000));
+  cmd->add_option("--repeat", opt->repeat, "Runs; timings are the median")
+      ->check(CLI::Range(1, 100000));
+  cmd->add_option(
+      "--graph", opt->graph,
+      "Take the segmentation parameters from this graph file ('tabletop': the embedded one)");
+  cmd->add_option("--leaf", opt->leaf, "Voxel leaf in metres (0: no voxel grid)")
+      ->check(CLI::Range(0.0, 1e6));
+  cmd->add_option("--plane-tau", opt->plane_tau, "RANSAC inlier distance, metres")
+      ->check(CLI::Range(0.0, 1e6));
+  cmd->add_option("--plane-iters", opt->plane_iters, "RANSAC iterations")
+      ->check(CLI::Range(1, 100000000));
   cmd->add_option("--cluster-tol", opt->cluster_tol, "Cluster distance tolerance, metres")
       ->check(CLI::Range(1e-6, 1e6));
-  cmd->add_option("--min-cluster", opt->min_cluster, "Minimum points per cluster")->check(CLI::Range(1, 100000000));
+  cmd->add_option("--min-cluster", opt->min_cluster, "Minimum points per cluster")
+      ->check(CLI::Range(1, 100000000));
   cmd->callback([opt] { run_segment(*opt); });
 }
 

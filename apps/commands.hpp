@@ -11,26 +11,35 @@ namespace orthoflow::apps {
 inline constexpr int EXIT_OK = 0;
 inline constexpr int EXIT_FAILURE_GENERIC = 1;  ///< the operation failed (message on stderr)
 inline constexpr int EXIT_BAD_INPUT = 2;        ///< unreadable or malformed input file
-inline constexpr int EXIT_USAGE = 106;          ///< bad arguments (the code CLI11 uses for RequiredError; its own validators exit 105)
+inline constexpr int EXIT_USAGE =
+    106;  ///< bad arguments (the code CLI11 uses for RequiredError; its own validators exit 105)
 
 /// @brief `graph check|dot|run FILE`: validate, draw (Graphviz) and run dataflow graph files.
 void add_graph_command(CLI::App& app);
-/// @brief `describe FILE.pcd`: GOOD descriptor, object frame, bbox, projection order; --json, --png.
+/// @brief `describe FILE.pcd`: GOOD descriptor, object frame, bbox, projection order; --json,
+/// --png.
 void add_describe_command(CLI::App& app);
-/// @brief `synth` and `synth-dataset`: synthetic Kinect tabletop frames and the object-view dataset.
+/// @brief `synth` and `synth-dataset`: synthetic Kinect tabletop frames and the object-view
+/// dataset.
 void add_synth_command(CLI::App& app);
-/// @brief `info FILE [--json]`: fields, point count, layout, finite points, bounding box of a .pcd/.ply file.
+/// @brief `info FILE [--json]`: fields, point count, layout, finite points, bounding box of a
+/// .pcd/.ply file.
 void add_info_command(CLI::App& app);
-/// @brief `segment FILE.pcd`: tabletop plane, objects and per-stage timings; --json, --repeat, PCL-named parameters.
+/// @brief `segment FILE.pcd`: tabletop plane, objects and per-stage timings; --json, --repeat,
+/// PCL-named parameters.
 void add_segment_command(CLI::App& app);
-/// @brief `memory --db DIR teach|ask|correct|list|stats|forget|export|import|calibrate`: the perceptual memory.
+/// @brief `memory --db DIR teach|ask|correct|list|stats|forget|export|import|calibrate`: the
+/// perceptual memory.
 void add_memory_command(CLI::App& app);
 
-/// @brief `ipc config|doctor|echo|send|run`: operate the iceoryx transport (exit codes 20-22 in docs/IPC.md).
+/// @brief `ipc config|doctor|echo|send|run`: operate the iceoryx transport (exit codes 20-22 in
+/// docs/IPC.md).
 void add_ipc_command(CLI::App& app);
 
-/// @brief `run`: the tabletop graph on the embedded session or a given source; summary, JSON lines, snapshot.
+/// @brief `run`: the tabletop graph on the embedded session or a given source; summary, JSON lines,
+/// snapshot.
 void add_run_command(CLI::App& app);
-/// @brief `evaluate --dataset DIR --protocol ...`: cross-validation, simulated teacher, context change, robustness.
+/// @brief `evaluate --dataset DIR --protocol ...`: cross-validation, simulated teacher, context
+/// change, robustness.
 void add_evaluate_command(CLI::App& app);
 }  // namespace orthoflow::apps

@@ -18,8 +18,6 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", ORTHOFLOW_VERSION);
   try {
     app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e);
-  }
+  } catch (const CLI::ParseError& e) { return app.exit(e); }
   return orthoflow::apps::EXIT_OK;
 }

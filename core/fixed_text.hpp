@@ -1,9 +1,9 @@
 #pragma once
 /// @file
-/// @brief Fixed-capacity text: category labels, node names and messages that travel on the frame path,
-/// in pool blocks, in IPC payloads and in learner snapshots. Copying never allocates; the bytes are
-/// inline and always zero-terminated, so the type is trivially copyable and has the same layout on every
-/// platform (a char array of capacity + 1).
+/// @brief Fixed-capacity text: category labels, node names and messages that travel on the frame
+/// path, in pool blocks, in IPC payloads and in learner snapshots. Copying never allocates; the
+/// bytes are inline and always zero-terminated, so the type is trivially copyable and has the same
+/// layout on every platform (a char array of capacity + 1).
 #include <algorithm>
 #include <array>
 #include <cstddef>
@@ -22,7 +22,8 @@ struct FixedText {
   static constexpr std::size_t capacity() noexcept { return CAPACITY; }
   /// @brief The text up to its terminating zero ("" when empty). Never allocates.
   [[nodiscard]] std::string_view view() const noexcept {
-    // chars[CAPACITY] is always zero (assign writes at most CAPACITY bytes), so strnlen stays in bounds.
+    // chars[CAPACITY] is always zero (assign writes at most CAPACITY bytes), so strnlen stays in
+    // bounds.
     return {chars.data(), ::strnlen(chars.data(), chars.size())};
   }
   /// @brief Stores @p s, truncated to CAPACITY bytes (and at an embedded zero, as view() reads it).
@@ -38,7 +39,9 @@ struct FixedText {
     return t;
   }
   [[nodiscard]] bool empty() const noexcept { return chars[0] == '\0'; }
-  [[nodiscard]] bool operator==(const FixedText& other) const noexcept { return view() == other.view(); }
+  [[nodiscard]] bool operator==(const FixedText& other) const noexcept {
+    return view() == other.view();
+  }
 };
 
 /// @brief Longest label or name in bytes (category names, node names in errors).

@@ -27,10 +27,11 @@ template <class E>
 template <class T, class E>
 class [[nodiscard]] Result {
  public:
-  Result(T value) : storage_(std::in_place_index<0>, std::move(value)) {}  // NOLINT: implicit by design
+  Result(T value)
+      : storage_(std::in_place_index<0>, std::move(value)) {}  // NOLINT: implicit by design
   template <class U>
-    requires std::is_constructible_v<E, U>
-  Result(Unexpected<U> error) : storage_(std::in_place_index<1>, std::move(error.error)) {}  // NOLINT
+  requires std::is_constructible_v<E, U> Result(Unexpected<U> error)
+      : storage_(std::in_place_index<1>, std::move(error.error)) {}  // NOLINT
 
   [[nodiscard]] bool has_value() const noexcept { return storage_.index() == 0; }
   explicit operator bool() const noexcept { return has_value(); }
@@ -67,8 +68,8 @@ class [[nodiscard]] Result<void, E> {
  public:
   Result() = default;
   template <class U>
-    requires std::is_constructible_v<E, U>
-  Result(Unexpected<U> error) : error_(std::move(error.error)), failed_(true) {}  // NOLINT
+  requires std::is_constructible_v<E, U> Result(Unexpected<U> error)
+      : error_(std::move(error.error)), failed_(true) {}  // NOLINT
 
   [[nodiscard]] bool has_value() const noexcept { return !failed_; }
   explicit operator bool() const noexcept { return has_value(); }

@@ -1,17 +1,17 @@
 #pragma once
 /// @file
-/// @brief The one seeded random generator of orthoflow: xoshiro256** (Blackman and Vigna 2018) seeded
-/// through SplitMix64, with integer-only range reduction and a transcendental-free normal approximation,
-/// so that a sequence is identical on every platform and compiler (x86-64, aarch64). The standard
-/// library's distributions are not portable across implementations, so orthoflow never uses them where
-/// results must reproduce (RANSAC, synthetic scenes, evaluation folds and orders).
+/// @brief The one seeded random generator of orthoflow: xoshiro256** (Blackman and Vigna 2018)
+/// seeded through SplitMix64, with integer-only range reduction and a transcendental-free normal
+/// approximation, so that a sequence is identical on every platform and compiler (x86-64, aarch64).
+/// The standard library's distributions are not portable across implementations, so orthoflow never
+/// uses them where results must reproduce (RANSAC, synthetic scenes, evaluation folds and orders).
 #include <cstdint>
 
 namespace orthoflow::core {
 
 /// @brief xoshiro256** with portable helpers.
-/// @note A value type: copy it to fork the stream. Not thread-safe; give each thread (or task) its own.
-/// Deterministic: the same seed gives the same sequence everywhere (exact arithmetic only).
+/// @note A value type: copy it to fork the stream. Not thread-safe; give each thread (or task) its
+/// own. Deterministic: the same seed gives the same sequence everywhere (exact arithmetic only).
 class Rng {
  public:
   /// @brief Seeds the 256-bit state from @p seed with SplitMix64 (never all zero).
@@ -32,7 +32,8 @@ class Rng {
     return result;
   }
 
-  /// @brief Uniform integer in [0, n) by Lemire's multiply-shift with rejection (unbiased). @pre n > 0.
+  /// @brief Uniform integer in [0, n) by Lemire's multiply-shift with rejection (unbiased). @pre n
+  /// > 0.
   std::uint64_t below(std::uint64_t n) noexcept {
     // The rejection loop ends with probability >= 1/2 per draw; in practice almost always at once.
     while (true) {

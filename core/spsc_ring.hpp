@@ -1,10 +1,10 @@
 #pragma once
 /// @file
-/// @brief SpscRing<T>: the one bounded single-producer / single-consumer ring of orthoflow (learning
-/// commands and acknowledgements, durable teach jobs, JSON lines). Storage is allocated once at
-/// construction; push and pop are wait-free, never allocate and never block. Several producers share
-/// one ring through a lock of their own around push (see graphs/learning_channel.hpp): the consumer
-/// side stays lock-free.
+/// @brief SpscRing<T>: the one bounded single-producer / single-consumer ring of orthoflow
+/// (learning commands and acknowledgements, durable teach jobs, JSON lines). Storage is allocated
+/// once at construction; push and pop are wait-free, never allocate and never block. Several
+/// producers share one ring through a lock of their own around push (see
+/// graphs/learning_channel.hpp): the consumer side stays lock-free.
 #include <atomic>
 #include <cstddef>
 #include <memory>
@@ -14,13 +14,14 @@
 namespace orthoflow::core {
 
 /// @brief Fixed-capacity FIFO of trivially copyable @p T.
-/// @note Thread safety: at most one thread pushes and at most one thread pops at a time; any thread may
-/// read size(). Indices grow without wrapping in practice (64-bit counters).
+/// @note Thread safety: at most one thread pushes and at most one thread pops at a time; any thread
+/// may read size(). Indices grow without wrapping in practice (64-bit counters).
 template <class T>
 class SpscRing {
  public:
   /// @brief Allocates room for @p capacity elements (start-up only). @pre capacity > 0.
-  explicit SpscRing(std::size_t capacity) : slots_(std::make_unique<T[]>(capacity)), capacity_(capacity) {}
+  explicit SpscRing(std::size_t capacity)
+      : slots_(std::make_unique<T[]>(capacity)), capacity_(capacity) {}
   SpscRing(const SpscRing&) = delete;
   SpscRing& operator=(const SpscRing&) = delete;
 
@@ -33,7 +34,8 @@ class SpscRing {
   /// @brief Producer: appends @p value. @return false (nothing changed) if the ring is full.
   bool try_push(const T& value) noexcept { return try_push_all(std::span<const T>(&value, 1)); }
 
-  /// @brief Producer: appends all of @p values, or none of them if they do not fit. @return whether they did.
+  /// @brief Producer: appends all of @p values, or none of them if they do not fit. @return whether
+  /// they did.
   bool try_push_all(std::span<const T> values) noexcept {
     const std::size_t head = head_.load(std::memory_order_relaxed);
     if (head - tail_.load(std::memory_order_acquire) + values.size() > capacity_) return false;
@@ -42,13 +44,18 @@ class SpscRing {
     return true;
   }
 
-  /// @brief Producer: the next free slot to fill in place (nullptr when full); publish() makes it visible.
+  /// @brief Producer: the next free slot to fill in place (nullptr when full); publish() makes it
+  /// visible.
   [[nodiscard]] T* claim() noexcept {
     const std::size_t head = head_.load(std::memory_order_relaxed);
-    return head - tail_.load(std::memory_order_acquire) == capacity_ ? nullptr : &slots_[head % capacity_];
+    return head - tail_.load(std::memory_order_acquire) == capacity_ ? nullptr
+                                                                     : &slots_[head % capacity_];
   }
-  /// @brief Producer: publishes the slot claim() returned. @pre claim() returned non-null since the last publish.
-  void publish() noexcept { head_.store(head_.load(std::memory_order_relaxed) + 1, std::memory_order_release); }
+  /// @brief Producer: publishes the slot claim() returned. @pre claim() returned non-null since the
+  /// last publish.
+  void publish() noexcept {
+    head_.store(head_.load(std::memory_order_relaxed) + 1, std::memory_order_release);
+  }
 
   /// @brief Consumer: takes the oldest element. @return false if the ring is empty.
   bool try_pop(T& out) noexcept {
@@ -72,7 +79,9 @@ class SpscRing {
     return {std::span<const T>(&slots_[start], first), std::span<const T>(&slots_[0], n - first)};
   }
   /// @brief Consumer: drops everything queued (with no producer pushing at the same time).
-  void clear() noexcept { tail_.store(head_.load(std::memory_order_acquire), std::memory_order_release); }
+  void clear() noexcept {
+    tail_.store(head_.load(std::memory_order_acquire), std::memory_order_release);
+  }
   /// @brief Consumer: frees the @p n oldest elements. @pre n <= size().
   void release(std::size_t n) noexcept {
     tail_.store(tail_.load(std::memory_order_relaxed) + n, std::memory_order_release);

@@ -1,5 +1,6 @@
 // LibusbTransport: device discovery. enumerate() and the lookup open() needs, both over one scan of
-// libusb's device list. Part of the libusb implementation: one of the four files that include libusb.h.
+// libusb's device list. Part of the libusb implementation: one of the four files that include
+// libusb.h.
 #include "drivers/libusb_transport.hpp"
 
 #include <libusb-1.0/libusb.h>
@@ -19,11 +20,13 @@ class DeviceList {
  public:
   static Result<DeviceList, UsbError> get(libusb_context* context) {
     libusb_device** list = nullptr;
-    auto count_result = libusb_call("libusb_get_device_list", [&] { return libusb_get_device_list(context, &list); });
+    auto count_result = libusb_call("libusb_get_device_list",
+                                    [&] { return libusb_get_device_list(context, &list); });
     if (!count_result) return orthoflow::err(count_result.error());
     return DeviceList(list, static_cast<std::size_t>(*count_result));
   }
-  DeviceList(DeviceList&& other) noexcept : list_(std::exchange(other.list_, nullptr)), count_(other.count_) {}
+  DeviceList(DeviceList&& other) noexcept
+      : list_(std::exchange(other.list_, nullptr)), count_(other.count_) {}
   DeviceList(const DeviceList&) = delete;
   DeviceList& operator=(const DeviceList&) = delete;
   DeviceList& operator=(DeviceList&&) = delete;
@@ -39,8 +42,8 @@ class DeviceList {
 };
 
 bool read_descriptor(libusb_device* device, libusb_device_descriptor& descriptor) {
-  auto read_result =
-      libusb_call("libusb_get_device_descriptor", [&] { return libusb_get_device_descriptor(device, &descriptor); });
+  auto read_result = libusb_call("libusb_get_device_descriptor",
+                                 [&] { return libusb_get_device_descriptor(device, &descriptor); });
   return read_result.has_value();
 }
 
@@ -50,7 +53,8 @@ void read_serial(libusb_device* device, std::uint8_t string_index, UsbDeviceInfo
   if (!libusb_call("libusb_open", [&] { return libusb_open(device, &handle); })) return;
   std::array<unsigned char, USB_SERIAL_MAX_BYTES + 1> text{};
   auto length_result = libusb_call("libusb_get_string_descriptor_ascii", [&] {
-    return libusb_get_string_descriptor_ascii(handle, string_index, text.data(), static_cast<int>(text.size()));
+    return libusb_get_string_descriptor_ascii(handle, string_index, text.data(),
+                                              static_cast<int>(text.size()));
   });
   libusb_close(handle);
   if (!length_result) return;
@@ -66,9 +70,11 @@ UsbDeviceInfo describe(libusb_device* device, const libusb_device_descriptor& de
   info.product = descriptor.idProduct;
   info.bcd_device = descriptor.bcdDevice;
   auto depth_result = libusb_call("libusb_get_port_numbers", [&] {
-    return libusb_get_port_numbers(device, info.port_path.data(), static_cast<int>(info.port_path.size()));
+    return libusb_get_port_numbers(device, info.port_path.data(),
+                                   static_cast<int>(info.port_path.size()));
   });
-  if (depth_result) info.port_depth = static_cast<std::uint8_t>(std::min<int>(*depth_result, USB_MAX_PORT_DEPTH));
+  if (depth_result)
+    info.port_depth = static_cast<std::uint8_t>(std::min<int>(*depth_result, USB_MAX_PORT_DEPTH));
   libusb_config_descriptor* config = nullptr;
   if (libusb_call("libusb_get_active_config_descriptor",
                   [&] { return libusb_get_active_config_descriptor(device, &config); })) {
@@ -81,8 +87,8 @@ UsbDeviceInfo describe(libusb_device* device, const libusb_device_descriptor& de
 
 }  // namespace
 
-Result<std::vector<UsbDeviceInfo>, UsbError> LibusbTransport::enumerate(std::uint16_t vendor,
-                                                                        std::optional<std::uint16_t> product) {
+Result<std::vector<UsbDeviceInfo>, UsbError> LibusbTransport::enumerate(
+    std::uint16_t vendor, std::optional<std::uint16_t> product) {
   check_not_in_callback();
   auto list_result = DeviceList::get(context_);
   if (!list_result) return orthoflow::err(list_result.error());
@@ -102,7 +108,9 @@ Result<libusb_device_handle*, UsbError> LibusbTransport::open_native(const UsbDe
   libusb_device* match = nullptr;
   for (libusb_device* device : list_result->devices()) {
     libusb_device_descriptor descriptor{};
-    if (libusb_get_bus_number(device) != wanted.bus || libusb_get_device_address(device) != wanted.address) continue;
+    if (libusb_get_bus_number(device) != wanted.bus ||
+        libusb_get_device_address(device) != wanted.address)
+      continue;
     if (read_descriptor(device, descriptor) && descriptor.idVendor == wanted.vendor &&
         descriptor.idProduct == wanted.product) {
       match = device;

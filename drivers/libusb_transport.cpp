@@ -1,8 +1,8 @@
-// LibusbTransport: the context, open devices, synchronous transfers and the event pump. The rest of the
-// libusb implementation is libusb_discovery.cpp (enumerate, finding a device to open), libusb_iso.cpp
-// (isochronous streams) and libusb_call.cpp (code mapping); only these four files include libusb.h
-// (STYLE rule 16). Every libusb call that can fail goes through libusb_call(); the ones made without it
-// cannot fail (getters, frees, libusb_close, libusb_exit).
+// LibusbTransport: the context, open devices, synchronous transfers and the event pump. The rest of
+// the libusb implementation is libusb_discovery.cpp (enumerate, finding a device to open),
+// libusb_iso.cpp (isochronous streams) and libusb_call.cpp (code mapping); only these four files
+// include libusb.h (STYLE rule 16). Every libusb call that can fail goes through libusb_call(); the
+// ones made without it cannot fail (getters, frees, libusb_close, libusb_exit).
 #include "drivers/libusb_transport.hpp"
 
 #include <libusb-1.0/libusb.h>
@@ -21,8 +21,9 @@ namespace orthoflow::drivers {
 struct LibusbOpenDevice {
   std::uint32_t id = 0;
   libusb_device_handle* handle = nullptr;
-  std::bitset<256> claimed;   // interfaces to release on close
-  std::bitset<256> detached;  // interfaces whose kernel driver is re-attached on close (KINECT_V1.md 2)
+  std::bitset<256> claimed;  // interfaces to release on close
+  std::bitset<256>
+      detached;  // interfaces whose kernel driver is re-attached on close (KINECT_V1.md 2)
 };
 
 void LibusbOpenDeviceDeleter::operator()(LibusbOpenDevice* device) const noexcept { delete device; }
@@ -39,7 +40,8 @@ unsigned int libusb_timeout(UsbTimeout timeout) noexcept {
 }
 
 template <class Call>
-Result<int, UsbError> on_device(const LibusbOpenDevice* device, std::string_view operation, Call&& call) {
+Result<int, UsbError> on_device(const LibusbOpenDevice* device, std::string_view operation,
+                                Call&& call) {
   if (device == nullptr) return orthoflow::err(refused(UsbError::Code::NOT_OPEN, operation));
   return libusb_call(operation, [&] { return call(device->handle); });
 }
@@ -57,7 +59,8 @@ LibusbTransport::LibusbTransport(libusb_context* context, const MonotonicClock* 
     : context_(context), clock_(clock != nullptr ? clock : &steady_clock_) {}
 
 LibusbTransport::~LibusbTransport() {
-  OF_ASSERT(devices_.empty(), "LibusbTransport destroyed while a UsbDeviceHandle of it is still open");
+  OF_ASSERT(devices_.empty(),
+            "LibusbTransport destroyed while a UsbDeviceHandle of it is still open");
   while (!devices_.empty()) close_device(devices_.back()->id);
   // A context with transfers still in flight must outlive them: then it is leaked, not exited.
   if (release_all_streams()) libusb_exit(context_);
@@ -69,14 +72,16 @@ Result<std::unique_ptr<LibusbTransport>, UsbError> LibusbTransport::create() {
   return std::unique_ptr<LibusbTransport>(new LibusbTransport(*context_result, nullptr));
 }
 
-Result<std::unique_ptr<LibusbTransport>, UsbError> LibusbTransport::create(const MonotonicClock& clock) {
+Result<std::unique_ptr<LibusbTransport>, UsbError> LibusbTransport::create(
+    const MonotonicClock& clock) {
   auto context_result = init_context();
   if (!context_result) return orthoflow::err(context_result.error());
   return std::unique_ptr<LibusbTransport>(new LibusbTransport(*context_result, &clock));
 }
 
 void LibusbTransport::check_not_in_callback() const noexcept {
-  OF_ENFORCE(!in_callback_, "LibusbTransport called from an iso callback (libusb cannot nest event handling)");
+  OF_ENFORCE(!in_callback_,
+             "LibusbTransport called from an iso callback (libusb cannot nest event handling)");
 }
 
 LibusbOpenDevice* LibusbTransport::find_device(const UsbDeviceHandle& handle) const noexcept {
@@ -105,7 +110,8 @@ Result<UsbDeviceHandle, UsbError> LibusbTransport::open(const UsbDeviceInfo& wan
 
 void LibusbTransport::close_device(std::uint32_t id) noexcept {
   check_not_in_callback();
-  const auto it = std::find_if(devices_.begin(), devices_.end(), [id](const auto& d) { return d->id == id; });
+  const auto it =
+      std::find_if(devices_.begin(), devices_.end(), [id](const auto& d) { return d->id == id; });
   if (it == devices_.end()) return;
   // Streams first: libusb must not see the handle closed under transfers still in flight.
   stop_streams_of(id);
@@ -117,19 +123,22 @@ void LibusbTransport::close_device(std::uint32_t id) noexcept {
                         [&] { return libusb_release_interface(device.handle, interface_number); });
     }
     if (device.detached.test(i)) {
-      (void)libusb_call("libusb_attach_kernel_driver",
-                        [&] { return libusb_attach_kernel_driver(device.handle, interface_number); });
+      (void)libusb_call("libusb_attach_kernel_driver", [&] {
+        return libusb_attach_kernel_driver(device.handle, interface_number);
+      });
     }
   }
   libusb_close(device.handle);
   devices_.erase(it);
 }
 
-Result<void, UsbError> LibusbTransport::claim_interface(const UsbDeviceHandle& handle, std::uint8_t interface_number) {
+Result<void, UsbError> LibusbTransport::claim_interface(const UsbDeviceHandle& handle,
+                                                        std::uint8_t interface_number) {
   check_not_in_callback();
   LibusbOpenDevice* device = find_device(handle);
-  auto claim_result = on_device(device, "libusb_claim_interface",
-                                [&](libusb_device_handle* h) { return libusb_claim_interface(h, interface_number); });
+  auto claim_result = on_device(device, "libusb_claim_interface", [&](libusb_device_handle* h) {
+    return libusb_claim_interface(h, interface_number);
+  });
   if (claim_result) device->claimed.set(interface_number);
   return as_void(claim_result);
 }
@@ -145,20 +154,22 @@ Result<void, UsbError> LibusbTransport::release_interface(const UsbDeviceHandle&
   return as_void(release_result);
 }
 
-Result<void, UsbError> LibusbTransport::set_alt_setting(const UsbDeviceHandle& handle, std::uint8_t interface_number,
+Result<void, UsbError> LibusbTransport::set_alt_setting(const UsbDeviceHandle& handle,
+                                                        std::uint8_t interface_number,
                                                         std::uint8_t alt_setting) {
   check_not_in_callback();
-  return as_void(on_device(find_device(handle), "libusb_set_interface_alt_setting", [&](libusb_device_handle* h) {
-    return libusb_set_interface_alt_setting(h, interface_number, alt_setting);
-  }));
+  return as_void(on_device(
+      find_device(handle), "libusb_set_interface_alt_setting", [&](libusb_device_handle* h) {
+        return libusb_set_interface_alt_setting(h, interface_number, alt_setting);
+      }));
 }
 
 Result<bool, UsbError> LibusbTransport::kernel_driver_active(const UsbDeviceHandle& handle,
                                                              std::uint8_t interface_number) {
   check_not_in_callback();
-  auto active_result = on_device(find_device(handle), "libusb_kernel_driver_active", [&](libusb_device_handle* h) {
-    return libusb_kernel_driver_active(h, interface_number);
-  });
+  auto active_result = on_device(
+      find_device(handle), "libusb_kernel_driver_active",
+      [&](libusb_device_handle* h) { return libusb_kernel_driver_active(h, interface_number); });
   if (!active_result) return orthoflow::err(active_result.error());
   return *active_result == 1;
 }
@@ -167,9 +178,9 @@ Result<void, UsbError> LibusbTransport::detach_kernel_driver(const UsbDeviceHand
                                                              std::uint8_t interface_number) {
   check_not_in_callback();
   LibusbOpenDevice* device = find_device(handle);
-  auto detach_result = on_device(device, "libusb_detach_kernel_driver", [&](libusb_device_handle* h) {
-    return libusb_detach_kernel_driver(h, interface_number);
-  });
+  auto detach_result = on_device(
+      device, "libusb_detach_kernel_driver",
+      [&](libusb_device_handle* h) { return libusb_detach_kernel_driver(h, interface_number); });
   if (detach_result) device->detached.set(interface_number);
   return as_void(detach_result);
 }
@@ -178,9 +189,9 @@ Result<void, UsbError> LibusbTransport::attach_kernel_driver(const UsbDeviceHand
                                                              std::uint8_t interface_number) {
   check_not_in_callback();
   LibusbOpenDevice* device = find_device(handle);
-  auto attach_result = on_device(device, "libusb_attach_kernel_driver", [&](libusb_device_handle* h) {
-    return libusb_attach_kernel_driver(h, interface_number);
-  });
+  auto attach_result = on_device(
+      device, "libusb_attach_kernel_driver",
+      [&](libusb_device_handle* h) { return libusb_attach_kernel_driver(h, interface_number); });
   if (attach_result) device->detached.reset(interface_number);
   return as_void(attach_result);
 }
@@ -191,14 +202,18 @@ Result<void, UsbError> LibusbTransport::reset_device(const UsbDeviceHandle& hand
                            [](libusb_device_handle* h) { return libusb_reset_device(h); }));
 }
 
-Result<void, UsbError> LibusbTransport::clear_halt(const UsbDeviceHandle& handle, std::uint8_t endpoint) {
+Result<void, UsbError> LibusbTransport::clear_halt(const UsbDeviceHandle& handle,
+                                                   std::uint8_t endpoint) {
   check_not_in_callback();
-  return as_void(on_device(find_device(handle), "libusb_clear_halt",
-                           [&](libusb_device_handle* h) { return libusb_clear_halt(h, endpoint); }));
+  return as_void(on_device(find_device(handle), "libusb_clear_halt", [&](libusb_device_handle* h) {
+    return libusb_clear_halt(h, endpoint);
+  }));
 }
 
-Result<std::size_t, UsbError> LibusbTransport::control(const UsbDeviceHandle& handle, const UsbControlSetup& setup,
-                                                       std::span<std::byte> data, UsbTimeout timeout) {
+Result<std::size_t, UsbError> LibusbTransport::control(const UsbDeviceHandle& handle,
+                                                       const UsbControlSetup& setup,
+                                                       std::span<std::byte> data,
+                                                       UsbTimeout timeout) {
   check_not_in_callback();
   const LibusbOpenDevice* device = find_device(handle);
   if (device != nullptr && (data.size() > 0xFFFF || timeout.count() < 0)) {
@@ -207,26 +222,31 @@ Result<std::size_t, UsbError> LibusbTransport::control(const UsbDeviceHandle& ha
   auto length_result = on_device(device, "libusb_control_transfer", [&](libusb_device_handle* h) {
     return libusb_control_transfer(h, setup.request_type, setup.request, setup.value, setup.index,
                                    reinterpret_cast<unsigned char*>(data.data()),
-                                   static_cast<std::uint16_t>(data.size()), libusb_timeout(timeout));
+                                   static_cast<std::uint16_t>(data.size()),
+                                   libusb_timeout(timeout));
   });
   if (!length_result) return orthoflow::err(length_result.error());
   const bool is_out = (setup.request_type & LIBUSB_ENDPOINT_IN) == 0;
   return finish_transfer(0, *length_result, data.size(), is_out, "libusb_control_transfer");
 }
 
-Result<std::size_t, UsbError> LibusbTransport::bulk(const UsbDeviceHandle& handle, std::uint8_t endpoint,
+Result<std::size_t, UsbError> LibusbTransport::bulk(const UsbDeviceHandle& handle,
+                                                    std::uint8_t endpoint,
                                                     std::span<std::byte> data, UsbTimeout timeout) {
   return sync_transfer(handle, endpoint, data, timeout, true);
 }
 
-Result<std::size_t, UsbError> LibusbTransport::interrupt(const UsbDeviceHandle& handle, std::uint8_t endpoint,
-                                                         std::span<std::byte> data, UsbTimeout timeout) {
+Result<std::size_t, UsbError> LibusbTransport::interrupt(const UsbDeviceHandle& handle,
+                                                         std::uint8_t endpoint,
+                                                         std::span<std::byte> data,
+                                                         UsbTimeout timeout) {
   return sync_transfer(handle, endpoint, data, timeout, false);
 }
 
-Result<std::size_t, UsbError> LibusbTransport::sync_transfer(const UsbDeviceHandle& handle, std::uint8_t endpoint,
-                                                             std::span<std::byte> data, UsbTimeout timeout,
-                                                             bool is_bulk) {
+Result<std::size_t, UsbError> LibusbTransport::sync_transfer(const UsbDeviceHandle& handle,
+                                                             std::uint8_t endpoint,
+                                                             std::span<std::byte> data,
+                                                             UsbTimeout timeout, bool is_bulk) {
   check_not_in_callback();
   const std::string_view operation = is_bulk ? "libusb_bulk_transfer" : "libusb_interrupt_transfer";
   const LibusbOpenDevice* device = find_device(handle);
@@ -238,19 +258,23 @@ Result<std::size_t, UsbError> LibusbTransport::sync_transfer(const UsbDeviceHand
   int transferred = 0;
   auto status_result = on_device(device, operation, [&](libusb_device_handle* h) {
     transferred = 0;
-    return is_bulk ? libusb_bulk_transfer(h, endpoint, bytes, length, &transferred, libusb_timeout(timeout))
-                   : libusb_interrupt_transfer(h, endpoint, bytes, length, &transferred, libusb_timeout(timeout));
+    return is_bulk ? libusb_bulk_transfer(h, endpoint, bytes, length, &transferred,
+                                          libusb_timeout(timeout))
+                   : libusb_interrupt_transfer(h, endpoint, bytes, length, &transferred,
+                                               libusb_timeout(timeout));
   });
   if (!status_result) return orthoflow::err(status_result.error());
-  return finish_transfer(0, transferred, data.size(), (endpoint & LIBUSB_ENDPOINT_IN) == 0, operation);
+  return finish_transfer(0, transferred, data.size(), (endpoint & LIBUSB_ENDPOINT_IN) == 0,
+                         operation);
 }
 
 Result<std::size_t, UsbError> LibusbTransport::max_iso_packet_size(const UsbDeviceHandle& handle,
                                                                    std::uint8_t endpoint) {
   check_not_in_callback();
-  auto size_result = on_device(find_device(handle), "libusb_get_max_iso_packet_size", [&](libusb_device_handle* h) {
-    return libusb_get_max_iso_packet_size(libusb_get_device(h), endpoint);
-  });
+  auto size_result = on_device(
+      find_device(handle), "libusb_get_max_iso_packet_size", [&](libusb_device_handle* h) {
+        return libusb_get_max_iso_packet_size(libusb_get_device(h), endpoint);
+      });
   if (!size_result) return orthoflow::err(size_result.error());
   return static_cast<std::size_t>(*size_result);
 }
@@ -266,7 +290,8 @@ Result<void, UsbError> LibusbTransport::pump(UsbTimeout timeout, int* completed)
 
 Result<void, UsbError> LibusbTransport::handle_events(UsbTimeout timeout) {
   check_not_in_callback();
-  if (timeout.count() < 0) return orthoflow::err(refused(UsbError::Code::INVALID_PARAM, "handle_events"));
+  if (timeout.count() < 0)
+    return orthoflow::err(refused(UsbError::Code::INVALID_PARAM, "handle_events"));
   auto pump_result = pump(timeout, nullptr);
   collect_abandoned_streams();
   return pump_result;

@@ -1,9 +1,9 @@
 #pragma once
 /// @file
-/// @brief The injectable monotonic clock of the USB seam (STYLE rule 16): protocol code (control-reply
-/// polling, the JACO watchdog, the DSP >= 5 double send, frame-arrival timeouts) reads time only through
-/// MonotonicClock, so tests run those timeouts in microseconds with a ManualClock and a simulator can run
-/// its devices on simulated time. Header only.
+/// @brief The injectable monotonic clock of the USB seam (STYLE rule 16): protocol code
+/// (control-reply polling, the JACO watchdog, the DSP >= 5 double send, frame-arrival timeouts)
+/// reads time only through MonotonicClock, so tests run those timeouts in microseconds with a
+/// ManualClock and a simulator can run its devices on simulated time. Header only.
 #include <atomic>
 #include <chrono>
 #include <cstdint>
@@ -46,17 +46,20 @@ class ManualClock final : public MonotonicClock {
   explicit ManualClock(std::int64_t start_ns = 0) noexcept : now_ns_(start_ns) {}
 
   /// @brief The time set so far. @pre none. @note Thread-safe.
-  [[nodiscard]] std::int64_t now_ns() const noexcept override { return now_ns_.load(std::memory_order_acquire); }
+  [[nodiscard]] std::int64_t now_ns() const noexcept override {
+    return now_ns_.load(std::memory_order_acquire);
+  }
 
-  /// @brief Moves the clock forward by @p delta. @pre delta >= 0 (OF_ENFORCE: time never goes back).
+  /// @brief Moves the clock forward by @p delta. @pre delta >= 0 (OF_ENFORCE: time never goes
+  /// back).
   /// @note Thread-safe.
   void advance(std::chrono::nanoseconds delta) noexcept {
     OF_ENFORCE(delta.count() >= 0, "ManualClock::advance: a monotonic clock cannot go backwards");
     now_ns_.fetch_add(delta.count(), std::memory_order_acq_rel);
   }
 
-  /// @brief Sets the clock to @p t_ns. @pre t_ns >= now_ns() (OF_ENFORCE). @note Thread-safe with readers;
-  /// two threads setting it at once is a bug of the test.
+  /// @brief Sets the clock to @p t_ns. @pre t_ns >= now_ns() (OF_ENFORCE). @note Thread-safe with
+  /// readers; two threads setting it at once is a bug of the test.
   void set_ns(std::int64_t t_ns) noexcept {
     OF_ENFORCE(t_ns >= now_ns(), "ManualClock::set_ns: a monotonic clock cannot go backwards");
     now_ns_.store(t_ns, std::memory_order_release);

@@ -4,23 +4,39 @@ namespace orthoflow::drivers {
 
 const char* to_string(UsbError::Code code) noexcept {
   switch (code) {
-    case UsbError::Code::IO: return "io";
-    case UsbError::Code::INVALID_PARAM: return "invalid_param";
-    case UsbError::Code::ACCESS: return "access";
-    case UsbError::Code::NO_DEVICE: return "no_device";
-    case UsbError::Code::NOT_FOUND: return "not_found";
-    case UsbError::Code::BUSY: return "busy";
-    case UsbError::Code::TIMEOUT: return "timeout";
-    case UsbError::Code::OVERFLOW: return "overflow";
-    case UsbError::Code::PIPE: return "pipe";
-    case UsbError::Code::INTERRUPTED: return "interrupted";
-    case UsbError::Code::NO_MEM: return "no_mem";
-    case UsbError::Code::NOT_SUPPORTED: return "not_supported";
-    case UsbError::Code::OTHER: return "other";
-    case UsbError::Code::SHORT_TRANSFER: return "short_transfer";
-    case UsbError::Code::NOT_OPEN: return "not_open";
+    case UsbError::Code::IO:
+      return "io";
+    case UsbError::Code::INVALID_PARAM:
+      return "invalid_param";
+    case UsbError::Code::ACCESS:
+      return "access";
+    case UsbError::Code::NO_DEVICE:
+      return "no_device";
+    case UsbError::Code::NOT_FOUND:
+      return "not_found";
+    case UsbError::Code::BUSY:
+      return "busy";
+    case UsbError::Code::TIMEOUT:
+      return "timeout";
+    case UsbError::Code::OVERFLOW:
+      return "overflow";
+    case UsbError::Code::PIPE:
+      return "pipe";
+    case UsbError::Code::INTERRUPTED:
+      return "interrupted";
+    case UsbError::Code::NO_MEM:
+      return "no_mem";
+    case UsbError::Code::NOT_SUPPORTED:
+      return "not_supported";
+    case UsbError::Code::OTHER:
+      return "other";
+    case UsbError::Code::SHORT_TRANSFER:
+      return "short_transfer";
+    case UsbError::Code::NOT_OPEN:
+      return "not_open";
   }
-  // Only reachable through a cast of an out-of-range value: name it rather than crash in a log line.
+  // Only reachable through a cast of an out-of-range value: name it rather than crash in a log
+  // line.
   return "unknown";
 }
 

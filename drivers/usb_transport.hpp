@@ -1,25 +1,30 @@
 #pragma once
 /// @file
-/// @brief UsbTransport: the one narrow interface Kinect v1 and JACO protocol code talks to (STYLE rule 16,
-/// USB_TESTING.md 3.1). No libusb type appears here, so protocol code compiles and is tested without it.
+/// @brief UsbTransport: the one narrow interface Kinect v1 and JACO protocol code talks to (STYLE
+/// rule 16, USB_TESTING.md 3.1). No libusb type appears here, so protocol code compiles and is
+/// tested without it.
 ///
 /// Implementations:
-/// - LibusbTransport (libusb_transport.hpp): real hardware. Its libusb_*.cpp files alone include libusb.h.
-/// - Planned: FakeTransport (scripted replies), SimTransport (hosts device simulators that implement the
-///   documented protocols on simulated time, USB_TESTING.md 3.3), RecordingTransport and ReplayTransport
-///   (decorators that log, then replay, every call made at this seam, USB_TESTING.md 3.4).
+/// - LibusbTransport (libusb_transport.hpp): real hardware. Its libusb_*.cpp files alone include
+/// libusb.h.
+/// - Planned: FakeTransport (scripted replies), SimTransport (hosts device simulators that
+/// implement the
+///   documented protocols on simulated time, USB_TESTING.md 3.3), RecordingTransport and
+///   ReplayTransport (decorators that log, then replay, every call made at this seam,
+///   USB_TESTING.md 3.4).
 /// What makes those possible:
-/// - handles are opaque ids that each implementation maps to its own state (a decorator maps its ids to
+/// - handles are opaque ids that each implementation maps to its own state (a decorator maps its
+/// ids to
 ///   the handles of the transport it wraps);
 /// - every call is a plain value in, a Result out: one record each for a recorder;
 /// - isochronous data reaches the driver only through a callback run from handle_events(), which a
 ///   simulator or a replay may drive faster than real time;
 /// - each transport carries its clock(): a simulator's clock is its simulated time.
 ///
-/// Threading, for every implementation: a transport and its handles belong to one thread at a time (the
-/// driver's USB thread). Iso callbacks run on that thread, inside handle_events() or inside a synchronous
-/// call (control, bulk, interrupt, stop_iso) that pumps events while it waits. A callback must not call
-/// back into the transport (OF_ENFORCE) and must not throw.
+/// Threading, for every implementation: a transport and its handles belong to one thread at a time
+/// (the driver's USB thread). Iso callbacks run on that thread, inside handle_events() or inside a
+/// synchronous call (control, bulk, interrupt, stop_iso) that pumps events while it waits. A
+/// callback must not call back into the transport (OF_ENFORCE) and must not throw.
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -48,23 +53,27 @@ inline constexpr std::size_t USB_SERIAL_MAX_BYTES = 126;
 struct UsbDeviceInfo {
   std::uint8_t bus = 0;      ///< bus number
   std::uint8_t address = 0;  ///< device address on that bus (changes when the device re-enumerates)
-  std::array<std::uint8_t, USB_MAX_PORT_DEPTH> port_path{};  ///< hub ports from the root, port_depth used
-  std::uint8_t port_depth = 0;      ///< entries of port_path in use; 0 if the platform cannot tell
-  std::uint16_t vendor = 0;         ///< idVendor, e.g. 0x045E (Microsoft), 0x22CD (Kinova)
-  std::uint16_t product = 0;        ///< idProduct, e.g. 0x02AE (Kinect camera)
-  std::uint16_t bcd_device = 0;     ///< bcdDevice: 0x010B marks a Kinect model 1414 camera
-  std::uint8_t interface_count = 0; ///< bNumInterfaces of the active configuration; 0 if unreadable
-  core::FixedText<USB_SERIAL_MAX_BYTES> serial{};  ///< iSerialNumber as ASCII; empty if none or unreadable
+  std::array<std::uint8_t, USB_MAX_PORT_DEPTH>
+      port_path{};               ///< hub ports from the root, port_depth used
+  std::uint8_t port_depth = 0;   ///< entries of port_path in use; 0 if the platform cannot tell
+  std::uint16_t vendor = 0;      ///< idVendor, e.g. 0x045E (Microsoft), 0x22CD (Kinova)
+  std::uint16_t product = 0;     ///< idProduct, e.g. 0x02AE (Kinect camera)
+  std::uint16_t bcd_device = 0;  ///< bcdDevice: 0x010B marks a Kinect model 1414 camera
+  std::uint8_t interface_count =
+      0;  ///< bNumInterfaces of the active configuration; 0 if unreadable
+  core::FixedText<USB_SERIAL_MAX_BYTES>
+      serial{};  ///< iSerialNumber as ASCII; empty if none or unreadable
 
-  /// @brief The used part of port_path. @pre port_depth <= USB_MAX_PORT_DEPTH. @note Views this object.
+  /// @brief The used part of port_path. @pre port_depth <= USB_MAX_PORT_DEPTH. @note Views this
+  /// object.
   [[nodiscard]] std::span<const std::uint8_t> ports() const noexcept {
     OF_ASSERT(port_depth <= USB_MAX_PORT_DEPTH, "UsbDeviceInfo: port_depth out of range");
     return {port_path.data(), port_depth};
   }
 };
 
-/// @brief True if @p a and @p b hang off the same hub port: same bus, same path but for the last port.
-/// Used to match a Kinect's motor and audio functions to its camera (KINECT_V1.md 1).
+/// @brief True if @p a and @p b hang off the same hub port: same bus, same path but for the last
+/// port. Used to match a Kinect's motor and audio functions to its camera (KINECT_V1.md 1).
 /// @pre none. @note Pure; false when either path is unknown (depth 0).
 [[nodiscard]] inline bool same_parent_hub(const UsbDeviceInfo& a, const UsbDeviceInfo& b) noexcept {
   if (a.bus != b.bus || a.port_depth == 0 || a.port_depth != b.port_depth) return false;
@@ -83,48 +92,71 @@ struct UsbControlSetup {
 };
 
 /// @brief How an isochronous packet (or its whole transfer) ended; mirrors libusb_transfer_status.
-enum class UsbPacketStatus : std::uint8_t { COMPLETED, ERROR, TIMED_OUT, CANCELLED, STALL, NO_DEVICE, OVERFLOW };
+enum class UsbPacketStatus : std::uint8_t {
+  COMPLETED,
+  ERROR,
+  TIMED_OUT,
+  CANCELLED,
+  STALL,
+  NO_DEVICE,
+  OVERFLOW
+};
 
 /// @brief Lower-case name, e.g. "no_device". @pre none. @note Never allocates; thread-safe.
 [[nodiscard]] constexpr const char* to_string(UsbPacketStatus status) noexcept {
   switch (status) {
-    case UsbPacketStatus::COMPLETED: return "completed";
-    case UsbPacketStatus::ERROR: return "error";
-    case UsbPacketStatus::TIMED_OUT: return "timed_out";
-    case UsbPacketStatus::CANCELLED: return "cancelled";
-    case UsbPacketStatus::STALL: return "stall";
-    case UsbPacketStatus::NO_DEVICE: return "no_device";
-    case UsbPacketStatus::OVERFLOW: return "overflow";
+    case UsbPacketStatus::COMPLETED:
+      return "completed";
+    case UsbPacketStatus::ERROR:
+      return "error";
+    case UsbPacketStatus::TIMED_OUT:
+      return "timed_out";
+    case UsbPacketStatus::CANCELLED:
+      return "cancelled";
+    case UsbPacketStatus::STALL:
+      return "stall";
+    case UsbPacketStatus::NO_DEVICE:
+      return "no_device";
+    case UsbPacketStatus::OVERFLOW:
+      return "overflow";
   }
   return "unknown";
 }
 
-/// @brief Buffering of one isochronous IN stream, fixed when it starts (Kinect on Linux: 16 x 16 x 1920).
+/// @brief Buffering of one isochronous IN stream, fixed when it starts (Kinect on Linux: 16 x 16 x
+/// 1920).
 struct UsbIsoConfig {
-  std::size_t transfers = 16;             ///< transfers kept in flight
-  std::size_t packets_per_transfer = 16;  ///< iso packets per transfer (one per microframe at high speed)
-  std::size_t packet_size = 1920;         ///< bytes reserved per packet: use max_iso_packet_size()
+  std::size_t transfers = 16;  ///< transfers kept in flight
+  std::size_t packets_per_transfer =
+      16;                          ///< iso packets per transfer (one per microframe at high speed)
+  std::size_t packet_size = 1920;  ///< bytes reserved per packet: use max_iso_packet_size()
 };
 
 /// @brief Called once for every isochronous packet, in completion order.
-/// - `bytes`: the packet's received bytes (bytes.size() == actual_length); empty unless status is COMPLETED.
+/// - `bytes`: the packet's received bytes (bytes.size() == actual_length); empty unless status is
+/// COMPLETED.
 ///   Valid only during the call: copy what you keep. Untrusted device data (STYLE rule 16).
 /// - `actual_length`: bytes received, never more than the configured packet_size.
-/// - `status`: the packet's status, or the whole transfer's when the transfer failed (NO_DEVICE on unplug;
+/// - `status`: the packet's status, or the whole transfer's when the transfer failed (NO_DEVICE on
+/// unplug;
 ///   CANCELLED that stop_iso did not ask for means a disconnect on some platforms).
-/// @note Runs on the transport's thread; must not call the transport or throw. Not called after stop_iso().
-using UsbIsoCallback =
-    std::function<void(std::span<const std::byte> bytes, std::size_t actual_length, UsbPacketStatus status)>;
+/// @note Runs on the transport's thread; must not call the transport or throw. Not called after
+/// stop_iso().
+using UsbIsoCallback = std::function<void(std::span<const std::byte> bytes,
+                                          std::size_t actual_length, UsbPacketStatus status)>;
 
 /// @brief Health counters of one isochronous stream (STYLE rule 16: every loss and retry is data).
 struct UsbIsoStats {
   std::uint64_t transfers_completed = 0;  ///< transfers that came back COMPLETED
-  std::uint64_t transfers_failed = 0;     ///< transfers that came back with any other status (not stop_iso's)
-  std::uint64_t packets_completed = 0;    ///< packets delivered with status COMPLETED (empty ones included)
-  std::uint64_t packets_failed = 0;       ///< packets delivered with any other status
-  std::uint64_t bytes_received = 0;       ///< sum of actual_length over completed packets
-  std::uint64_t resubmit_failures = 0;    ///< transfers that could not be resubmitted and left the stream
-  std::size_t transfers_in_flight = 0;    ///< transfers submitted now
+  std::uint64_t transfers_failed =
+      0;  ///< transfers that came back with any other status (not stop_iso's)
+  std::uint64_t packets_completed =
+      0;  ///< packets delivered with status COMPLETED (empty ones included)
+  std::uint64_t packets_failed = 0;  ///< packets delivered with any other status
+  std::uint64_t bytes_received = 0;  ///< sum of actual_length over completed packets
+  std::uint64_t resubmit_failures =
+      0;  ///< transfers that could not be resubmitted and left the stream
+  std::size_t transfers_in_flight = 0;  ///< transfers submitted now
 };
 
 class UsbTransport;
@@ -152,39 +184,44 @@ class UsbDeviceHandle {
   [[nodiscard]] bool is_open() const noexcept { return transport_ != nullptr; }
   /// @brief The transport-chosen id (never 0 while open; ids are not reused). @pre none.
   [[nodiscard]] std::uint32_t id() const noexcept { return id_; }
-  /// @brief The transport that opened it, or nullptr. Implementations check it before using id(). @pre none.
+  /// @brief The transport that opened it, or nullptr. Implementations check it before using id().
+  /// @pre none.
   [[nodiscard]] const UsbTransport* transport() const noexcept { return transport_; }
 
  private:
   friend class UsbTransport;
-  UsbDeviceHandle(UsbTransport& transport, std::uint32_t id) noexcept : transport_(&transport), id_(id) {}
+  UsbDeviceHandle(UsbTransport& transport, std::uint32_t id) noexcept
+      : transport_(&transport), id_(id) {}
   void reset() noexcept;
 
   UsbTransport* transport_ = nullptr;
   std::uint32_t id_ = 0;
 };
 
-/// @brief A millisecond timeout; 0 means "wait forever" for transfers (libusb's rule), "do not block" for
-/// handle_events(). Frame-path code always passes a finite timeout.
+/// @brief A millisecond timeout; 0 means "wait forever" for transfers (libusb's rule), "do not
+/// block" for handle_events(). Frame-path code always passes a finite timeout.
 using UsbTimeout = std::chrono::milliseconds;
 
 /// @brief The USB seam. Every operation returns a Result and never throws.
-/// @note Not thread-safe: one thread at a time uses a transport and its handles (see the file comment).
+/// @note Not thread-safe: one thread at a time uses a transport and its handles (see the file
+/// comment).
 class UsbTransport {
  public:
   virtual ~UsbTransport() = default;
   UsbTransport(const UsbTransport&) = delete;
   UsbTransport& operator=(const UsbTransport&) = delete;
 
-  /// @brief Devices present now with idVendor @p vendor and, if given, idProduct @p product (JACO matches
-  /// on the vendor only). Reading a serial may briefly open the device; a failure leaves it empty.
+  /// @brief Devices present now with idVendor @p vendor and, if given, idProduct @p product (JACO
+  /// matches on the vendor only). Reading a serial may briefly open the device; a failure leaves it
+  /// empty.
   /// @pre none. @note Allocates; call at start-up or on re-plug, never on the frame path.
   [[nodiscard]] virtual Result<std::vector<UsbDeviceInfo>, UsbError> enumerate(
       std::uint16_t vendor, std::optional<std::uint16_t> product) = 0;
   /// @brief Opens the device @p device describes (matched by bus, address, vendor and product).
   /// @pre none. @return NO_DEVICE if it is no longer there, ACCESS without permission.
   [[nodiscard]] virtual Result<UsbDeviceHandle, UsbError> open(const UsbDeviceInfo& device) = 0;
-  /// @brief Closes @p handle now (as its destructor would) and empties it. @pre none; empty is a no-op.
+  /// @brief Closes @p handle now (as its destructor would) and empties it. @pre none; empty is a
+  /// no-op.
   void close(UsbDeviceHandle& handle) noexcept;
 
   /// @brief Claims interface @p interface_number (released again on close). @pre none.
@@ -193,74 +230,94 @@ class UsbTransport {
   /// @brief Releases a claimed interface. @pre none.
   [[nodiscard]] virtual Result<void, UsbError> release_interface(const UsbDeviceHandle& handle,
                                                                  std::uint8_t interface_number) = 0;
-  /// @brief Selects alternate setting @p alt_setting of a claimed interface (K4W camera: alt 1). @pre none.
+  /// @brief Selects alternate setting @p alt_setting of a claimed interface (K4W camera: alt 1).
+  /// @pre none.
   [[nodiscard]] virtual Result<void, UsbError> set_alt_setting(const UsbDeviceHandle& handle,
                                                                std::uint8_t interface_number,
                                                                std::uint8_t alt_setting) = 0;
   /// @brief True if a kernel driver (gspca_kinect) is bound to the interface. @pre none.
   /// @return NOT_SUPPORTED on platforms without kernel drivers to query.
-  [[nodiscard]] virtual Result<bool, UsbError> kernel_driver_active(const UsbDeviceHandle& handle,
-                                                                    std::uint8_t interface_number) = 0;
+  [[nodiscard]] virtual Result<bool, UsbError> kernel_driver_active(
+      const UsbDeviceHandle& handle, std::uint8_t interface_number) = 0;
   /// @brief Unbinds the kernel driver from the interface; it is re-attached on close. @pre none.
-  [[nodiscard]] virtual Result<void, UsbError> detach_kernel_driver(const UsbDeviceHandle& handle,
-                                                                    std::uint8_t interface_number) = 0;
+  [[nodiscard]] virtual Result<void, UsbError> detach_kernel_driver(
+      const UsbDeviceHandle& handle, std::uint8_t interface_number) = 0;
   /// @brief Re-binds a kernel driver detached before. @pre Its interfaces are released.
-  [[nodiscard]] virtual Result<void, UsbError> attach_kernel_driver(const UsbDeviceHandle& handle,
-                                                                    std::uint8_t interface_number) = 0;
-  /// @brief Port-resets the device (Kinect audio at open). NOT_FOUND means it re-enumerated: close the
-  /// handle, enumerate and open again. @pre No stream is running on it.
+  [[nodiscard]] virtual Result<void, UsbError> attach_kernel_driver(
+      const UsbDeviceHandle& handle, std::uint8_t interface_number) = 0;
+  /// @brief Port-resets the device (Kinect audio at open). NOT_FOUND means it re-enumerated: close
+  /// the handle, enumerate and open again. @pre No stream is running on it.
   [[nodiscard]] virtual Result<void, UsbError> reset_device(const UsbDeviceHandle& handle) = 0;
   /// @brief Clears a halt (stall) on @p endpoint. @pre No transfer is pending on it.
-  [[nodiscard]] virtual Result<void, UsbError> clear_halt(const UsbDeviceHandle& handle, std::uint8_t endpoint) = 0;
+  [[nodiscard]] virtual Result<void, UsbError> clear_halt(const UsbDeviceHandle& handle,
+                                                          std::uint8_t endpoint) = 0;
 
-  /// @brief A control transfer on EP0 moving @p data (wLength = data.size()), IN or OUT by request_type.
-  /// @pre data.size() <= 65535 (else INVALID_PARAM). @return bytes moved: for IN at most data.size(); an
-  /// OUT moving fewer bytes than given is SHORT_TRANSFER. @note Blocks up to @p timeout; pumps events.
+  /// @brief A control transfer on EP0 moving @p data (wLength = data.size()), IN or OUT by
+  /// request_type.
+  /// @pre data.size() <= 65535 (else INVALID_PARAM). @return bytes moved: for IN at most
+  /// data.size(); an OUT moving fewer bytes than given is SHORT_TRANSFER. @note Blocks up to @p
+  /// timeout; pumps events.
   [[nodiscard]] virtual Result<std::size_t, UsbError> control(const UsbDeviceHandle& handle,
                                                               const UsbControlSetup& setup,
-                                                              std::span<std::byte> data, UsbTimeout timeout) = 0;
-  /// @brief A bulk transfer on @p endpoint (bit 7 set = IN) of @p data. @pre data.size() <= INT_MAX.
-  /// @return bytes moved (short IN is success, short OUT is SHORT_TRANSFER). A timeout reports TIMEOUT
-  /// even if part of the data moved. @note Blocks up to @p timeout; pumps events.
-  [[nodiscard]] virtual Result<std::size_t, UsbError> bulk(const UsbDeviceHandle& handle, std::uint8_t endpoint,
-                                                           std::span<std::byte> data, UsbTimeout timeout) = 0;
+                                                              std::span<std::byte> data,
+                                                              UsbTimeout timeout) = 0;
+  /// @brief A bulk transfer on @p endpoint (bit 7 set = IN) of @p data. @pre data.size() <=
+  /// INT_MAX.
+  /// @return bytes moved (short IN is success, short OUT is SHORT_TRANSFER). A timeout reports
+  /// TIMEOUT even if part of the data moved. @note Blocks up to @p timeout; pumps events.
+  [[nodiscard]] virtual Result<std::size_t, UsbError> bulk(const UsbDeviceHandle& handle,
+                                                           std::uint8_t endpoint,
+                                                           std::span<std::byte> data,
+                                                           UsbTimeout timeout) = 0;
   /// @brief An interrupt transfer, same contract as bulk() (JACO: 64-byte packets on 0x02 / 0x82).
   [[nodiscard]] virtual Result<std::size_t, UsbError> interrupt(const UsbDeviceHandle& handle,
-                                                                std::uint8_t endpoint, std::span<std::byte> data,
+                                                                std::uint8_t endpoint,
+                                                                std::span<std::byte> data,
                                                                 UsbTimeout timeout) = 0;
 
-  /// @brief Bytes @p endpoint moves per (micro)frame, transactions included (Kinect: 2 x 960 = 1920).
+  /// @brief Bytes @p endpoint moves per (micro)frame, transactions included (Kinect: 2 x 960 =
+  /// 1920).
   /// @pre none. @return NOT_FOUND if the active configuration has no such endpoint.
-  [[nodiscard]] virtual Result<std::size_t, UsbError> max_iso_packet_size(const UsbDeviceHandle& handle,
-                                                                          std::uint8_t endpoint) = 0;
-  /// @brief Starts streaming isochronous IN @p endpoint: allocates and submits config.transfers transfers
-  /// and keeps resubmitting them as they complete; @p on_packet sees every packet. Submit first, then
-  /// write the device's start registers (KINECT_V1.md 5). @pre An IN endpoint, every config field >= 1,
-  /// a non-empty callback (else INVALID_PARAM). @return BUSY if the endpoint already streams.
+  [[nodiscard]] virtual Result<std::size_t, UsbError> max_iso_packet_size(
+      const UsbDeviceHandle& handle, std::uint8_t endpoint) = 0;
+  /// @brief Starts streaming isochronous IN @p endpoint: allocates and submits config.transfers
+  /// transfers and keeps resubmitting them as they complete; @p on_packet sees every packet. Submit
+  /// first, then write the device's start registers (KINECT_V1.md 5). @pre An IN endpoint, every
+  /// config field >= 1, a non-empty callback (else INVALID_PARAM). @return BUSY if the endpoint
+  /// already streams.
   /// @note Allocates all buffers here, never later.
-  [[nodiscard]] virtual Result<void, UsbError> start_iso(const UsbDeviceHandle& handle, std::uint8_t endpoint,
-                                                         const UsbIsoConfig& config, UsbIsoCallback on_packet) = 0;
-  /// @brief Stops the stream: no callback runs after this call begins; cancels every transfer and waits
-  /// (pumping events, bounded) until all are back, then frees them. @pre none.
-  /// @return NOT_FOUND if the endpoint does not stream; TIMEOUT if transfers never came back (then they
-  /// are deliberately leaked, never freed under the host controller).
-  [[nodiscard]] virtual Result<void, UsbError> stop_iso(const UsbDeviceHandle& handle, std::uint8_t endpoint) = 0;
-  /// @brief The stream's health counters. @pre none. @return NOT_FOUND if the endpoint does not stream.
+  [[nodiscard]] virtual Result<void, UsbError> start_iso(const UsbDeviceHandle& handle,
+                                                         std::uint8_t endpoint,
+                                                         const UsbIsoConfig& config,
+                                                         UsbIsoCallback on_packet) = 0;
+  /// @brief Stops the stream: no callback runs after this call begins; cancels every transfer and
+  /// waits (pumping events, bounded) until all are back, then frees them. @pre none.
+  /// @return NOT_FOUND if the endpoint does not stream; TIMEOUT if transfers never came back (then
+  /// they are deliberately leaked, never freed under the host controller).
+  [[nodiscard]] virtual Result<void, UsbError> stop_iso(const UsbDeviceHandle& handle,
+                                                        std::uint8_t endpoint) = 0;
+  /// @brief The stream's health counters. @pre none. @return NOT_FOUND if the endpoint does not
+  /// stream.
   [[nodiscard]] virtual Result<UsbIsoStats, UsbError> iso_stats(const UsbDeviceHandle& handle,
                                                                 std::uint8_t endpoint) const = 0;
 
-  /// @brief The event pump: completes transfers and runs their callbacks, blocking up to @p timeout while
-  /// nothing happens (0 = only what is pending). Never busy-polls. @pre timeout >= 0 (else INVALID_PARAM).
+  /// @brief The event pump: completes transfers and runs their callbacks, blocking up to @p timeout
+  /// while nothing happens (0 = only what is pending). Never busy-polls. @pre timeout >= 0 (else
+  /// INVALID_PARAM).
   [[nodiscard]] virtual Result<void, UsbError> handle_events(UsbTimeout timeout) = 0;
 
-  /// @brief The clock protocol code must use for its own timeouts and watchdogs with this transport.
+  /// @brief The clock protocol code must use for its own timeouts and watchdogs with this
+  /// transport.
   /// @pre none. @note Thread-safe to read; outlives the transport's handles.
   [[nodiscard]] virtual const MonotonicClock& clock() const noexcept = 0;
 
  protected:
   UsbTransport() = default;
-  /// @brief For implementations: a handle of this transport carrying @p id. @pre id != 0, not reused.
-  [[nodiscard]] UsbDeviceHandle make_handle(std::uint32_t id) noexcept { return UsbDeviceHandle(*this, id); }
+  /// @brief For implementations: a handle of this transport carrying @p id. @pre id != 0, not
+  /// reused.
+  [[nodiscard]] UsbDeviceHandle make_handle(std::uint32_t id) noexcept {
+    return UsbDeviceHandle(*this, id);
+  }
   /// @brief For implementations: releases everything device @p id holds. Unknown ids are ignored.
   /// @pre Not called from an iso callback.
   virtual void close_device(std::uint32_t id) noexcept = 0;

@@ -22,7 +22,8 @@ namespace flow = tbb::flow;
 namespace {
 
 std::int64_t now_ns() noexcept {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::steady_clock::now().time_since_epoch())
       .count();
 }
 
@@ -105,12 +106,14 @@ struct Engine::Impl {
       rt->stats->name = gr.spec.nodes[i].name;
       rt->stats->sink = rt->node->outputs().empty();
       rt->policy = gr.spec.nodes[i].policy;
-      rt->deadline_ns = gr.spec.nodes[i].deadline_ns > 0 ? gr.spec.nodes[i].deadline_ns : gr.spec.period_ns;
+      rt->deadline_ns =
+          gr.spec.nodes[i].deadline_ns > 0 ? gr.spec.nodes[i].deadline_ns : gr.spec.period_ns;
       rt->out.resize(rt->node->outputs().size());
       runtimes.push_back(std::move(rt));
     }
     for (const auto& e : gr.edges) {
-      runtimes[e.from_node]->out[e.from_port].push_back({e.to_node, static_cast<std::uint32_t>(e.to_port)});
+      runtimes[e.from_node]->out[e.from_port].push_back(
+          {e.to_node, static_cast<std::uint32_t>(e.to_port)});
     }
     arena.execute([this] { build_flow(); });
   }
@@ -177,8 +180,9 @@ struct Engine::Impl {
       source_ended = true;
       return;
     }
-    next_tick_ns.store(std::max(next_tick_ns.load(std::memory_order_relaxed) + graph.spec.period_ns, now_ns()),
-                       std::memory_order_relaxed);
+    next_tick_ns.store(
+        std::max(next_tick_ns.load(std::memory_order_relaxed) + graph.spec.period_ns, now_ns()),
+        std::memory_order_relaxed);
     NodeStats& source_stats = *runtimes[graph.source]->stats;
     source_stats.processed.fetch_add(1, std::memory_order_relaxed);
     source_stats.service.record(now_ns() - start);
@@ -216,8 +220,10 @@ struct Engine::Impl {
       lock.unlock();
       // Sleep in short slices so a stop request is seen within ~2 ms.
       while (now_ns() < next_tick_ns.load(std::memory_order_relaxed) && !should_stop()) {
-        const std::int64_t left_us = (next_tick_ns.load(std::memory_order_relaxed) - now_ns()) / 1000 + 1;
-        std::this_thread::sleep_for(std::chrono::microseconds(std::min<std::int64_t>(2000, left_us)));
+        const std::int64_t left_us =
+            (next_tick_ns.load(std::memory_order_relaxed) - now_ns()) / 1000 + 1;
+        std::this_thread::sleep_for(
+            std::chrono::microseconds(std::min<std::int64_t>(2000, left_us)));
       }
       dispatch->try_put(token);
       g->release_wait();
@@ -231,8 +237,8 @@ struct Engine::Impl {
       slots[message.slot].pending.fetch_add(1, std::memory_order_relaxed);
       if (to.policy == Policy::LATEST) {
         std::uint64_t seen = to.newest.load(std::memory_order_relaxed);
-        while (message.frame_id > seen && !to.newest.compare_exchange_weak(seen, message.frame_id)) {
-        }
+        while (message.frame_id > seen &&
+               !to.newest.compare_exchange_weak(seen, message.frame_id)) {}
       }
       Message copy = message;
       copy.port = t.port;
@@ -254,7 +260,8 @@ struct Engine::Impl {
       // downstream still see exactly one message per frame.
       rt.stats->skipped.fetch_add(1, std::memory_order_relaxed);
       for (std::size_t port = 0; port < rt.out.size(); ++port) send(rt, port, m);
-    } else if (rt.policy == Policy::LATEST && m.frame_id < rt.newest.load(std::memory_order_relaxed)) {
+    } else if (rt.policy == Policy::LATEST &&
+               m.frame_id < rt.newest.load(std::memory_order_relaxed)) {
       rt.stats->dropped.fetch_add(1, std::memory_order_relaxed);  // a newer frame is already queued
       forward_tombstone(rt, m);
     } else {
@@ -262,14 +269,14 @@ struct Engine::Impl {
       // Concurrency gauge: shows per-object work really runs in parallel (telemetry, tests).
       const std::uint32_t running = rt.stats->running.fetch_add(1, std::memory_order_relaxed) + 1;
       std::uint32_t seen = rt.stats->max_running.load(std::memory_order_relaxed);
-      while (running > seen && !rt.stats->max_running.compare_exchange_weak(seen, running)) {
-      }
+      while (running > seen && !rt.stats->max_running.compare_exchange_weak(seen, running)) {}
       rt.node->process(m, router);
       rt.stats->running.fetch_sub(1, std::memory_order_relaxed);
       const std::int64_t end = now_ns();
       rt.stats->processed.fetch_add(1, std::memory_order_relaxed);
       rt.stats->service.record(end - start);
-      if (rt.deadline_ns > 0 && end - start > rt.deadline_ns) rt.stats->deadline_misses.fetch_add(1);
+      if (rt.deadline_ns > 0 && end - start > rt.deadline_ns)
+        rt.stats->deadline_misses.fetch_add(1);
       if (rt.stats->sink) rt.stats->age.record(end - m.stamp_ns);
     }
     // TBB hands the body a reference to its own non-const copy (held by the task or buffer);
@@ -285,7 +292,8 @@ struct Engine::Impl {
     if (slot.pending.fetch_sub(1, std::memory_order_acq_rel) != 1) return;
     const std::int64_t latency = now_ns() - slot.stamp_ns;
     stats.frame_latency.record(latency);
-    if (graph.spec.period_ns > 0 && latency > graph.spec.period_ns) stats.deadline_misses.fetch_add(1);
+    if (graph.spec.period_ns > 0 && latency > graph.spec.period_ns)
+      stats.deadline_misses.fetch_add(1);
     stats.frames_done.fetch_add(1, std::memory_order_relaxed);
     Message token;
     token.slot = slot_index;
@@ -331,7 +339,9 @@ StopReason Engine::run(const RunOptions& options) {
   return impl_->reason;
 }
 
-void Engine::request_stop() noexcept { impl_->stop_requested.store(true, std::memory_order_relaxed); }
+void Engine::request_stop() noexcept {
+  impl_->stop_requested.store(true, std::memory_order_relaxed);
+}
 
 const GraphStats& Engine::stats() const noexcept { return impl_->stats; }
 

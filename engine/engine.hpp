@@ -1,9 +1,9 @@
 #pragma once
 /// @file
 /// @brief Engine: runs a validated Graph on a oneTBB flow graph inside one task_arena it owns.
-/// Admission (max_in_flight tokens, <= pool blocks) -> source -> nodes; stateless nodes run with unlimited
-/// concurrency, stateful ones serially; `ordered` nodes sit behind a sequencer keyed by frame id;
-/// `latest` nodes skip stale frames. See engine/README.md for the model.
+/// Admission (max_in_flight tokens, <= pool blocks) -> source -> nodes; stateless nodes run with
+/// unlimited concurrency, stateful ones serially; `ordered` nodes sit behind a sequencer keyed by
+/// frame id; `latest` nodes skip stale frames. See engine/README.md for the model.
 #include <atomic>
 #include <cstdint>
 #include <memory>
@@ -21,8 +21,8 @@ struct EngineConfig {
 
 /// @brief Per-run settings.
 struct RunOptions {
-  std::uint64_t max_frames = 0;               ///< stop the source after this many frames (0 = no limit)
-  const std::atomic<bool>* stop = nullptr;    ///< external stop flag (e.g. set by a signal handler)
+  std::uint64_t max_frames = 0;  ///< stop the source after this many frames (0 = no limit)
+  const std::atomic<bool>* stop = nullptr;  ///< external stop flag (e.g. set by a signal handler)
 };
 
 /// @brief Why run() returned. In every case all in-flight frames were drained first.

@@ -40,12 +40,14 @@ Offsets offsets(std::size_t n, std::uint32_t fields) noexcept {
 template <class T, class Byte>
 std::span<T> array_at(Byte* base, std::size_t offset, std::size_t n) noexcept {
   if (offset == 0) { return {}; }
-  return {reinterpret_cast<T*>(base + offset), n};  // NOLINT: the layout is 64-byte aligned by construction
+  return {reinterpret_cast<T*>(base + offset),
+          n};  // NOLINT: the layout is 64-byte aligned by construction
 }
 
 }  // namespace
 
-std::size_t frame_payload_bytes(std::uint32_t width, std::uint32_t height, std::uint32_t fields) noexcept {
+std::size_t frame_payload_bytes(std::uint32_t width, std::uint32_t height,
+                                std::uint32_t fields) noexcept {
   const std::uint64_t n = std::uint64_t{width} * height;
   if (n > MAX_POINTS) { return 0; }
   return offsets(static_cast<std::size_t>(n), fields).end;
@@ -55,20 +57,28 @@ std::string FrameError::to_string() const {
   const std::string e = std::to_string(expected);
   const std::string f = std::to_string(found);
   switch (code) {
-    case Code::TOO_SMALL: return "frame payload: " + f + " bytes, the frame needs " + e;
-    case Code::MISALIGNED: return "frame payload: not 64-byte aligned";
-    case Code::WRONG_TYPE: return "frame payload: type id " + f + " is not a frame (" + e + ")";
-    case Code::WRONG_VERSION: return "frame payload: version " + f + ", this build reads " + e;
-    case Code::BAD_SHAPE: return "frame payload: " + f + " points is not a valid shape (at most " + e + ")";
-    case Code::SIZE_MISMATCH: return "frame payload: header says " + f + " bytes, the shape needs " + e;
+    case Code::TOO_SMALL:
+      return "frame payload: " + f + " bytes, the frame needs " + e;
+    case Code::MISALIGNED:
+      return "frame payload: not 64-byte aligned";
+    case Code::WRONG_TYPE:
+      return "frame payload: type id " + f + " is not a frame (" + e + ")";
+    case Code::WRONG_VERSION:
+      return "frame payload: version " + f + ", this build reads " + e;
+    case Code::BAD_SHAPE:
+      return "frame payload: " + f + " points is not a valid shape (at most " + e + ")";
+    case Code::SIZE_MISMATCH:
+      return "frame payload: header says " + f + " bytes, the shape needs " + e;
   }
   return "frame payload: unknown error";
 }
 
-Result<FrameSpan, FrameError> layout_frame(std::span<std::byte> bytes, std::uint32_t width, std::uint32_t height,
-                                           std::uint32_t fields) noexcept {
+Result<FrameSpan, FrameError> layout_frame(std::span<std::byte> bytes, std::uint32_t width,
+                                           std::uint32_t height, std::uint32_t fields) noexcept {
   using Code = FrameError::Code;
-  if (reinterpret_cast<std::uintptr_t>(bytes.data()) % ALIGN != 0) { return err(FrameError{Code::MISALIGNED, 0, 0}); }
+  if (reinterpret_cast<std::uintptr_t>(bytes.data()) % ALIGN != 0) {
+    return err(FrameError{Code::MISALIGNED, 0, 0});
+  }
   const std::size_t need = frame_payload_bytes(width, height, fields);
   if (need == 0 || height == 0) {
     return err(FrameError{Code::BAD_SHAPE, MAX_POINTS, std::uint64_t{width} * height});
@@ -82,34 +92,52 @@ Result<FrameSpan, FrameError> layout_frame(std::span<std::byte> bytes, std::uint
   const std::size_t n = std::size_t{width} * height;
   const Offsets o = offsets(n, fields);
   std::byte* base = bytes.data();
-  return FrameSpan{header,
-                   {array_at<float>(base, o.x, n), array_at<float>(base, o.y, n), array_at<float>(base, o.z, n)},
-                   array_at<std::uint32_t>(base, o.rgb, n), array_at<std::uint32_t>(base, o.label, n)};
+  return FrameSpan{
+      header,
+      {array_at<float>(base, o.x, n), array_at<float>(base, o.y, n), array_at<float>(base, o.z, n)},
+      array_at<std::uint32_t>(base, o.rgb, n),
+      array_at<std::uint32_t>(base, o.label, n)};
 }
 
 Result<FrameView, FrameError> view_frame(std::span<const std::byte> bytes) noexcept {
   using Code = FrameError::Code;
-  if (bytes.size() < sizeof(FrameHeader)) { return err(FrameError{Code::TOO_SMALL, sizeof(FrameHeader), bytes.size()}); }
-  if (reinterpret_cast<std::uintptr_t>(bytes.data()) % ALIGN != 0) { return err(FrameError{Code::MISALIGNED, 0, 0}); }
-  const auto* header = reinterpret_cast<const FrameHeader*>(bytes.data());  // NOLINT: checked size and alignment
-  if (header->type_id != FRAME_TYPE_ID) { return err(FrameError{Code::WRONG_TYPE, FRAME_TYPE_ID, header->type_id}); }
-  if (header->version != FRAME_VERSION) { return err(FrameError{Code::WRONG_VERSION, FRAME_VERSION, header->version}); }
+  if (bytes.size() < sizeof(FrameHeader)) {
+    return err(FrameError{Code::TOO_SMALL, sizeof(FrameHeader), bytes.size()});
+  }
+  if (reinterpret_cast<std::uintptr_t>(bytes.data()) % ALIGN != 0) {
+    return err(FrameError{Code::MISALIGNED, 0, 0});
+  }
+  const auto* header =
+      reinterpret_cast<const FrameHeader*>(bytes.data());  // NOLINT: checked size and alignment
+  if (header->type_id != FRAME_TYPE_ID) {
+    return err(FrameError{Code::WRONG_TYPE, FRAME_TYPE_ID, header->type_id});
+  }
+  if (header->version != FRAME_VERSION) {
+    return err(FrameError{Code::WRONG_VERSION, FRAME_VERSION, header->version});
+  }
   const std::size_t need = frame_payload_bytes(header->width, header->height, header->fields);
   if (need == 0 || header->height == 0) {
-    return err(FrameError{Code::BAD_SHAPE, MAX_POINTS, std::uint64_t{header->width} * header->height});
+    return err(
+        FrameError{Code::BAD_SHAPE, MAX_POINTS, std::uint64_t{header->width} * header->height});
   }
-  if (header->payload_bytes != need) { return err(FrameError{Code::SIZE_MISMATCH, need, header->payload_bytes}); }
+  if (header->payload_bytes != need) {
+    return err(FrameError{Code::SIZE_MISMATCH, need, header->payload_bytes});
+  }
   if (bytes.size() < need) { return err(FrameError{Code::TOO_SMALL, need, bytes.size()}); }
   const std::size_t n = std::size_t{header->width} * header->height;
   const Offsets o = offsets(n, header->fields);
   const std::byte* base = bytes.data();
-  const kernels::PointsView points{array_at<const float>(base, o.x, n), array_at<const float>(base, o.y, n),
+  const kernels::PointsView points{array_at<const float>(base, o.x, n),
+                                   array_at<const float>(base, o.y, n),
                                    array_at<const float>(base, o.z, n)};
-  return FrameView{header, {points, header->width, header->height}, array_at<const std::uint32_t>(base, o.rgb, n),
+  return FrameView{header,
+                   {points, header->width, header->height},
+                   array_at<const std::uint32_t>(base, o.rgb, n),
                    array_at<const std::uint32_t>(base, o.label, n)};
 }
 
-Result<std::size_t, FrameError> write_frame(std::span<std::byte> bytes, const kernels::PointCloud& cloud) noexcept {
+Result<std::size_t, FrameError> write_frame(std::span<std::byte> bytes,
+                                            const kernels::PointCloud& cloud) noexcept {
   const std::uint32_t fields = (cloud.has(kernels::Field::RGB) ? FRAME_FIELD_RGB : 0U) |
                                (cloud.has(kernels::Field::LABEL) ? FRAME_FIELD_LABEL : 0U);
   const std::uint32_t height = std::max<std::uint32_t>(cloud.height(), 1);

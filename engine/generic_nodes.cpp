@@ -50,15 +50,17 @@ class Ticker final : public Node {
 class Busy final : public Node {
  public:
   Busy(const std::string& type, std::int64_t spin_us, std::int64_t add, bool serial)
-      : ports_{{"in", type, true}, {"out", type, false}}, spin_us_(spin_us), add_(add), serial_(serial) {}
+      : ports_{{"in", type, true}, {"out", type, false}},
+        spin_us_(spin_us),
+        add_(add),
+        serial_(serial) {}
   std::span<const PortSpec> inputs() const noexcept override { return {ports_.data(), 1}; }
   std::span<const PortSpec> outputs() const noexcept override { return {ports_.data() + 1, 1}; }
   bool stateful() const noexcept override { return serial_; }
   void process(const Message& in, Emitter& out) noexcept override {
     if (spin_us_ > 0) {
       const auto until = std::chrono::steady_clock::now() + std::chrono::microseconds(spin_us_);
-      while (std::chrono::steady_clock::now() < until) {
-      }
+      while (std::chrono::steady_clock::now() < until) {}
     }
     Message result = in;
     result.value += add_;
@@ -139,10 +141,12 @@ Made make_ticker(const ParamMap& params, const NodeContext& context) {
   if (auto ok = params.only({"frames", "payload_bytes"}); !ok) return err(ok.error());
   auto frames_result = params.integer("frames", 0, 0, std::int64_t{1} << 40);
   if (!frames_result) return err(frames_result.error());
-  const std::int64_t limit = context.pool ? static_cast<std::int64_t>(context.pool->block_bytes()) : 0;
+  const std::int64_t limit =
+      context.pool ? static_cast<std::int64_t>(context.pool->block_bytes()) : 0;
   auto bytes_result = params.integer("payload_bytes", 0, 0, limit);
   if (!bytes_result) return err(bytes_result.error() + " (the pool's block_bytes)");
-  return std::unique_ptr<Node>(new Ticker(*frames_result, static_cast<std::size_t>(*bytes_result), context));
+  return std::unique_ptr<Node>(
+      new Ticker(*frames_result, static_cast<std::size_t>(*bytes_result), context));
 }
 
 Made make_busy(const ParamMap& params) {
@@ -155,7 +159,8 @@ Made make_busy(const ParamMap& params) {
   if (!type_result) return err(type_result.error());
   if (!spin_result) return err(spin_result.error());
   if (!add_result) return err(add_result.error());
-  return std::unique_ptr<Node>(new Busy(*type_result, *spin_result, *add_result, *serial_result == 1));
+  return std::unique_ptr<Node>(
+      new Busy(*type_result, *spin_result, *add_result, *serial_result == 1));
 }
 
 Made make_fanout(const ParamMap& params) {
@@ -164,14 +169,16 @@ Made make_fanout(const ParamMap& params) {
   auto vary_result = params.integer("vary", 0, 0, 1);
   if (!objects_result) return err(objects_result.error());
   if (!vary_result) return err(vary_result.error());
-  return std::unique_ptr<Node>(new Fanout(static_cast<std::uint32_t>(*objects_result), *vary_result == 1));
+  return std::unique_ptr<Node>(
+      new Fanout(static_cast<std::uint32_t>(*objects_result), *vary_result == 1));
 }
 
 }  // namespace
 
 void CountSink::process(const Message& in, Emitter& /*out*/) noexcept {
   received.fetch_add(1, std::memory_order_relaxed);
-  if (!first_ && in.frame_id < last_frame.load(std::memory_order_relaxed)) out_of_order.fetch_add(1);
+  if (!first_ && in.frame_id < last_frame.load(std::memory_order_relaxed))
+    out_of_order.fetch_add(1);
   first_ = false;
   last_frame.store(in.frame_id, std::memory_order_relaxed);
   if (in.skipped) {
@@ -195,7 +202,8 @@ bool payload_matches(const memory_pool::BlockHandle& payload, std::uint64_t fram
   return stored == frame_id;
 }
 
-Result<std::unique_ptr<Node>, std::string> make_generic_node(const std::string& kind, const ParamMap& params,
+Result<std::unique_ptr<Node>, std::string> make_generic_node(const std::string& kind,
+                                                             const ParamMap& params,
                                                              const NodeContext& context) {
   if (kind == "ticker") return make_ticker(params, context);
   if (kind == "busy" || kind == "pass") return make_busy(params);
@@ -223,10 +231,9 @@ void add_generic_nodes(NodeRegistry& registry) {
       {"count", "stateful sink: counts frames, checks order and payload; type=frame|object"}};
   for (const auto& [kind, description] : descriptions) {
     const std::string name = kind;
-    registry.add(name, description,
-                 [name](const ParamMap& params, const NodeContext& context) {
-                   return make_generic_node(name, params, context);
-                 });
+    registry.add(name, description, [name](const ParamMap& params, const NodeContext& context) {
+      return make_generic_node(name, params, context);
+    });
   }
 }
 

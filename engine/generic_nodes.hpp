@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
+#include "core/result.hpp"
 #include "engine/node.hpp"
 #include "engine/params.hpp"
-#include "core/result.hpp"
 
 namespace orthoflow::engine {
 
@@ -25,11 +25,11 @@ class CountSink final : public Node {
   bool wants_skipped() const noexcept override { return true; }
   void process(const Message& in, Emitter& out) noexcept override;
 
-  std::atomic<std::uint64_t> received{0};       ///< messages, tombstones included
-  std::atomic<std::uint64_t> skipped{0};        ///< tombstones
-  std::atomic<std::uint64_t> out_of_order{0};   ///< frame id lower than the previous one
-  std::atomic<std::uint64_t> payload_errors{0}; ///< payload does not start with its frame id
-  std::atomic<std::int64_t> value_sum{0};       ///< sum of values of non-skipped messages
+  std::atomic<std::uint64_t> received{0};        ///< messages, tombstones included
+  std::atomic<std::uint64_t> skipped{0};         ///< tombstones
+  std::atomic<std::uint64_t> out_of_order{0};    ///< frame id lower than the previous one
+  std::atomic<std::uint64_t> payload_errors{0};  ///< payload does not start with its frame id
+  std::atomic<std::int64_t> value_sum{0};        ///< sum of values of non-skipped messages
   std::atomic<std::uint64_t> last_frame{0};
 
  private:
@@ -40,12 +40,12 @@ class CountSink final : public Node {
 /// @brief Writes `frame_id` into the first 8 bytes of a payload block (the ticker does this).
 void stamp_payload(const memory_pool::BlockHandle& payload, std::uint64_t frame_id) noexcept;
 /// @brief True if a payload's first 8 bytes equal `frame_id` (or the payload is empty).
-[[nodiscard]] bool payload_matches(const memory_pool::BlockHandle& payload, std::uint64_t frame_id) noexcept;
+[[nodiscard]] bool payload_matches(const memory_pool::BlockHandle& payload,
+                                   std::uint64_t frame_id) noexcept;
 
 /// @brief Builds the generic kinds by name: ticker, pass, busy, fanout, join, count.
 /// @return nullptr-free node or an error message naming the bad parameter.
-[[nodiscard]] Result<std::unique_ptr<Node>, std::string> make_generic_node(const std::string& kind,
-                                                                           const ParamMap& params,
-                                                                           const NodeContext& context);
+[[nodiscard]] Result<std::unique_ptr<Node>, std::string> make_generic_node(
+    const std::string& kind, const ParamMap& params, const NodeContext& context);
 
 }  // namespace orthoflow::engine

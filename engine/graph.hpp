@@ -1,17 +1,17 @@
 #pragma once
 /// @file
-/// @brief The declarative graph: GraphSpec (what the YAML file says), GraphError (what is wrong with
-/// it, with file and line) and Graph (validated, nodes instantiated, ready for the Engine).
+/// @brief The declarative graph: GraphSpec (what the YAML file says), GraphError (what is wrong
+/// with it, with file and line) and Graph (validated, nodes instantiated, ready for the Engine).
 #include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "core/result.hpp"
 #include "engine/node.hpp"
 #include "engine/params.hpp"
 #include "engine/registry.hpp"
 #include "memory_pool/block_pool.hpp"
-#include "core/result.hpp"
 
 namespace orthoflow::engine {
 
@@ -25,8 +25,8 @@ struct NodeSpec {
   std::string kind;
   ParamMap params;
   Policy policy = Policy::QUEUE;
-  bool ordered = false;         ///< restore frame order (sequencer keyed by frame id) before it
-  std::int64_t deadline_ns = 0; ///< per-node deadline for its own processing (0 = graph period)
+  bool ordered = false;          ///< restore frame order (sequencer keyed by frame id) before it
+  std::int64_t deadline_ns = 0;  ///< per-node deadline for its own processing (0 = graph period)
   int line = 0;
 };
 
@@ -38,12 +38,12 @@ struct EdgeSpec {
 
 /// @brief A whole graph file.
 struct GraphSpec {
-  std::string file;               ///< for error messages
+  std::string file;  ///< for error messages
   std::string name = "graph";
-  std::int64_t period_ns = 0;     ///< expected frame period: deadline for each frame (0 = none)
-  std::size_t block_bytes = 4096; ///< frame pool: bytes per block
-  std::size_t blocks = 8;         ///< frame pool: number of blocks
-  std::size_t max_in_flight = 0;  ///< frames in flight (limiter); 0 = blocks
+  std::int64_t period_ns = 0;      ///< expected frame period: deadline for each frame (0 = none)
+  std::size_t block_bytes = 4096;  ///< frame pool: bytes per block
+  std::size_t blocks = 8;          ///< frame pool: number of blocks
+  std::size_t max_in_flight = 0;   ///< frames in flight (limiter); 0 = blocks
   std::vector<NodeSpec> nodes;
   std::vector<EdgeSpec> edges;
 };
@@ -51,8 +51,19 @@ struct GraphSpec {
 /// @brief A graph file problem, located by file and 1-based line.
 struct GraphError {
   enum class Code {
-    FILE_UNREADABLE, SYNTAX, BAD_STRUCTURE, DUPLICATE_NODE, UNKNOWN_KIND, UNKNOWN_NODE, UNKNOWN_PORT,
-    TYPE_MISMATCH, UNCONNECTED_INPUT, CYCLE, BAD_PARAMETER, SOURCE_COUNT, POOL
+    FILE_UNREADABLE,
+    SYNTAX,
+    BAD_STRUCTURE,
+    DUPLICATE_NODE,
+    UNKNOWN_KIND,
+    UNKNOWN_NODE,
+    UNKNOWN_PORT,
+    TYPE_MISMATCH,
+    UNCONNECTED_INPUT,
+    CYCLE,
+    BAD_PARAMETER,
+    SOURCE_COUNT,
+    POOL
   };
   Code code = Code::SYNTAX;
   std::string file;
@@ -66,7 +77,8 @@ struct GraphError {
 [[nodiscard]] std::string to_string(const GraphError& error);
 
 /// @brief Parses graph YAML text; `file` only labels errors. Start-up only (may allocate freely).
-[[nodiscard]] Result<GraphSpec, GraphError> parse_graph(const std::string& text, const std::string& file);
+[[nodiscard]] Result<GraphSpec, GraphError> parse_graph(const std::string& text,
+                                                        const std::string& file);
 /// @brief Reads and parses a graph file.
 [[nodiscard]] Result<GraphSpec, GraphError> load_graph_file(const std::string& path);
 
@@ -85,7 +97,7 @@ struct Graph {
   std::unique_ptr<memory_pool::BlockPool> pool;  // declared before nodes: destroyed after them
   std::vector<std::unique_ptr<Node>> nodes;      // same order as spec.nodes
   std::vector<Edge> edges;
-  std::vector<std::size_t> topo_order;           // sources first
+  std::vector<std::size_t> topo_order;  // sources first
   std::size_t source = 0;
   std::size_t max_in_flight = 1;
   BuildMode mode = BuildMode::RUN;  // CHECK: validated only; the Engine refuses it

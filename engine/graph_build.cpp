@@ -38,13 +38,15 @@ std::optional<GraphError> make_nodes(Graph& graph, const NodeRegistry& registry)
     if (factory == nullptr) {
       std::string known;
       for (const auto& k : registry.kinds()) known += (known.empty() ? "" : ", ") + k;
-      return error_at(spec, Code::UNKNOWN_KIND, node.line,
-                      "node '" + node.name + "': unknown kind '" + node.kind + "' (known: " + known + ")");
+      return error_at(
+          spec, Code::UNKNOWN_KIND, node.line,
+          "node '" + node.name + "': unknown kind '" + node.kind + "' (known: " + known + ")");
     }
     const NodeContext context{node.name, graph.pool.get(), graph.max_in_flight, graph.mode};
     auto node_result = (*factory)(node.params, context);
     if (!node_result) {
-      return error_at(spec, Code::BAD_PARAMETER, node.line, "node '" + node.name + "': " + node_result.error());
+      return error_at(spec, Code::BAD_PARAMETER, node.line,
+                      "node '" + node.name + "': " + node_result.error());
     }
     graph.nodes.push_back(std::move(*node_result));
   }
@@ -59,8 +61,8 @@ std::optional<GraphError> make_nodes(Graph& graph, const NodeRegistry& registry)
     std::string names;
     for (const auto& s : sources) names += " '" + s + "'";
     return error_at(spec, Code::SOURCE_COUNT, spec.nodes.empty() ? 0 : spec.nodes.front().line,
-                    "a graph needs exactly one source node (no inputs), found " + std::to_string(sources.size()) +
-                        names);
+                    "a graph needs exactly one source node (no inputs), found " +
+                        std::to_string(sources.size()) + names);
   }
   return std::nullopt;
 }
@@ -74,26 +76,28 @@ std::optional<GraphError> resolve_edges(Graph& graph) {
     const auto to = index.find(e.to_node);
     if (from == index.end() || to == index.end()) {
       const std::string& missing = from == index.end() ? e.from_node : e.to_node;
-      return error_at(spec, Code::UNKNOWN_NODE, e.line, "edge names unknown node '" + missing + "'");
+      return error_at(spec, Code::UNKNOWN_NODE, e.line,
+                      "edge names unknown node '" + missing + "'");
     }
     const auto outs = graph.nodes[from->second]->outputs();
     const auto ins = graph.nodes[to->second]->inputs();
     const auto out_port = port_index(outs, e.from_port);
     if (!out_port) {
       return error_at(spec, Code::UNKNOWN_PORT, e.line,
-                      "node '" + e.from_node + "' has no output port '" + e.from_port + "' (outputs: " +
-                          port_list(outs) + ")");
+                      "node '" + e.from_node + "' has no output port '" + e.from_port +
+                          "' (outputs: " + port_list(outs) + ")");
     }
     const auto in_port = port_index(ins, e.to_port);
     if (!in_port) {
       return error_at(spec, Code::UNKNOWN_PORT, e.line,
-                      "node '" + e.to_node + "' has no input port '" + e.to_port + "' (inputs: " + port_list(ins) +
-                          ")");
+                      "node '" + e.to_node + "' has no input port '" + e.to_port +
+                          "' (inputs: " + port_list(ins) + ")");
     }
     if (outs[*out_port].type != ins[*in_port].type) {
       return error_at(spec, Code::TYPE_MISMATCH, e.line,
-                      e.from_node + "." + e.from_port + " carries '" + outs[*out_port].type + "' but " + e.to_node +
-                          "." + e.to_port + " expects '" + ins[*in_port].type + "'");
+                      e.from_node + "." + e.from_port + " carries '" + outs[*out_port].type +
+                          "' but " + e.to_node + "." + e.to_port + " expects '" +
+                          ins[*in_port].type + "'");
     }
     graph.edges.push_back({from->second, *out_port, to->second, *in_port});
   }
@@ -105,11 +109,13 @@ std::optional<GraphError> check_required_inputs(const Graph& graph) {
   for (std::size_t n = 0; n < graph.nodes.size(); ++n) {
     const auto ins = graph.nodes[n]->inputs();
     for (std::size_t p = 0; p < ins.size(); ++p) {
-      const bool connected = std::any_of(graph.edges.begin(), graph.edges.end(),
-                                         [&](const Edge& e) { return e.to_node == n && e.to_port == p; });
+      const bool connected =
+          std::any_of(graph.edges.begin(), graph.edges.end(),
+                      [&](const Edge& e) { return e.to_node == n && e.to_port == p; });
       if (ins[p].required && !connected) {
-        return error_at(spec, Code::UNCONNECTED_INPUT, spec.nodes[n].line,
-                        "required input '" + spec.nodes[n].name + "." + ins[p].name + "' has no incoming edge");
+        return error_at(
+            spec, Code::UNCONNECTED_INPUT, spec.nodes[n].line,
+            "required input '" + spec.nodes[n].name + "." + ins[p].name + "' has no incoming edge");
       }
     }
   }
@@ -154,15 +160,16 @@ std::optional<GraphError> order_nodes(Graph& graph) {
 }  // namespace
 
 std::string to_string(GraphError::Code code) {
-  static const char* const NAMES[] = {"FILE_UNREADABLE", "SYNTAX",        "BAD_STRUCTURE", "DUPLICATE_NODE",
-                                      "UNKNOWN_KIND",    "UNKNOWN_NODE",  "UNKNOWN_PORT",  "TYPE_MISMATCH",
-                                      "UNCONNECTED_INPUT", "CYCLE",       "BAD_PARAMETER", "SOURCE_COUNT",
-                                      "POOL"};
+  static const char* const NAMES[] = {
+      "FILE_UNREADABLE", "SYNTAX",       "BAD_STRUCTURE", "DUPLICATE_NODE",    "UNKNOWN_KIND",
+      "UNKNOWN_NODE",    "UNKNOWN_PORT", "TYPE_MISMATCH", "UNCONNECTED_INPUT", "CYCLE",
+      "BAD_PARAMETER",   "SOURCE_COUNT", "POOL"};
   return NAMES[static_cast<std::size_t>(code)];
 }
 
 std::string to_string(const GraphError& error) {
-  return error.file + ":" + std::to_string(error.line) + ": error [" + to_string(error.code) + "]: " + error.message;
+  return error.file + ":" + std::to_string(error.line) + ": error [" + to_string(error.code) +
+         "]: " + error.message;
 }
 
 Built build_graph(const GraphSpec& spec, const NodeRegistry& registry, BuildMode mode) {
@@ -172,11 +179,14 @@ Built build_graph(const GraphSpec& spec, const NodeRegistry& registry, BuildMode
   graph->max_in_flight = spec.max_in_flight == 0 ? spec.blocks : spec.max_in_flight;
   if (graph->max_in_flight > spec.blocks) {
     return err(error_at(spec, Code::POOL, 0,
-                        "max_in_flight " + std::to_string(graph->max_in_flight) + " exceeds the pool's " +
-                            std::to_string(spec.blocks) + " blocks (the limiter is sized to the pool)"));
+                        "max_in_flight " + std::to_string(graph->max_in_flight) +
+                            " exceeds the pool's " + std::to_string(spec.blocks) +
+                            " blocks (the limiter is sized to the pool)"));
   }
-  auto pool_result = memory_pool::BlockPool::create_owned({spec.block_bytes, spec.blocks, graph->spec.name});
-  if (!pool_result) return err(error_at(spec, Code::POOL, 0, memory_pool::to_string(pool_result.error())));
+  auto pool_result =
+      memory_pool::BlockPool::create_owned({spec.block_bytes, spec.blocks, graph->spec.name});
+  if (!pool_result)
+    return err(error_at(spec, Code::POOL, 0, memory_pool::to_string(pool_result.error())));
   graph->pool = std::move(*pool_result);
   if (auto e = make_nodes(*graph, registry)) return err(*e);
   if (auto e = resolve_edges(*graph)) return err(*e);
@@ -193,13 +203,15 @@ std::string to_dot(const Graph& graph) {
     if (graph.nodes[i]->stateful()) label += "\\nserial";
     if (n.policy == Policy::LATEST) label += "\\nlatest-wins";
     if (n.ordered) label += "\\nordered";
-    dot += "  \"" + n.name + "\" [label=\"" + label + "\"" + (i == graph.source ? ", shape=invhouse" : "") + "];\n";
+    dot += "  \"" + n.name + "\" [label=\"" + label + "\"" +
+           (i == graph.source ? ", shape=invhouse" : "") + "];\n";
   }
   for (const auto& e : graph.edges) {
     const auto& out = graph.nodes[e.from_node]->outputs()[e.from_port];
     const auto& in = graph.nodes[e.to_node]->inputs()[e.to_port];
-    dot += "  \"" + graph.spec.nodes[e.from_node].name + "\" -> \"" + graph.spec.nodes[e.to_node].name +
-           "\" [label=\"" + out.name + "->" + in.name + " (" + out.type + ")\"];\n";
+    dot += "  \"" + graph.spec.nodes[e.from_node].name + "\" -> \"" +
+           graph.spec.nodes[e.to_node].name + "\" [label=\"" + out.name + "->" + in.name + " (" +
+           out.type + ")\"];\n";
   }
   return dot + "}\n";
 }

@@ -23,7 +23,8 @@ struct Fail {
 
 int line_of(const YAML::Node& node) { return node.Mark().line >= 0 ? node.Mark().line + 1 : 0; }
 
-[[noreturn]] void fail(Code code, const std::string& file, const YAML::Node& at, const std::string& message) {
+[[noreturn]] void fail(Code code, const std::string& file, const YAML::Node& at,
+                       const std::string& message) {
   throw Fail{GraphError{code, file, line_of(at), message}};
 }
 
@@ -32,11 +33,13 @@ std::string scalar(const YAML::Node& node, const std::string& file, const std::s
   return node.Scalar();
 }
 
-double number(const YAML::Node& node, const std::string& file, const std::string& what, double max) {
+double number(const YAML::Node& node, const std::string& file, const std::string& what,
+              double max) {
   double value = 0.0;
-  if (!node.IsScalar() || !YAML::convert<double>::decode(node, value) || !std::isfinite(value) || value < 0.0 ||
-      value > max) {
-    fail(Code::BAD_PARAMETER, file, node, what + " must be a number in [0, " + std::to_string(max) + "]");
+  if (!node.IsScalar() || !YAML::convert<double>::decode(node, value) || !std::isfinite(value) ||
+      value < 0.0 || value > max) {
+    fail(Code::BAD_PARAMETER, file, node,
+         what + " must be a number in [0, " + std::to_string(max) + "]");
   }
   return value;
 }
@@ -50,16 +53,20 @@ void parse_header(const YAML::Node& graph, GraphSpec& spec) {
     if (key == "name") {
       spec.name = scalar(value, spec.file, "graph.name");
     } else if (key == "period_ms") {
-      spec.period_ns = static_cast<std::int64_t>(number(value, spec.file, "graph.period_ms", 3.6e6) * 1e6);
+      spec.period_ns =
+          static_cast<std::int64_t>(number(value, spec.file, "graph.period_ms", 3.6e6) * 1e6);
     } else if (key == "max_in_flight") {
-      spec.max_in_flight = static_cast<std::size_t>(number(value, spec.file, "graph.max_in_flight", 4096));
+      spec.max_in_flight =
+          static_cast<std::size_t>(number(value, spec.file, "graph.max_in_flight", 4096));
     } else if (key == "pool" && value.IsMap()) {
       for (const auto& p : value) {
         const std::string pkey = p.first.Scalar();
         if (pkey == "block_bytes") {
-          spec.block_bytes = static_cast<std::size_t>(number(p.second, spec.file, "pool.block_bytes", 1 << 30));
+          spec.block_bytes =
+              static_cast<std::size_t>(number(p.second, spec.file, "pool.block_bytes", 1 << 30));
         } else if (pkey == "blocks") {
-          spec.blocks = static_cast<std::size_t>(number(p.second, spec.file, "pool.blocks", 1 << 20));
+          spec.blocks =
+              static_cast<std::size_t>(number(p.second, spec.file, "pool.blocks", 1 << 20));
         } else {
           fail(Code::BAD_PARAMETER, spec.file, p.first, "unknown pool key '" + pkey + "'");
         }
@@ -70,7 +77,8 @@ void parse_header(const YAML::Node& graph, GraphSpec& spec) {
   }
 }
 
-void parse_node_key(const std::string& key, const YAML::Node& value, NodeSpec& node, const std::string& file) {
+void parse_node_key(const std::string& key, const YAML::Node& value, NodeSpec& node,
+                    const std::string& file) {
   if (key == "name") {
     node.name = scalar(value, file, "node name");
   } else if (key == "kind") {
@@ -78,7 +86,8 @@ void parse_node_key(const std::string& key, const YAML::Node& value, NodeSpec& n
   } else if (key == "policy") {
     const std::string policy = scalar(value, file, "policy");
     if (policy != "queue" && policy != "latest") {
-      fail(Code::BAD_PARAMETER, file, value, "policy '" + policy + "' is not one of {queue, latest}");
+      fail(Code::BAD_PARAMETER, file, value,
+           "policy '" + policy + "' is not one of {queue, latest}");
     }
     node.policy = policy == "latest" ? Policy::LATEST : Policy::QUEUE;
   } else if (key == "ordered") {
@@ -92,7 +101,8 @@ void parse_node_key(const std::string& key, const YAML::Node& value, NodeSpec& n
   } else if (key == "params") {
     if (!value.IsMap()) fail(Code::BAD_STRUCTURE, file, value, "params must be a map");
     for (const auto& p : value) {
-      node.params.set(p.first.Scalar(), scalar(p.second, file, "parameter '" + p.first.Scalar() + "'"),
+      node.params.set(p.first.Scalar(),
+                      scalar(p.second, file, "parameter '" + p.first.Scalar() + "'"),
                       line_of(p.first));
     }
   } else {
@@ -101,7 +111,8 @@ void parse_node_key(const std::string& key, const YAML::Node& value, NodeSpec& n
 }
 
 void parse_nodes(const YAML::Node& nodes, GraphSpec& spec) {
-  if (!nodes || !nodes.IsSequence()) fail(Code::BAD_STRUCTURE, spec.file, nodes, "'nodes' must be a list");
+  if (!nodes || !nodes.IsSequence())
+    fail(Code::BAD_STRUCTURE, spec.file, nodes, "'nodes' must be a list");
   std::set<std::string> names;
   for (const auto& item : nodes) {
     if (!item.IsMap()) fail(Code::BAD_STRUCTURE, spec.file, item, "each node must be a map");
@@ -149,9 +160,11 @@ void parse_edges(const YAML::Node& edges, GraphSpec& spec) {
     EdgeSpec edge;
     edge.line = line_of(item);
     const auto arrow = text.find("->");
-    if (arrow == std::string::npos || !split_endpoint(text.substr(0, arrow), edge.from_node, edge.from_port) ||
+    if (arrow == std::string::npos ||
+        !split_endpoint(text.substr(0, arrow), edge.from_node, edge.from_port) ||
         !split_endpoint(text.substr(arrow + 2), edge.to_node, edge.to_port)) {
-      fail(Code::BAD_STRUCTURE, spec.file, item, "edge '" + text + "' is not of the form 'node.port -> node.port'");
+      fail(Code::BAD_STRUCTURE, spec.file, item,
+           "edge '" + text + "' is not of the form 'node.port -> node.port'");
     }
     spec.edges.push_back(std::move(edge));
   }
@@ -164,7 +177,8 @@ Result<GraphSpec, GraphError> parse_graph(const std::string& text, const std::st
   spec.file = file;
   try {
     const YAML::Node root = YAML::Load(text);
-    if (!root.IsMap()) fail(Code::BAD_STRUCTURE, file, root, "a graph file must be a map with 'nodes' and 'edges'");
+    if (!root.IsMap())
+      fail(Code::BAD_STRUCTURE, file, root, "a graph file must be a map with 'nodes' and 'edges'");
     for (const auto& item : root) {
       const std::string key = item.first.Scalar();
       if (key != "graph" && key != "nodes" && key != "edges") {
@@ -174,9 +188,7 @@ Result<GraphSpec, GraphError> parse_graph(const std::string& text, const std::st
     parse_header(root["graph"], spec);
     parse_nodes(root["nodes"], spec);
     parse_edges(root["edges"], spec);
-  } catch (const Fail& f) {
-    return err(f.error);
-  } catch (const YAML::Exception& e) {
+  } catch (const Fail& f) { return err(f.error); } catch (const YAML::Exception& e) {
     return err(GraphError{Code::SYNTAX, file, e.mark.line >= 0 ? e.mark.line + 1 : 0, e.msg});
   }
   return spec;

@@ -28,8 +28,7 @@ void LatencyHistogram::record(std::int64_t ns) noexcept {
   count_.fetch_add(1, std::memory_order_relaxed);
   std::int64_t seen = max_.load(std::memory_order_relaxed);
   const auto sample = static_cast<std::int64_t>(value);
-  while (sample > seen && !max_.compare_exchange_weak(seen, sample, std::memory_order_relaxed)) {
-  }
+  while (sample > seen && !max_.compare_exchange_weak(seen, sample, std::memory_order_relaxed)) {}
 }
 
 std::int64_t LatencyHistogram::percentile(double q) const noexcept {

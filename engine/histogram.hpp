@@ -1,7 +1,7 @@
 #pragma once
 /// @file
-/// @brief LatencyHistogram: lock-free log-linear histogram of nanosecond durations (8 sub-buckets per
-/// power of two, so a reported percentile is at most 12.5% above the true value; max is exact).
+/// @brief LatencyHistogram: lock-free log-linear histogram of nanosecond durations (8 sub-buckets
+/// per power of two, so a reported percentile is at most 12.5% above the true value; max is exact).
 #include <array>
 #include <atomic>
 #include <cstdint>
@@ -17,7 +17,9 @@ class LatencyHistogram {
 
   /// @brief Adds one sample (negative values count as 0). Lock-free, wait-free except max.
   void record(std::int64_t ns) noexcept;
-  [[nodiscard]] std::uint64_t count() const noexcept { return count_.load(std::memory_order_relaxed); }
+  [[nodiscard]] std::uint64_t count() const noexcept {
+    return count_.load(std::memory_order_relaxed);
+  }
   [[nodiscard]] std::int64_t max() const noexcept { return max_.load(std::memory_order_relaxed); }
   /// @brief Upper bound of the bucket holding quantile q in [0, 1] (clamped to max); 0 if empty.
   [[nodiscard]] std::int64_t percentile(double q) const noexcept;

@@ -39,7 +39,8 @@ static_assert(offsetof(FrameRef, payload_bytes) == 48);
 /// @brief The frame bytes a block stands for: the referenced bytes if @p block starts with a
 /// FrameRef, else @p block itself. Thread-safe, no allocation.
 /// @pre If the block holds a FrameRef, its target is alive (guaranteed while the block is held).
-[[nodiscard]] inline std::span<const std::byte> resolve_frame_bytes(std::span<const std::byte> block) noexcept {
+[[nodiscard]] inline std::span<const std::byte> resolve_frame_bytes(
+    std::span<const std::byte> block) noexcept {
   if (block.size() < sizeof(FrameRef)) return block;
   std::uint32_t type_id = 0;
   std::uint16_t version = 0;

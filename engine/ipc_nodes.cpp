@@ -20,7 +20,8 @@ namespace {
 using Made = Result<std::unique_ptr<Node>, std::string>;
 
 std::int64_t now_ms() noexcept {
-  return std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now().time_since_epoch())
+  return std::chrono::duration_cast<std::chrono::milliseconds>(
+             std::chrono::steady_clock::now().time_since_epoch())
       .count();
 }
 
@@ -78,7 +79,8 @@ class IpcSubscribeNode final : public IpcNode {
         held_(context.pool->block_count()),
         last_data_ms_(now_ms()) {}
   ~IpcSubscribeNode() override {
-    for (Held& held : held_) held.sample.reset();  // chunks back to iceoryx before the subscriber goes
+    for (Held& held : held_)
+      held.sample.reset();  // chunks back to iceoryx before the subscriber goes
   }
   std::span<const PortSpec> inputs() const noexcept override { return {}; }
   std::span<const PortSpec> outputs() const noexcept override { return outputs_; }
@@ -237,12 +239,14 @@ Result<IpcPayloadType, std::string> ipc_payload_type(const std::string& port_typ
 }
 
 void add_ipc_nodes(NodeRegistry& registry) {
-  registry.add("ipc_publish",
-               "sink: topic=service/instance/event, type=frame|objects, history, lossless=0|1, max_bytes, "
-               "roudi_config=PATH (else RouDi's live pools); copies each payload once into a chunk",
-               make_publish);
+  registry.add(
+      "ipc_publish",
+      "sink: topic=service/instance/event, type=frame|objects, history, lossless=0|1, max_bytes, "
+      "roudi_config=PATH (else RouDi's live pools); copies each payload once into a chunk",
+      make_publish);
   registry.add("ipc_subscribe",
-               "source: topic, type=frame|objects, policy=latest|queue|lossless, depth, history, frames, idle_ms, "
+               "source: topic, type=frame|objects, policy=latest|queue|lossless, depth, history, "
+               "frames, idle_ms, "
                "wait_ms; zero-copy (the block holds a FrameRef to the chunk)",
                make_subscribe);
 }

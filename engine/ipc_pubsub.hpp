@@ -44,7 +44,8 @@ inline constexpr std::uint32_t PAYLOAD_ALIGNMENT = 64;
 /// @return WRONG_TYPE / WRONG_VERSION / BAD_SIZE (payload_bytes below 56 or above bytes.size()),
 /// naming `topic`. Thread-safe, reads only bytes[0, 56).
 [[nodiscard]] Result<std::uint64_t, IpcError> check_payload_header(std::span<const std::byte> bytes,
-                                                                   IpcPayloadType type, const std::string& topic);
+                                                                   IpcPayloadType type,
+                                                                   const std::string& topic);
 
 /// @brief Subscriber queue policy. LATEST: keep only the newest chunk (older ones are dropped and
 /// counted). QUEUE: a FIFO of `depth`, the oldest dropped and counted when full. LOSSLESS: a FIFO
@@ -55,8 +56,8 @@ enum class IpcPolicy { LATEST, QUEUE, LOSSLESS };
 struct IpcPublisherConfig {
   IpcPayloadType type;
   std::uint64_t max_payload_bytes = 4096;  ///< checked against RouDi's pools at creation
-  std::uint64_t history = 0;                ///< samples kept for late subscribers
-  bool lossless = false;                    ///< wait for LOSSLESS subscribers instead of dropping
+  std::uint64_t history = 0;               ///< samples kept for late subscribers
+  bool lossless = false;                   ///< wait for LOSSLESS subscribers instead of dropping
 };
 
 /// @brief Subscriber settings.
@@ -81,9 +82,8 @@ class IpcPublisher {
  public:
   /// @brief Offers `topic`. Checks that `pools` holds a max_payload_bytes chunk (NO_FITTING_POOL).
   /// @pre init_ipc_runtime succeeded (else ROUDI_UNREACHABLE). Start-up only.
-  [[nodiscard]] static Result<std::unique_ptr<IpcPublisher>, IpcError> create(const IpcTopic& topic,
-                                                                              const IpcPublisherConfig& config,
-                                                                              const IpcPools& pools);
+  [[nodiscard]] static Result<std::unique_ptr<IpcPublisher>, IpcError> create(
+      const IpcTopic& topic, const IpcPublisherConfig& config, const IpcPools& pools);
   ~IpcPublisher();
   IpcPublisher(const IpcPublisher&) = delete;
   IpcPublisher& operator=(const IpcPublisher&) = delete;
@@ -144,8 +144,8 @@ class IpcSample {
 class IpcSubscriber {
  public:
   /// @pre init_ipc_runtime succeeded (else ROUDI_UNREACHABLE). depth in 1..256 (else BAD_TOPIC).
-  [[nodiscard]] static Result<std::unique_ptr<IpcSubscriber>, IpcError> create(const IpcTopic& topic,
-                                                                               const IpcSubscriberConfig& config);
+  [[nodiscard]] static Result<std::unique_ptr<IpcSubscriber>, IpcError> create(
+      const IpcTopic& topic, const IpcSubscriberConfig& config);
   ~IpcSubscriber();
   IpcSubscriber(const IpcSubscriber&) = delete;
   IpcSubscriber& operator=(const IpcSubscriber&) = delete;

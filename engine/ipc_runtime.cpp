@@ -31,13 +31,15 @@ std::string runtime_name;
 std::atomic<bool> runtime_ready{false};
 std::atomic<bool> roudi_lost{false};
 
-IpcError make_error(IpcError::Code code, std::string message) { return IpcError{code, std::move(message)}; }
+IpcError make_error(IpcError::Code code, std::string message) {
+  return IpcError{code, std::move(message)};
+}
 
 bool valid_name(std::string_view name) {
   if (name.empty() || name.size() > 100) return false;
   return std::all_of(name.begin(), name.end(), [](char c) {
-    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-' ||
-           c == '.';
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' ||
+           c == '-' || c == '.';
   });
 }
 
@@ -62,23 +64,37 @@ std::string_view parse_error_name(iox::roudi::RouDiConfigFileParseError error) {
 
 std::string_view to_string(IpcError::Code code) noexcept {
   switch (code) {
-    case IpcError::Code::ROUDI_UNREACHABLE: return "ROUDI_UNREACHABLE";
-    case IpcError::Code::ROUDI_LOST: return "ROUDI_LOST";
-    case IpcError::Code::RUNTIME_NAME: return "RUNTIME_NAME";
-    case IpcError::Code::BAD_TOPIC: return "BAD_TOPIC";
-    case IpcError::Code::CONFIG: return "CONFIG";
-    case IpcError::Code::NO_POOL_INFO: return "NO_POOL_INFO";
-    case IpcError::Code::NO_FITTING_POOL: return "NO_FITTING_POOL";
-    case IpcError::Code::POOL_EXHAUSTED: return "POOL_EXHAUSTED";
-    case IpcError::Code::TOO_MANY_LOANS: return "TOO_MANY_LOANS";
-    case IpcError::Code::WRONG_TYPE: return "WRONG_TYPE";
-    case IpcError::Code::WRONG_VERSION: return "WRONG_VERSION";
-    case IpcError::Code::BAD_SIZE: return "BAD_SIZE";
+    case IpcError::Code::ROUDI_UNREACHABLE:
+      return "ROUDI_UNREACHABLE";
+    case IpcError::Code::ROUDI_LOST:
+      return "ROUDI_LOST";
+    case IpcError::Code::RUNTIME_NAME:
+      return "RUNTIME_NAME";
+    case IpcError::Code::BAD_TOPIC:
+      return "BAD_TOPIC";
+    case IpcError::Code::CONFIG:
+      return "CONFIG";
+    case IpcError::Code::NO_POOL_INFO:
+      return "NO_POOL_INFO";
+    case IpcError::Code::NO_FITTING_POOL:
+      return "NO_FITTING_POOL";
+    case IpcError::Code::POOL_EXHAUSTED:
+      return "POOL_EXHAUSTED";
+    case IpcError::Code::TOO_MANY_LOANS:
+      return "TOO_MANY_LOANS";
+    case IpcError::Code::WRONG_TYPE:
+      return "WRONG_TYPE";
+    case IpcError::Code::WRONG_VERSION:
+      return "WRONG_VERSION";
+    case IpcError::Code::BAD_SIZE:
+      return "BAD_SIZE";
   }
   return "UNKNOWN";
 }
 
-std::string to_string(const IpcError& error) { return std::string(to_string(error.code)) + ": " + error.message; }
+std::string to_string(const IpcError& error) {
+  return std::string(to_string(error.code)) + ": " + error.message;
+}
 
 Result<void, IpcError> probe_roudi() noexcept {
   // RouDi binds a SOCK_DGRAM unix socket at /tmp/roudi; connect() on a datagram socket only checks
@@ -93,9 +109,10 @@ Result<void, IpcError> probe_roudi() noexcept {
   ::close(fd);
   if (rc == 0) return {};
   try {
-    return err(make_error(IpcError::Code::ROUDI_UNREACHABLE,
-                          "no RouDi on " + std::string(ROUDI_SOCKET_PATH) + " (" + std::strerror(error) +
-                              "): start it with `iox-roudi -c config.toml` (see `orthoflow ipc config`)"));
+    return err(
+        make_error(IpcError::Code::ROUDI_UNREACHABLE,
+                   "no RouDi on " + std::string(ROUDI_SOCKET_PATH) + " (" + std::strerror(error) +
+                       "): start it with `iox-roudi -c config.toml` (see `orthoflow ipc config`)"));
   } catch (...) {  // out of memory while formatting: still report the code
     return err(IpcError{IpcError::Code::ROUDI_UNREACHABLE, {}});
   }
@@ -104,14 +121,15 @@ Result<void, IpcError> probe_roudi() noexcept {
 Result<void, IpcError> init_ipc_runtime(std::string_view app_name) {
   const std::lock_guard<std::mutex> lock(runtime_mutex);
   if (!valid_name(app_name)) {
-    return err(make_error(IpcError::Code::RUNTIME_NAME,
-                          "runtime name '" + std::string(app_name) + "': 1..100 characters of [A-Za-z0-9_.-]"));
+    return err(make_error(
+        IpcError::Code::RUNTIME_NAME,
+        "runtime name '" + std::string(app_name) + "': 1..100 characters of [A-Za-z0-9_.-]"));
   }
   if (runtime_ready.load()) {
     if (runtime_name == app_name) return {};
-    return err(make_error(IpcError::Code::RUNTIME_NAME, "this process is already registered with RouDi as '" +
-                                                            runtime_name + "', cannot register as '" +
-                                                            std::string(app_name) + "'"));
+    return err(make_error(IpcError::Code::RUNTIME_NAME,
+                          "this process is already registered with RouDi as '" + runtime_name +
+                              "', cannot register as '" + std::string(app_name) + "'"));
   }
   if (auto probe = probe_roudi(); !probe) return probe;
   iox::RuntimeName_t name(iox::cxx::TruncateToCapacity, app_name.data(), app_name.size());
@@ -130,20 +148,24 @@ Result<IpcPools, IpcError> load_roudi_pools(const std::string& path) {
   if (!path.empty()) {
     struct stat info {};
     if (::stat(path.c_str(), &info) != 0 || !S_ISREG(info.st_mode)) {
-      return err(make_error(IpcError::Code::CONFIG, "RouDi config '" + path + "': not a readable file"));
+      return err(
+          make_error(IpcError::Code::CONFIG, "RouDi config '" + path + "': not a readable file"));
     }
     if (path.size() > iox::roudi::ConfigFilePathString_t::capacity()) {
-      return err(make_error(IpcError::Code::CONFIG, "RouDi config '" + path + "': path too long for iceoryx"));
+      return err(make_error(IpcError::Code::CONFIG,
+                            "RouDi config '" + path + "': path too long for iceoryx"));
     }
-    args.configFilePath = iox::roudi::ConfigFilePathString_t(iox::cxx::TruncateToCapacity, path.c_str());
+    args.configFilePath =
+        iox::roudi::ConfigFilePathString_t(iox::cxx::TruncateToCapacity, path.c_str());
   } else {
     return default_roudi_pools();
   }
   iox::config::TomlRouDiConfigFileProvider provider(args);
   auto parsed = provider.parse();
   if (parsed.has_error()) {
-    return err(make_error(IpcError::Code::CONFIG,
-                          "RouDi config '" + path + "': " + std::string(parse_error_name(parsed.get_error()))));
+    return err(make_error(
+        IpcError::Code::CONFIG,
+        "RouDi config '" + path + "': " + std::string(parse_error_name(parsed.get_error()))));
   }
   return pools_of(parsed.value());
 }
@@ -155,7 +177,8 @@ IpcPools default_roudi_pools() {
 }
 
 Result<IpcPools, IpcError> query_roudi_pools(std::chrono::milliseconds timeout) {
-  if (!ipc_runtime_ready()) return err(make_error(IpcError::Code::NO_POOL_INFO, "IPC runtime not initialised"));
+  if (!ipc_runtime_ready())
+    return err(make_error(IpcError::Code::NO_POOL_INFO, "IPC runtime not initialised"));
   iox::popo::SubscriberOptions options;
   options.queueCapacity = 1;
   options.historyRequest = 1;
@@ -167,30 +190,36 @@ Result<IpcPools, IpcError> query_roudi_pools(std::chrono::milliseconds timeout) 
     bool got = false;
     subscriber.take().and_then([&](const auto& sample) {
       got = true;
-      // Entry 0 describes RouDi's own introspection memory; user pools follow, one entry per segment.
+      // Entry 0 describes RouDi's own introspection memory; user pools follow, one entry per
+      // segment.
       for (std::size_t s = 1; s < sample->size(); ++s) {
-        for (const auto& info : (*sample)[s].m_mempoolInfo) pools.push_back(IpcPool{info.m_chunkPayloadSize, info.m_numChunks});
+        for (const auto& info : (*sample)[s].m_mempoolInfo)
+          pools.push_back(IpcPool{info.m_chunkPayloadSize, info.m_numChunks});
       }
     });
     if (got) return pools;
     if (!probe_roudi()) {
       mark_roudi_lost();
-      return err(make_error(IpcError::Code::ROUDI_LOST, "RouDi disappeared while its pools were queried"));
+      return err(
+          make_error(IpcError::Code::ROUDI_LOST, "RouDi disappeared while its pools were queried"));
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
-  return err(make_error(IpcError::Code::NO_POOL_INFO, "RouDi published no MemPool introspection within " +
-                                                          std::to_string(timeout.count()) + " ms"));
+  return err(
+      make_error(IpcError::Code::NO_POOL_INFO, "RouDi published no MemPool introspection within " +
+                                                   std::to_string(timeout.count()) + " ms"));
 }
 
-std::uint64_t ipc_required_chunk_bytes(std::uint64_t payload_bytes, std::uint32_t alignment) noexcept {
+std::uint64_t ipc_required_chunk_bytes(std::uint64_t payload_bytes,
+                                       std::uint32_t alignment) noexcept {
   if (payload_bytes > UINT32_MAX) return 0;
-  auto settings = iox::mepoo::ChunkSettings::create(static_cast<std::uint32_t>(payload_bytes), alignment);
+  auto settings =
+      iox::mepoo::ChunkSettings::create(static_cast<std::uint32_t>(payload_bytes), alignment);
   return settings.has_error() ? 0 : settings.value().requiredChunkSize();
 }
 
-Result<void, IpcError> check_pool_fits(const IpcPools& pools, std::uint64_t payload_bytes, std::uint32_t alignment,
-                                       std::string_view who) {
+Result<void, IpcError> check_pool_fits(const IpcPools& pools, std::uint64_t payload_bytes,
+                                       std::uint32_t alignment, std::string_view who) {
   const std::uint64_t needed = ipc_required_chunk_bytes(payload_bytes, alignment);
   std::uint64_t largest = 0;
   // A pool configured with `size` payload bytes holds chunks of size + sizeof(ChunkHeader)
@@ -201,9 +230,10 @@ Result<void, IpcError> check_pool_fits(const IpcPools& pools, std::uint64_t payl
     if (needed != 0 && pool.count > 0 && needed <= chunk) return {};
   }
   return err(make_error(IpcError::Code::NO_FITTING_POOL,
-                        std::string(who) + ": a " + std::to_string(payload_bytes) + " B payload needs a " +
-                            std::to_string(needed) + " B chunk; RouDi's largest pool holds " +
-                            std::to_string(largest) + " B payloads (" + std::to_string(pools.size()) +
+                        std::string(who) + ": a " + std::to_string(payload_bytes) +
+                            " B payload needs a " + std::to_string(needed) +
+                            " B chunk; RouDi's largest pool holds " + std::to_string(largest) +
+                            " B payloads (" + std::to_string(pools.size()) +
                             " pools): add a pool (`orthoflow ipc config`)"));
 }
 

@@ -86,11 +86,13 @@ void mark_roudi_lost() noexcept;
 
 /// @brief Chunk bytes iceoryx needs for a payload of `payload_bytes` aligned to `alignment`
 /// (iox::mepoo::ChunkSettings), or 0 if iceoryx rejects the parameters.
-[[nodiscard]] std::uint64_t ipc_required_chunk_bytes(std::uint64_t payload_bytes, std::uint32_t alignment) noexcept;
+[[nodiscard]] std::uint64_t ipc_required_chunk_bytes(std::uint64_t payload_bytes,
+                                                     std::uint32_t alignment) noexcept;
 
 /// @brief Checks that some pool can hold a `payload_bytes` payload aligned to `alignment`.
 /// @return NO_FITTING_POOL naming `who`, the bytes needed and the largest pool.
-[[nodiscard]] Result<void, IpcError> check_pool_fits(const IpcPools& pools, std::uint64_t payload_bytes,
+[[nodiscard]] Result<void, IpcError> check_pool_fits(const IpcPools& pools,
+                                                     std::uint64_t payload_bytes,
                                                      std::uint32_t alignment, std::string_view who);
 
 }  // namespace orthoflow::engine

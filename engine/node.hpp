@@ -25,10 +25,10 @@ enum class BuildMode { RUN, CHECK };
 
 /// @brief What a node can use while it runs; owned by the engine and alive as long as the node.
 struct NodeContext {
-  std::string_view name;                    ///< the node's instance name (for pool error messages)
-  memory_pool::BlockPool* pool = nullptr;   ///< the graph's frame pool
-  std::size_t max_in_flight = 1;            ///< frames that can be in flight at once (limiter size)
-  BuildMode mode = BuildMode::RUN;          ///< CHECK: validate only, connect to nothing
+  std::string_view name;                   ///< the node's instance name (for pool error messages)
+  memory_pool::BlockPool* pool = nullptr;  ///< the graph's frame pool
+  std::size_t max_in_flight = 1;           ///< frames that can be in flight at once (limiter size)
+  BuildMode mode = BuildMode::RUN;         ///< CHECK: validate only, connect to nothing
 };
 
 /// @brief Where a node puts its results during process(). Implemented by the engine.

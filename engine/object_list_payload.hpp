@@ -1,11 +1,12 @@
 #pragma once
 /// @file
 /// @brief ObjectListPayload: the recognised objects of one frame as one fixed-size POD: what the
-/// tabletop graph's objects_output node hands to in-process consumers (graphs/objects_output.hpp) and,
-/// through ipc_publish, to the iceoryx topic `orthoflow/<graph>/objects`. With frame_payload.hpp this is
-/// the one place orthoflow's message schemas live; the transport and every consumer include it.
-/// Same header rules as every payload: type id, version, payload_bytes at offset 48.
-/// Version 2: decided_ns and age_ns (reserved in 1), per-object sensor-frame box and flags.
+/// tabletop graph's objects_output node hands to in-process consumers (graphs/objects_output.hpp)
+/// and, through ipc_publish, to the iceoryx topic `orthoflow/<graph>/objects`. With
+/// frame_payload.hpp this is the one place orthoflow's message schemas live; the transport and
+/// every consumer include it. Same header rules as every payload: type id, version, payload_bytes
+/// at offset 48. Version 2: decided_ns and age_ns (reserved in 1), per-object sensor-frame box and
+/// flags.
 #include <cstddef>
 #include <cstdint>
 #include <type_traits>
@@ -14,30 +15,33 @@
 
 namespace orthoflow::engine {
 
-inline constexpr std::uint32_t OBJECT_LIST_TYPE_ID = 0x4C4F464FU;  ///< "OFOL" in little-endian bytes
+inline constexpr std::uint32_t OBJECT_LIST_TYPE_ID =
+    0x4C4F464FU;  ///< "OFOL" in little-endian bytes
 inline constexpr std::uint16_t OBJECT_LIST_VERSION = 2;
 inline constexpr std::uint32_t OBJECT_LIST_CAPACITY = 64;
 
 /// @brief One object: track, label, pose frame and size.
 struct ObjectEntry {
-  std::uint64_t track_id;          ///< 0: not tracked
-  core::Text label;                ///< the category, or empty when Unknown
-  float score;                     ///< recognition score (learner's decision value; NaN before any lesson)
-  std::uint32_t unknown;           ///< 1 if no known category matched (or the object was not recognised)
-  float centroid[3];               ///< metres, sensor frame
-  float frame[16];                 ///< sensor-to-object transform, row-major 4x4 (GOOD's object frame)
-  float bbox[3];                   ///< bounding-box extents along the object frame's axes, metres
+  std::uint64_t track_id;  ///< 0: not tracked
+  core::Text label;        ///< the category, or empty when Unknown
+  float score;             ///< recognition score (learner's decision value; NaN before any lesson)
+  std::uint32_t unknown;   ///< 1 if no known category matched (or the object was not recognised)
+  float centroid[3];       ///< metres, sensor frame
+  float frame[16];         ///< sensor-to-object transform, row-major 4x4 (GOOD's object frame)
+  float bbox[3];           ///< bounding-box extents along the object frame's axes, metres
   std::uint32_t point_count;
-  float bbox_min[3];               ///< axis-aligned box in the sensor frame, metres
+  float bbox_min[3];  ///< axis-aligned box in the sensor frame, metres
   float bbox_max[3];
-  std::uint32_t flags;             ///< OBJECT_* bits below
+  std::uint32_t flags;  ///< OBJECT_* bits below
 };
 
 inline constexpr std::uint32_t OBJECT_DESCRIBED = 1U << 0;  ///< it has a descriptor (and a frame)
 inline constexpr std::uint32_t OBJECT_MOVING = 1U << 1;     ///< the tracker sees it move
-inline constexpr std::uint32_t OBJECT_KEY_VIEW = 1U << 2;   ///< this view is one of its track's key views
-inline constexpr std::uint32_t OBJECT_FRAGMENT = 1U << 3;   ///< a piece of an object with the same track id
-inline constexpr std::uint32_t OBJECT_TAUGHT = 1U << 4;     ///< this view was taught in this frame
+inline constexpr std::uint32_t OBJECT_KEY_VIEW =
+    1U << 2;  ///< this view is one of its track's key views
+inline constexpr std::uint32_t OBJECT_FRAGMENT =
+    1U << 3;  ///< a piece of an object with the same track id
+inline constexpr std::uint32_t OBJECT_TAUGHT = 1U << 4;  ///< this view was taught in this frame
 
 /// @brief Header (64 bytes) + count + up to 64 objects. The user-written empty constructors leave
 /// the members uninitialised on purpose: iceoryx's typed loan() value-initialises its payload, and
@@ -53,10 +57,11 @@ struct alignas(64) ObjectListPayload {
   std::int64_t host_stamp_ns;
   std::int64_t decided_ns;      ///< steady-clock time the objects were decided (recognised), ns
   std::uint64_t payload_bytes;  ///< offset 48: sizeof(ObjectListPayload)
-  std::int64_t age_ns;          ///< decided_ns minus the frame's host stamp: the frame's age at decision
+  std::int64_t age_ns;  ///< decided_ns minus the frame's host stamp: the frame's age at decision
   ObjectEntry objects[OBJECT_LIST_CAPACITY];
 
-  ObjectListPayload() noexcept {}  // NOLINT: deliberately leaves the fields uninitialised (see above)
+  ObjectListPayload() noexcept {
+  }  // NOLINT: deliberately leaves the fields uninitialised (see above)
 
   /// @brief Writes type id, version, payload_bytes and zero count/stamps/reserved. No allocation.
   void reset_header() noexcept {

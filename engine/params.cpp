@@ -8,7 +8,8 @@ namespace orthoflow::engine {
 
 namespace {
 std::string where(const ParamMap::Entry& entry) {
-  return "parameter '" + entry.key + "'" + (entry.line > 0 ? " (line " + std::to_string(entry.line) + ")" : "");
+  return "parameter '" + entry.key + "'" +
+         (entry.line > 0 ? " (line " + std::to_string(entry.line) + ")" : "");
 }
 }  // namespace
 
@@ -19,19 +20,21 @@ void ParamMap::set(std::string key, std::string value, int line) {
 bool ParamMap::has(const std::string& key) const { return find(key) != nullptr; }
 
 const ParamMap::Entry* ParamMap::find(const std::string& key) const {
-  const auto it = std::find_if(entries_.begin(), entries_.end(), [&](const Entry& e) { return e.key == key; });
+  const auto it =
+      std::find_if(entries_.begin(), entries_.end(), [&](const Entry& e) { return e.key == key; });
   return it == entries_.end() ? nullptr : &*it;
 }
 
-Result<std::int64_t, std::string> ParamMap::integer(const std::string& key, std::int64_t fallback, std::int64_t min,
-                                                    std::int64_t max) const {
+Result<std::int64_t, std::string> ParamMap::integer(const std::string& key, std::int64_t fallback,
+                                                    std::int64_t min, std::int64_t max) const {
   const Entry* entry = find(key);
   if (entry == nullptr) return fallback;
   std::int64_t value = 0;
   const char* first = entry->value.data();
   const char* last = first + entry->value.size();
   const auto [ptr, ec] = std::from_chars(first, last, value);
-  if (ec != std::errc{} || ptr != last) return err(where(*entry) + ": '" + entry->value + "' is not an integer");
+  if (ec != std::errc{} || ptr != last)
+    return err(where(*entry) + ": '" + entry->value + "' is not an integer");
   if (value < min || value > max) {
     return err(where(*entry) + ": " + entry->value + " is outside [" + std::to_string(min) + ", " +
                std::to_string(max) + "]");
@@ -57,7 +60,8 @@ Result<double, std::string> ParamMap::number(const std::string& key, double fall
   return value;
 }
 
-Result<std::string, std::string> ParamMap::text(const std::string& key, const std::string& fallback) const {
+Result<std::string, std::string> ParamMap::text(const std::string& key,
+                                                const std::string& fallback) const {
   const Entry* entry = find(key);
   if (entry == nullptr) return fallback;
   if (entry->value.empty()) return err(where(*entry) + ": must not be empty");
@@ -75,7 +79,8 @@ void ParamMap::assign(const std::string& key, std::string value) {
   entries_.push_back({key, std::move(value), 0});
 }
 
-Result<std::string, std::string> ParamMap::choice(const std::string& key, const std::string& fallback,
+Result<std::string, std::string> ParamMap::choice(const std::string& key,
+                                                  const std::string& fallback,
                                                   const std::vector<std::string>& choices) const {
   const Entry* entry = find(key);
   if (entry == nullptr) return fallback;

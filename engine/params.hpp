@@ -23,18 +23,22 @@ class ParamMap {
   void set(std::string key, std::string value, int line = 0);
   [[nodiscard]] bool has(const std::string& key) const;
   /// @brief Integer in [min, max]; `fallback` if absent. Error: "parameter 'k' (line L): ...".
-  [[nodiscard]] Result<std::int64_t, std::string> integer(const std::string& key, std::int64_t fallback,
-                                                         std::int64_t min, std::int64_t max) const;
+  [[nodiscard]] Result<std::int64_t, std::string> integer(const std::string& key,
+                                                          std::int64_t fallback, std::int64_t min,
+                                                          std::int64_t max) const;
   /// @brief Finite real number in [min, max]; `fallback` if absent.
-  [[nodiscard]] Result<double, std::string> number(const std::string& key, double fallback, double min,
-                                                   double max) const;
+  [[nodiscard]] Result<double, std::string> number(const std::string& key, double fallback,
+                                                   double min, double max) const;
   /// @brief Free text (a path, a topic); `fallback` if absent. Error if present but empty.
-  [[nodiscard]] Result<std::string, std::string> text(const std::string& key, const std::string& fallback) const;
-  /// @brief Sets `key` to `value`, replacing an existing entry (command-line overrides of a graph file).
+  [[nodiscard]] Result<std::string, std::string> text(const std::string& key,
+                                                      const std::string& fallback) const;
+  /// @brief Sets `key` to `value`, replacing an existing entry (command-line overrides of a graph
+  /// file).
   void assign(const std::string& key, std::string value);
   /// @brief One of `choices`; `fallback` if absent.
-  [[nodiscard]] Result<std::string, std::string> choice(const std::string& key, const std::string& fallback,
-                                                       const std::vector<std::string>& choices) const;
+  [[nodiscard]] Result<std::string, std::string> choice(
+      const std::string& key, const std::string& fallback,
+      const std::vector<std::string>& choices) const;
   /// @brief Marks every key in `known` as used; returns an error naming the first unknown key.
   [[nodiscard]] Result<void, std::string> only(const std::vector<std::string>& known) const;
   [[nodiscard]] const std::vector<Entry>& entries() const noexcept { return entries_; }

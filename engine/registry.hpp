@@ -7,16 +7,17 @@
 #include <string>
 #include <vector>
 
+#include "core/result.hpp"
 #include "engine/node.hpp"
 #include "engine/params.hpp"
-#include "core/result.hpp"
 
 namespace orthoflow::engine {
 
 /// @brief Builds a node from its parameters; returns a message (without file/line) on bad ones.
 /// With NodeContext::mode == BuildMode::CHECK a factory validates exactly as for RUN but connects
 /// to nothing outside the process (daemons, devices); the node only has to report its ports.
-using NodeFactory = std::function<Result<std::unique_ptr<Node>, std::string>(const ParamMap&, const NodeContext&)>;
+using NodeFactory =
+    std::function<Result<std::unique_ptr<Node>, std::string>(const ParamMap&, const NodeContext&)>;
 
 /// @brief Maps kind names to factories. Filled at start-up, then only read (thread-safe to read).
 class NodeRegistry {
@@ -36,7 +37,8 @@ class NodeRegistry {
   std::map<std::string, Kind> kinds_;
 };
 
-/// @brief Adds the domain-free kinds of generic_nodes.hpp (ticker, pass, busy, fanout, join, count).
+/// @brief Adds the domain-free kinds of generic_nodes.hpp (ticker, pass, busy, fanout, join,
+/// count).
 void add_generic_nodes(NodeRegistry& registry);
 
 }  // namespace orthoflow::engine

@@ -14,15 +14,21 @@ double per_second(std::uint64_t count, std::int64_t elapsed_ns) {
 }
 
 nlohmann::json histogram_json(const LatencyHistogram& h) {
-  return {{"count", h.count()},         {"p50_ns", h.percentile(0.5)},    {"p90_ns", h.percentile(0.9)},
-          {"p99_ns", h.percentile(0.99)}, {"p999_ns", h.percentile(0.999)}, {"max_ns", h.max()}};
+  return {{"count", h.count()},
+          {"p50_ns", h.percentile(0.5)},
+          {"p90_ns", h.percentile(0.9)},
+          {"p99_ns", h.percentile(0.99)},
+          {"p999_ns", h.percentile(0.999)},
+          {"max_ns", h.max()}};
 }
 
-std::string row(const std::string& name, const LatencyHistogram& h, std::uint64_t count, double rate,
-                std::uint64_t drops, std::uint64_t misses, const LatencyHistogram* age) {
+std::string row(const std::string& name, const LatencyHistogram& h, std::uint64_t count,
+                double rate, std::uint64_t drops, std::uint64_t misses,
+                const LatencyHistogram* age) {
   char line[256];
   auto us = [](std::int64_t ns) { return static_cast<double>(ns) / 1e3; };
-  std::snprintf(line, sizeof line, "%-16s %10llu %10.1f %9.1f %9.1f %9.1f %9.1f %9.1f %8llu %8llu %10.1f\n",
+  std::snprintf(line, sizeof line,
+                "%-16s %10llu %10.1f %9.1f %9.1f %9.1f %9.1f %9.1f %8llu %8llu %10.1f\n",
                 name.c_str(), static_cast<unsigned long long>(count), rate, us(h.percentile(Q[0])),
                 us(h.percentile(Q[1])), us(h.percentile(Q[2])), us(h.percentile(Q[3])), us(h.max()),
                 static_cast<unsigned long long>(drops), static_cast<unsigned long long>(misses),
@@ -41,15 +47,16 @@ std::uint64_t GraphStats::total_drops() const noexcept {
 std::string format_table(const GraphStats& stats) {
   const std::int64_t elapsed = stats.elapsed_ns.load();
   std::string table =
-      "node                  count      msg/s   p50(us)   p90(us)   p99(us) p99.9(us)   max(us)    drops   misses "
+      "node                  count      msg/s   p50(us)   p90(us)   p99(us) p99.9(us)   max(us)    "
+      "drops   misses "
       "age50(us)\n";
   for (const auto& n : stats.nodes) {
-    table += row(n.name, n.service, n.processed.load(), per_second(n.processed.load(), elapsed), n.dropped.load(),
-                 n.deadline_misses.load(), n.sink ? &n.age : nullptr);
+    table += row(n.name, n.service, n.processed.load(), per_second(n.processed.load(), elapsed),
+                 n.dropped.load(), n.deadline_misses.load(), n.sink ? &n.age : nullptr);
   }
   table += row("[graph " + stats.name + "]", stats.frame_latency, stats.frames_done.load(),
-               per_second(stats.frames_done.load(), elapsed), stats.total_drops(), stats.deadline_misses.load(),
-               nullptr);
+               per_second(stats.frames_done.load(), elapsed), stats.total_drops(),
+               stats.deadline_misses.load(), nullptr);
   return table;
 }
 

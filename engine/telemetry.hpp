@@ -13,13 +13,13 @@ namespace orthoflow::engine {
 
 /// @brief Counters of one node. All fields are atomics written with relaxed ordering.
 struct NodeStats {
-  std::string name;                          ///< set at start-up
-  bool sink = false;                         ///< no outputs: frame age is recorded here
-  LatencyHistogram service;                  ///< time inside process()
-  LatencyHistogram age;                      ///< sinks: now - source stamp when the message arrives
-  std::atomic<std::uint64_t> processed{0};   ///< messages handed to process()
-  std::atomic<std::uint64_t> dropped{0};     ///< stale messages skipped by the latest-wins policy
-  std::atomic<std::uint64_t> skipped{0};     ///< tombstones passed through without processing
+  std::string name;                         ///< set at start-up
+  bool sink = false;                        ///< no outputs: frame age is recorded here
+  LatencyHistogram service;                 ///< time inside process()
+  LatencyHistogram age;                     ///< sinks: now - source stamp when the message arrives
+  std::atomic<std::uint64_t> processed{0};  ///< messages handed to process()
+  std::atomic<std::uint64_t> dropped{0};    ///< stale messages skipped by the latest-wins policy
+  std::atomic<std::uint64_t> skipped{0};    ///< tombstones passed through without processing
   std::atomic<std::uint64_t> deadline_misses{0};  ///< process() took longer than the node deadline
   std::atomic<std::uint32_t> running{0};          ///< process() calls in progress right now
   std::atomic<std::uint32_t> max_running{0};      ///< most process() calls ever seen at once
@@ -30,12 +30,12 @@ struct GraphStats {
   std::string name;
   std::int64_t period_ns = 0;
   std::deque<NodeStats> nodes;
-  LatencyHistogram frame_latency;                  ///< source stamp -> frame fully processed
-  std::atomic<std::uint64_t> frames_in{0};         ///< frames produced by the source
-  std::atomic<std::uint64_t> frames_done{0};       ///< frames fully processed (tombstones included)
-  std::atomic<std::uint64_t> source_drops{0};      ///< frames the source could not fill (pool)
-  std::atomic<std::uint64_t> deadline_misses{0};   ///< frames whose latency exceeded the period
-  std::atomic<std::int64_t> elapsed_ns{0};         ///< wall time of the last run
+  LatencyHistogram frame_latency;                 ///< source stamp -> frame fully processed
+  std::atomic<std::uint64_t> frames_in{0};        ///< frames produced by the source
+  std::atomic<std::uint64_t> frames_done{0};      ///< frames fully processed (tombstones included)
+  std::atomic<std::uint64_t> source_drops{0};     ///< frames the source could not fill (pool)
+  std::atomic<std::uint64_t> deadline_misses{0};  ///< frames whose latency exceeded the period
+  std::atomic<std::int64_t> elapsed_ns{0};        ///< wall time of the last run
 
   /// @brief Sum of drops over the source and every node.
   [[nodiscard]] std::uint64_t total_drops() const noexcept;

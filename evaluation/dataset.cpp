@@ -10,7 +10,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-EvalError bad(std::string message) { return EvalError{EvalError::Code::BAD_DATASET, std::move(message)}; }
+EvalError bad(std::string message) {
+  return EvalError{EvalError::Code::BAD_DATASET, std::move(message)};
+}
 
 bool hidden(const fs::path& p) { return p.filename().string().starts_with('.'); }
 bool is_pcd(const fs::path& p) { return p.extension() == ".pcd"; }
@@ -24,7 +26,8 @@ Result<std::vector<fs::directory_entry>, EvalError> sorted_entries(const fs::pat
   for (const fs::directory_entry& e : it) {
     if (!hidden(e.path())) { out.push_back(e); }
   }
-  std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.path().filename() < b.path().filename(); });
+  std::sort(out.begin(), out.end(),
+            [](const auto& a, const auto& b) { return a.path().filename() < b.path().filename(); });
   return out;
 }
 
@@ -34,7 +37,8 @@ bool is_dir(const fs::directory_entry& e) {
 }
 
 /// Adds the views of one instance folder.
-Result<void, EvalError> scan_instance(Dataset& ds, const fs::directory_entry& inst, std::uint32_t category) {
+Result<void, EvalError> scan_instance(Dataset& ds, const fs::directory_entry& inst,
+                                      std::uint32_t category) {
   auto files = sorted_entries(inst.path());
   if (!files) { return err(files.error()); }
   const std::string prefix = ds.categories[category] + "/" + inst.path().filename().string();
@@ -42,7 +46,8 @@ Result<void, EvalError> scan_instance(Dataset& ds, const fs::directory_entry& in
   bool any = false;
   for (const fs::directory_entry& f : *files) {
     if (is_dir(f) || !is_pcd(f.path())) { continue; }
-    ds.views.push_back(DatasetView{category, instance, prefix + "/" + f.path().filename().string()});
+    ds.views.push_back(
+        DatasetView{category, instance, prefix + "/" + f.path().filename().string()});
     any = true;
   }
   if (any) { ds.instances.push_back(prefix); }
@@ -52,7 +57,8 @@ Result<void, EvalError> scan_instance(Dataset& ds, const fs::directory_entry& in
 Result<void, EvalError> scan_category(Dataset& ds, const fs::directory_entry& cat) {
   const std::string name = cat.path().filename().string();
   if (name.size() > learning::LABEL_MAX_BYTES) {
-    return err(bad("category name '" + name + "' is longer than " + std::to_string(learning::LABEL_MAX_BYTES) + " bytes"));
+    return err(bad("category name '" + name + "' is longer than " +
+                   std::to_string(learning::LABEL_MAX_BYTES) + " bytes"));
   }
   auto entries = sorted_entries(cat.path());
   if (!entries) { return err(entries.error()); }
@@ -63,10 +69,14 @@ Result<void, EvalError> scan_category(Dataset& ds, const fs::directory_entry& ca
     if (is_dir(e)) {
       if (auto r = scan_instance(ds, e, category); !r) { return r; }
     } else if (is_pcd(e.path())) {
-      return err(bad(e.path().string() + " is directly in a category folder: expected DIR/<category>/<instance>/<view>.pcd"));
+      return err(
+          bad(e.path().string() +
+              " is directly in a category folder: expected DIR/<category>/<instance>/<view>.pcd"));
     }
   }
-  if (ds.views.size() == before) { return err(bad("category '" + name + "' (" + cat.path().string() + ") has no .pcd view")); }
+  if (ds.views.size() == before) {
+    return err(bad("category '" + name + "' (" + cat.path().string() + ") has no .pcd view"));
+  }
   return {};
 }
 
@@ -91,10 +101,14 @@ Result<Dataset, EvalError> scan_dataset(const std::filesystem::path& root) {
     if (is_dir(e)) {
       if (auto r = scan_category(ds, e); !r) { return err(r.error()); }
     } else if (is_pcd(e.path())) {
-      return err(bad(e.path().string() + " is at the top level: expected DIR/<category>/<instance>/<view>.pcd"));
+      return err(bad(e.path().string() +
+                     " is at the top level: expected DIR/<category>/<instance>/<view>.pcd"));
     }
   }
-  if (ds.views.empty()) { return err(bad(root.string() + " holds no view (expected DIR/<category>/<instance>/<view>.pcd)")); }
+  if (ds.views.empty()) {
+    return err(
+        bad(root.string() + " holds no view (expected DIR/<category>/<instance>/<view>.pcd)"));
+  }
   return ds;
 }
 

@@ -1,15 +1,15 @@
 #pragma once
 /// @file
-/// @brief A dataset of segmented object views laid out as `DIR/<category>/<instance>/<view>.pcd` (the layout
-/// `orthoflow synth-dataset` writes; real views can be arranged the same way), scanned into sorted lists so
-/// that every index below is the same on every machine for the same tree.
+/// @brief A dataset of segmented object views laid out as `DIR/<category>/<instance>/<view>.pcd`
+/// (the layout `orthoflow synth-dataset` writes; real views can be arranged the same way), scanned
+/// into sorted lists so that every index below is the same on every machine for the same tree.
 #include <cstdint>
 #include <filesystem>
 #include <string>
 #include <vector>
 
-#include "evaluation/eval_error.hpp"
 #include "core/result.hpp"
+#include "evaluation/eval_error.hpp"
 
 namespace orthoflow::evaluation {
 
@@ -30,10 +30,11 @@ struct Dataset {
   [[nodiscard]] std::vector<std::size_t> views_of(std::uint32_t category) const;
 };
 
-/// @brief Scans @p root. Directories and files whose name starts with '.' are skipped (e.g. caches);
-/// other files than .pcd are ignored where the layout allows files (top level, instance folders).
-/// Errors (BAD_DATASET): @p root missing or not a directory; a .pcd file at the wrong depth; a category
-/// name longer than learning::LABEL_MAX_BYTES; a category with no view; no view at all.
+/// @brief Scans @p root. Directories and files whose name starts with '.' are skipped (e.g.
+/// caches); other files than .pcd are ignored where the layout allows files (top level, instance
+/// folders). Errors (BAD_DATASET): @p root missing or not a directory; a .pcd file at the wrong
+/// depth; a category name longer than learning::LABEL_MAX_BYTES; a category with no view; no view
+/// at all.
 [[nodiscard]] Result<Dataset, EvalError> scan_dataset(const std::filesystem::path& root);
 
 }  // namespace orthoflow::evaluation

@@ -8,7 +8,8 @@
 
 namespace orthoflow::evaluation {
 
-kernels::PointCloud derive_view(const kernels::PointCloud& cloud, std::uint32_t index, std::uint64_t seed) {
+kernels::PointCloud derive_view(const kernels::PointCloud& cloud, std::uint32_t index,
+                                std::uint64_t seed) {
   std::vector<std::size_t> finite;
   double c[3] = {0.0, 0.0, 0.0};
   for (std::size_t i = 0; i < cloud.size(); ++i) {
@@ -29,13 +30,17 @@ kernels::PointCloud derive_view(const kernels::PointCloud& cloud, std::uint32_t 
   const double keep = index == 0 ? 1.0 : rng.uniform(0.7, 1.0);
   std::vector<std::pair<double, std::size_t>> along;
   for (const std::size_t i : finite) {
-    const double t = ((cloud.x()[i] - c[0]) * d[0] + (cloud.y()[i] - c[1]) * d[1] + (cloud.z()[i] - c[2]) * d[2]) / norm;
+    const double t = ((cloud.x()[i] - c[0]) * d[0] + (cloud.y()[i] - c[1]) * d[1] +
+                      (cloud.z()[i] - c[2]) * d[2]) /
+                     norm;
     along.emplace_back(t, i);
   }
   std::sort(along.begin(), along.end());
-  const auto kept = std::max<std::size_t>(1, static_cast<std::size_t>(keep * static_cast<double>(along.size())));
-  std::sort(along.begin(), along.begin() + static_cast<std::ptrdiff_t>(kept),
-            [](const auto& a, const auto& b) { return a.second < b.second; });  // original point order
+  const auto kept =
+      std::max<std::size_t>(1, static_cast<std::size_t>(keep * static_cast<double>(along.size())));
+  std::sort(
+      along.begin(), along.begin() + static_cast<std::ptrdiff_t>(kept),
+      [](const auto& a, const auto& b) { return a.second < b.second; });  // original point order
   out.resize_unorganized(kept);
   const double sigma = index == 0 ? 0.0 : 0.001;
   for (std::size_t k = 0; k < kept; ++k) {

@@ -1,11 +1,12 @@
-// The cache format: "OFDC" u32 version=1, u64 length, u64 count, then per entry u32 path bytes, path,
-// u64 size, i64 mtime_ns, length floats. Host byte order: the cache is a local file, never exchanged.
+// The cache format: "OFDC" u32 version=1, u64 length, u64 count, then per entry u32 path bytes,
+// path, u64 size, i64 mtime_ns, length floats. Host byte order: the cache is a local file, never
+// exchanged.
 #include "evaluation/descriptor_cache.hpp"
 
+#include <unistd.h>
 #include <algorithm>
 #include <chrono>
 #include <cstring>
-#include <unistd.h>
 #include <fstream>
 #include <system_error>
 
@@ -60,7 +61,8 @@ bool stamp_file(const std::filesystem::path& path, FileStamp& out) {
   const auto mtime = std::filesystem::last_write_time(path, ec);
   if (ec) { return false; }
   out.size = size;
-  out.mtime_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(mtime.time_since_epoch()).count();
+  out.mtime_ns =
+      std::chrono::duration_cast<std::chrono::nanoseconds>(mtime.time_since_epoch()).count();
   return true;
 }
 
@@ -71,8 +73,9 @@ DescriptorCache parse_descriptor_cache(std::span<const char> bytes, std::size_t 
   char magic[4] = {};
   std::uint32_t version = 0;
   std::uint64_t stored_length = 0, count = 0;
-  if (!r.get_bytes(magic, 4) || std::memcmp(magic, MAGIC, 4) != 0 || !r.get(version) || version != VERSION ||
-      !r.get(stored_length) || stored_length != length || length == 0 || !r.get(count)) {
+  if (!r.get_bytes(magic, 4) || std::memcmp(magic, MAGIC, 4) != 0 || !r.get(version) ||
+      version != VERSION || !r.get(stored_length) || stored_length != length || length == 0 ||
+      !r.get(count)) {
     return cache;
   }
   // Each entry takes at least 21 + 4 length bytes: a count beyond that cannot be honest.
@@ -92,13 +95,15 @@ std::string encode_descriptor_cache(const DescriptorCache& cache) {
   // Sorted by path so the same cache gives the same bytes.
   std::vector<const std::pair<const std::string, DescriptorCache::Entry>*> sorted;
   for (const auto& kv : cache.entries) { sorted.push_back(&kv); }
-  std::sort(sorted.begin(), sorted.end(), [](const auto* a, const auto* b) { return a->first < b->first; });
+  std::sort(sorted.begin(), sorted.end(),
+            [](const auto* a, const auto* b) { return a->first < b->first; });
   for (const auto* kv : sorted) {
     put(out, static_cast<std::uint32_t>(kv->first.size()));
     out += kv->first;
     put(out, kv->second.stamp.size);
     put(out, kv->second.stamp.mtime_ns);
-    out.append(reinterpret_cast<const char*>(kv->second.descriptor.data()), kv->second.descriptor.size() * sizeof(float));
+    out.append(reinterpret_cast<const char*>(kv->second.descriptor.data()),
+               kv->second.descriptor.size() * sizeof(float));
   }
   return out;
 }

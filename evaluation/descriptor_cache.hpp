@@ -1,8 +1,9 @@
 #pragma once
 /// @file
-/// @brief The on-disk descriptor cache of describe_dataset(): one binary file per (dataset, parameter set),
-/// entries keyed by a view's relative path, byte size and modification time. A cache is only ever a hint:
-/// a missing, truncated or foreign file is ignored and the descriptors are recomputed.
+/// @brief The on-disk descriptor cache of describe_dataset(): one binary file per (dataset,
+/// parameter set), entries keyed by a view's relative path, byte size and modification time. A
+/// cache is only ever a hint: a missing, truncated or foreign file is ignored and the descriptors
+/// are recomputed.
 #include <cstdint>
 #include <filesystem>
 #include <span>
@@ -32,13 +33,17 @@ struct DescriptorCache {
   std::unordered_map<std::string, Entry> entries;  ///< by relative path
 };
 
-/// @brief Parses a cache file's bytes; returns an empty cache (entries empty) for anything malformed or
-/// of another descriptor @p length. Bounds-checked on every field (fuzzed by tests/fuzz).
-[[nodiscard]] DescriptorCache parse_descriptor_cache(std::span<const char> bytes, std::size_t length);
+/// @brief Parses a cache file's bytes; returns an empty cache (entries empty) for anything
+/// malformed or of another descriptor @p length. Bounds-checked on every field (fuzzed by
+/// tests/fuzz).
+[[nodiscard]] DescriptorCache parse_descriptor_cache(std::span<const char> bytes,
+                                                     std::size_t length);
 /// @brief The file bytes of @p cache (magic "OFDC", version 1, little-endian host layout).
 [[nodiscard]] std::string encode_descriptor_cache(const DescriptorCache& cache);
-/// @brief Writes @p cache to @p path through a temporary file and a rename (never a half-written cache).
+/// @brief Writes @p cache to @p path through a temporary file and a rename (never a half-written
+/// cache).
 /// @return an error sentence, empty on success.
-[[nodiscard]] std::string save_descriptor_cache(const DescriptorCache& cache, const std::filesystem::path& path);
+[[nodiscard]] std::string save_descriptor_cache(const DescriptorCache& cache,
+                                                const std::filesystem::path& path);
 
 }  // namespace orthoflow::evaluation

@@ -13,32 +13,47 @@
 namespace orthoflow::evaluation {
 namespace {
 
-EvalError config_error(std::string m) { return EvalError{EvalError::Code::BAD_CONFIG, std::move(m)}; }
+EvalError config_error(std::string m) {
+  return EvalError{EvalError::Code::BAD_CONFIG, std::move(m)};
+}
 
 bool perturbed(Protocol p) { return p == Protocol::NOISE || p == Protocol::DOWNSAMPLE; }
 
 /// The seed of run @p r: every random choice of a run derives from it, never from the variant.
-std::uint64_t run_seed(std::uint64_t seed, std::size_t r) { return seed * 0x9E3779B97F4A7C15ULL + r * 0xBF58476D1CE4E5B9ULL + 1; }
+std::uint64_t run_seed(std::uint64_t seed, std::size_t r) {
+  return seed * 0x9E3779B97F4A7C15ULL + r * 0xBF58476D1CE4E5B9ULL + 1;
+}
 
 Result<void, EvalError> check(const Dataset& ds, const EvalOptions& o) {
   if (o.variants.empty()) { return err(config_error("no variant to evaluate")); }
-  if (o.runs == 0 || o.runs > 1000) { return err(config_error("runs must be in 1..1000, got " + std::to_string(o.runs))); }
-  if (o.folds < 2) { return err(config_error("folds must be at least 2, got " + std::to_string(o.folds))); }
-  for (const double l : protocol_levels(o)) {
-    if (!std::isfinite(l) || l <= 0.0 || l > 1.0) { return err(config_error("levels must be in (0, 1] m, got " + std::to_string(l))); }
+  if (o.runs == 0 || o.runs > 1000) {
+    return err(config_error("runs must be in 1..1000, got " + std::to_string(o.runs)));
   }
-  if (o.teacher.intro_views == 0 || o.teacher.breakpoint == 0 || !(o.teacher.tau >= 0.0 && o.teacher.tau < 1.0)) {
+  if (o.folds < 2) {
+    return err(config_error("folds must be at least 2, got " + std::to_string(o.folds)));
+  }
+  for (const double l : protocol_levels(o)) {
+    if (!std::isfinite(l) || l <= 0.0 || l > 1.0) {
+      return err(config_error("levels must be in (0, 1] m, got " + std::to_string(l)));
+    }
+  }
+  if (o.teacher.intro_views == 0 || o.teacher.breakpoint == 0 ||
+      !(o.teacher.tau >= 0.0 && o.teacher.tau < 1.0)) {
     return err(config_error("teacher needs intro views >= 1, breakpoint >= 1 and tau in [0, 1)"));
   }
   const bool teacher = o.protocol == Protocol::TEACHER || o.protocol == Protocol::TEACHER_CONTEXT;
   for (std::uint32_t c = 0; teacher && c < ds.categories.size(); ++c) {
     if (ds.views_of(c).size() <= o.teacher.intro_views) {
-      return err(EvalError{EvalError::Code::TOO_FEW_VIEWS, "category '" + ds.categories[c] + "' has " + std::to_string(ds.views_of(c).size()) +
-                                                               " views; the teacher needs more than the " + std::to_string(o.teacher.intro_views) + " it teaches"});
+      return err(EvalError{EvalError::Code::TOO_FEW_VIEWS,
+                           "category '" + ds.categories[c] + "' has " +
+                               std::to_string(ds.views_of(c).size()) +
+                               " views; the teacher needs more than the " +
+                               std::to_string(o.teacher.intro_views) + " it teaches"});
     }
   }
   if (o.protocol == Protocol::TEACHER_CONTEXT && ds.categories.size() < 3) {
-    return err(EvalError{EvalError::Code::TOO_FEW_VIEWS, "context change needs at least 3 categories"});
+    return err(
+        EvalError{EvalError::Code::TOO_FEW_VIEWS, "context change needs at least 3 categories"});
   }
   return {};
 }
@@ -46,7 +61,8 @@ Result<void, EvalError> check(const Dataset& ds, const EvalOptions& o) {
 /// Descriptor tables shared by variants with the same (mode, bins), computed once each.
 class Tables {
  public:
-  Tables(const Dataset& ds, const EvalOptions& o, Progress* p, Evaluation& e) : ds_(ds), o_(o), p_(p), e_(e) {}
+  Tables(const Dataset& ds, const EvalOptions& o, Progress* p, Evaluation& e)
+      : ds_(ds), o_(o), p_(p), e_(e) {}
   Result<const DescriptorTable*, EvalError> get(const ViewDescription& spec) {
     const std::string key = spec.key();
     if (const auto it = tables_.find(key); it != tables_.end()) { return &it->second; }
@@ -81,7 +97,8 @@ Result<std::vector<Folds>, EvalError> folds_per_run(const Dataset& ds, const Eva
   return folds;
 }
 
-Result<void, EvalError> run_cv(const Dataset& ds, const EvalOptions& o, Tables& tables, Evaluation& e, Progress* p) {
+Result<void, EvalError> run_cv(const Dataset& ds, const EvalOptions& o, Tables& tables,
+                               Evaluation& e, Progress* p) {
   auto run_folds = folds_per_run(ds, o);
   if (!run_folds) { return err(run_folds.error()); }
   const std::vector<Folds>& folds = *run_folds;
@@ -97,8 +114,10 @@ Result<void, EvalError> run_cv(const Dataset& ds, const EvalOptions& o, Tables& 
   return {};
 }
 
-Result<void, EvalError> run_levels(const Dataset& ds, const EvalOptions& o, Tables& tables, Evaluation& e, Progress* p) {
-  const Perturbation kind = o.protocol == Protocol::NOISE ? Perturbation::NOISE : Perturbation::DOWNSAMPLE;
+Result<void, EvalError> run_levels(const Dataset& ds, const EvalOptions& o, Tables& tables,
+                                   Evaluation& e, Progress* p) {
+  const Perturbation kind =
+      o.protocol == Protocol::NOISE ? Perturbation::NOISE : Perturbation::DOWNSAMPLE;
   std::vector<double> levels{0.0};
   for (const double l : protocol_levels(o)) { levels.push_back(l); }
   auto run_folds = folds_per_run(ds, o);
@@ -121,10 +140,12 @@ Result<void, EvalError> run_levels(const Dataset& ds, const EvalOptions& o, Tabl
   return {};
 }
 
-void run_teachers(const Dataset& ds, const EvalOptions& o, const DescriptorTable& t, VariantResult& vr, Progress* p) {
+void run_teachers(const Dataset& ds, const EvalOptions& o, const DescriptorTable& t,
+                  VariantResult& vr, Progress* p) {
   vr.teacher.resize(o.runs);
   tbb::parallel_for(std::size_t{0}, o.runs, [&](std::size_t r) {
-    const std::vector<std::uint32_t> order = category_order(ds.categories.size(), run_seed(o.seed, r));
+    const std::vector<std::uint32_t> order =
+        category_order(ds.categories.size(), run_seed(o.seed, r));
     vr.teacher[r] = run_teacher(ds, t, vr.variant, order, o.teacher, run_seed(o.seed, r) + 7);
     tick(p);
   });
@@ -141,12 +162,16 @@ std::size_t draw_rho(const EvalOptions& o, std::size_t r, double alc, std::size_
   return std::clamp<std::size_t>(rho, 1, categories - 1);
 }
 
-void run_context(const Dataset& ds, const EvalOptions& o, const DescriptorTable& t, VariantResult& vr, Progress* p) {
+void run_context(const Dataset& ds, const EvalOptions& o, const DescriptorTable& t,
+                 VariantResult& vr, Progress* p) {
   vr.context.resize(o.runs);
   vr.rho.resize(o.runs);
-  for (std::size_t r = 0; r < o.runs; ++r) { vr.rho[r] = draw_rho(o, r, vr.alc, ds.categories.size()); }
+  for (std::size_t r = 0; r < o.runs; ++r) {
+    vr.rho[r] = draw_rho(o, r, vr.alc, ds.categories.size());
+  }
   tbb::parallel_for(std::size_t{0}, o.runs, [&](std::size_t r) {
-    const std::vector<std::uint32_t> order = category_order(ds.categories.size(), run_seed(o.seed, r) + 1);
+    const std::vector<std::uint32_t> order =
+        category_order(ds.categories.size(), run_seed(o.seed, r) + 1);
     TeacherConfig cfg = o.teacher;
     cfg.context_a = vr.rho[r];
     vr.context[r] = run_teacher(ds, t, vr.variant, order, cfg, run_seed(o.seed, r) + 11);
@@ -158,18 +183,25 @@ void run_context(const Dataset& ds, const EvalOptions& o, const DescriptorTable&
 
 const char* to_string(Protocol p) noexcept {
   switch (p) {
-    case Protocol::CV10: return "cv10";
-    case Protocol::TEACHER: return "teacher";
-    case Protocol::TEACHER_CONTEXT: return "teacher-context";
-    case Protocol::NOISE: return "noise";
-    case Protocol::DOWNSAMPLE: return "downsample";
+    case Protocol::CV10:
+      return "cv10";
+    case Protocol::TEACHER:
+      return "teacher";
+    case Protocol::TEACHER_CONTEXT:
+      return "teacher-context";
+    case Protocol::NOISE:
+      return "noise";
+    case Protocol::DOWNSAMPLE:
+      return "downsample";
   }
   return "?";
 }
 
 std::vector<double> protocol_levels(const EvalOptions& o) {
   if (!o.levels_m.empty() || !perturbed(o.protocol)) { return o.levels_m; }
-  if (o.protocol == Protocol::NOISE) { return {0.001, 0.002, 0.003, 0.004, 0.005, 0.006, 0.007, 0.008, 0.009, 0.010}; }
+  if (o.protocol == Protocol::NOISE) {
+    return {0.001, 0.002, 0.003, 0.004, 0.005, 0.006, 0.007, 0.008, 0.009, 0.010};
+  }
   return {0.001, 0.002, 0.004, 0.006, 0.008, 0.010, 0.012, 0.014, 0.016, 0.018, 0.020};
 }
 
@@ -186,16 +218,27 @@ Result<Evaluation, EvalError> evaluate(const Dataset& ds, const EvalOptions& o, 
   if (auto ok = check(ds, o); !ok) { return err(ok.error()); }
   const auto start = std::chrono::steady_clock::now();
   Evaluation e{o, ds.categories, ds.views.size(), ds.instances.size(), {}, {}, {}, 0.0};
-  for (const Variant& v : o.variants) { e.variants.push_back(VariantResult{v, {}, {}, {}, {}, 0.0, {}}); }
+  for (const Variant& v : o.variants) {
+    e.variants.push_back(VariantResult{v, {}, {}, {}, {}, 0.0, {}});
+  }
   tbb::task_arena arena(o.threads == 0 ? tbb::task_arena::automatic : static_cast<int>(o.threads));
   Result<void, EvalError> outcome;
   arena.execute([&] {
     Tables tables(ds, o, p, e);
-    if (o.protocol == Protocol::CV10) { outcome = run_cv(ds, o, tables, e, p); return; }
-    if (perturbed(o.protocol)) { outcome = run_levels(ds, o, tables, e, p); return; }
+    if (o.protocol == Protocol::CV10) {
+      outcome = run_cv(ds, o, tables, e, p);
+      return;
+    }
+    if (perturbed(o.protocol)) {
+      outcome = run_levels(ds, o, tables, e, p);
+      return;
+    }
     for (VariantResult& vr : e.variants) {
       auto t = tables.get(vr.variant.descriptor());
-      if (!t) { outcome = err(t.error()); return; }
+      if (!t) {
+        outcome = err(t.error());
+        return;
+      }
       run_teachers(ds, o, **t, vr, p);
       if (o.protocol == Protocol::TEACHER_CONTEXT) { run_context(ds, o, **t, vr, p); }
     }

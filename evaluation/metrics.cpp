@@ -9,7 +9,9 @@ void Confusion::add(std::uint32_t truth, std::optional<std::uint32_t> predicted)
 }
 
 void Confusion::merge(const Confusion& other) {
-  for (std::size_t i = 0; i < counts.size() && i < other.counts.size(); ++i) { counts[i] += other.counts[i]; }
+  for (std::size_t i = 0; i < counts.size() && i < other.counts.size(); ++i) {
+    counts[i] += other.counts[i];
+  }
 }
 
 std::size_t Confusion::total() const {
@@ -30,7 +32,9 @@ Scores score(const Confusion& c) {
     for (std::size_t t = 0; t < c.classes; ++t) { column += c.at(t, k); }
     correct += c.at(k, k);
     s.unknown += c.at(k, c.classes);
-    if (column > 0) { precision_sum += static_cast<double>(c.at(k, k)) / static_cast<double>(column); }
+    if (column > 0) {
+      precision_sum += static_cast<double>(c.at(k, k)) / static_cast<double>(column);
+    }
     if (row > 0) {
       recall_sum += static_cast<double>(c.at(k, k)) / static_cast<double>(row);
       ++asked_classes;

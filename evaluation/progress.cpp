@@ -11,7 +11,8 @@ namespace orthoflow::evaluation {
 
 namespace {
 
-constexpr double REDRAW_SECONDS = 0.1;  // ~10 Hz: fast enough to look live, cheap on a slow terminal
+constexpr double REDRAW_SECONDS =
+    0.1;  // ~10 Hz: fast enough to look live, cheap on a slow terminal
 constexpr std::size_t BAR_WIDTH = 20;
 
 double steady_seconds() {
@@ -33,8 +34,13 @@ std::size_t tenths(std::size_t done, std::size_t total) {
 Progress::Progress(std::string label, std::size_t total, std::FILE* out, bool terminal)
     : Progress(std::move(label), total, out, terminal, steady_seconds) {}
 
-Progress::Progress(std::string label, std::size_t total, std::FILE* out, bool terminal, Clock now_seconds)
-    : label_(std::move(label)), total_(total), out_(out), terminal_(terminal), now_(std::move(now_seconds)),
+Progress::Progress(std::string label, std::size_t total, std::FILE* out, bool terminal,
+                   Clock now_seconds)
+    : label_(std::move(label)),
+      total_(total),
+      out_(out),
+      terminal_(terminal),
+      now_(std::move(now_seconds)),
       start_(now_()) {
   if (terminal_) {
     const std::lock_guard lock(draw_mutex_);
@@ -51,7 +57,8 @@ void Progress::advance(std::size_t n) {
     after = total_ - before < n ? total_ : before + n;
   } while (!done_.compare_exchange_weak(before, after, std::memory_order_relaxed));
   if (!terminal_) {
-    if (tenths(before, total_) == tenths(after, total_)) return;  // no 10 % boundary crossed: nothing to print
+    if (tenths(before, total_) == tenths(after, total_))
+      return;  // no 10 % boundary crossed: nothing to print
     const std::lock_guard lock(draw_mutex_);
     const std::size_t now_done = done_.load(std::memory_order_relaxed);
     const std::size_t tenth = tenths(now_done, total_);
@@ -74,7 +81,9 @@ void Progress::finish() {
   draw(done_.load(std::memory_order_relaxed), now_(), true);
 }
 
-bool Progress::is_terminal(std::FILE* out) noexcept { return out != nullptr && ::isatty(::fileno(out)) == 1; }
+bool Progress::is_terminal(std::FILE* out) noexcept {
+  return out != nullptr && ::isatty(::fileno(out)) == 1;
+}
 
 std::string Progress::format_duration(double seconds) {
   if (!std::isfinite(seconds) || seconds < 0) return "--";
@@ -101,8 +110,10 @@ std::string Progress::line(std::size_t done, double now, bool final_line) const 
                 static_cast<int>(std::floor(100.0 * frac)));
   text += counts + format_duration(elapsed);
   if (final_line) return text;
-  // ETA from the mean rate so far (thesis-style runs have steps of similar cost): elapsed * remaining / done.
-  const double eta = done == 0 ? -1.0 : elapsed * static_cast<double>(total_ - done) / static_cast<double>(done);
+  // ETA from the mean rate so far (thesis-style runs have steps of similar cost): elapsed *
+  // remaining / done.
+  const double eta =
+      done == 0 ? -1.0 : elapsed * static_cast<double>(total_ - done) / static_cast<double>(done);
   return text + "  ETA " + format_duration(eta);
 }
 
@@ -111,7 +122,8 @@ void Progress::draw(std::size_t done, double now, bool final_line) {
   last_draw_ = now;
   if (terminal_) {
     const std::size_t width = text.size();
-    if (width < last_width_) text.append(last_width_ - width, ' ');  // blank what a longer line left behind
+    if (width < last_width_)
+      text.append(last_width_ - width, ' ');  // blank what a longer line left behind
     last_width_ = width;
     std::fputc('\r', out_);
   }

@@ -10,15 +10,28 @@ namespace {
 using nlohmann::json;
 
 json scores_json(const Scores& s) {
-  return {{"accuracy", s.accuracy}, {"micro_precision", s.micro_precision}, {"micro_recall", s.micro_recall},
-          {"macro_precision", s.macro_precision}, {"macro_recall", s.macro_recall}, {"answers", s.answers}, {"unknown", s.unknown}};
+  return {{"accuracy", s.accuracy},
+          {"micro_precision", s.micro_precision},
+          {"micro_recall", s.micro_recall},
+          {"macro_precision", s.macro_precision},
+          {"macro_recall", s.macro_recall},
+          {"answers", s.answers},
+          {"unknown", s.unknown}};
 }
 
 json teacher_json(const TeacherRun& t) {
   json curve = json::array();
   for (const LearnedPoint& p : t.curve) { curve.push_back({p.iteration, p.learned, p.gca}); }
-  return {{"nlc", t.nlc}, {"qci", t.qci}, {"aic", t.aic}, {"gca", t.gca}, {"apa", t.apa}, {"stop", to_string(t.stop)},
-          {"learned_a", t.learned_a}, {"learned_b", t.learned_b}, {"switched", t.switched}, {"curve_iteration_learned_gca", curve}};
+  return {{"nlc", t.nlc},
+          {"qci", t.qci},
+          {"aic", t.aic},
+          {"gca", t.gca},
+          {"apa", t.apa},
+          {"stop", to_string(t.stop)},
+          {"learned_a", t.learned_a},
+          {"learned_b", t.learned_b},
+          {"switched", t.switched},
+          {"curve_iteration_learned_gca", curve}};
 }
 
 json cv_json(const VariantResult& v) {
@@ -32,8 +45,9 @@ json cv_json(const VariantResult& v) {
   return {{"runs", runs}, {"confusion_summed_over_runs", confusion}};
 }
 
-/// Adaptability = mean ALC_B / mean ALC_A over runs that switched context and ended at the breakpoint
-/// (thesis 7.3.1: a run ended by lack of data cannot measure it); null when there is none.
+/// Adaptability = mean ALC_B / mean ALC_A over runs that switched context and ended at the
+/// breakpoint (thesis 7.3.1: a run ended by lack of data cannot measure it); null when there is
+/// none.
 json adaptability(const VariantResult& v) {
   double a = 0.0, b = 0.0;
   std::size_t n = 0;
@@ -65,14 +79,18 @@ json variant_json(const VariantResult& v) {
     }
     j["adaptability"] = adaptability(v);
   }
-  for (const LevelResult& l : v.levels) { j["levels"].push_back({{"amount_m", l.amount_m}, {"accuracy", l.accuracy}}); }
+  for (const LevelResult& l : v.levels) {
+    j["levels"].push_back({{"amount_m", l.amount_m}, {"accuracy", l.accuracy}});
+  }
   return j;
 }
 
 Result<void, EvalError> write_text(const std::filesystem::path& path, const std::string& text) {
   std::ofstream f(path, std::ios::binary | std::ios::trunc);
   f << text;
-  if (!f.flush()) { return err(EvalError{EvalError::Code::WRITE_FAILED, "cannot write " + path.string()}); }
+  if (!f.flush()) {
+    return err(EvalError{EvalError::Code::WRITE_FAILED, "cannot write " + path.string()});
+  }
   return {};
 }
 
@@ -80,20 +98,34 @@ Result<void, EvalError> write_text(const std::filesystem::path& path, const std:
 
 std::string results_json(const Evaluation& e) {
   const EvalOptions& o = e.options;
-  json j{{"protocol", to_string(o.protocol)}, {"runs", o.runs}, {"seed", o.seed}, {"folds", o.folds},
-         {"levels_m", protocol_levels(o)}, {"tau", o.teacher.tau}, {"breakpoint", o.teacher.breakpoint},
-         {"intro_views", o.teacher.intro_views}, {"categories", e.categories}, {"views", e.views},
-         {"instances", e.instances}, {"descriptors_computed", e.describe.computed},
-         {"descriptors_cached", e.describe.cached}, {"seconds", e.seconds}, {"warnings", e.warnings}};
+  json j{{"protocol", to_string(o.protocol)},
+         {"runs", o.runs},
+         {"seed", o.seed},
+         {"folds", o.folds},
+         {"levels_m", protocol_levels(o)},
+         {"tau", o.teacher.tau},
+         {"breakpoint", o.teacher.breakpoint},
+         {"intro_views", o.teacher.intro_views},
+         {"categories", e.categories},
+         {"views", e.views},
+         {"instances", e.instances},
+         {"descriptors_computed", e.describe.computed},
+         {"descriptors_cached", e.describe.cached},
+         {"seconds", e.seconds},
+         {"warnings", e.warnings}};
   j["variants"] = json::array();
   for (const VariantResult& v : e.variants) { j["variants"].push_back(variant_json(v)); }
   return j.dump(1) + "\n";
 }
 
-Result<std::vector<std::filesystem::path>, EvalError> write_report(const Evaluation& e, const std::filesystem::path& out) {
+Result<std::vector<std::filesystem::path>, EvalError> write_report(
+    const Evaluation& e, const std::filesystem::path& out) {
   std::error_code ec;
   std::filesystem::create_directories(out, ec);
-  if (ec) { return err(EvalError{EvalError::Code::WRITE_FAILED, "cannot create " + out.string() + ": " + ec.message()}); }
+  if (ec) {
+    return err(EvalError{EvalError::Code::WRITE_FAILED,
+                         "cannot create " + out.string() + ": " + ec.message()});
+  }
   std::vector<std::filesystem::path> written{out / "results.json", out / "summary.md"};
   if (auto r = write_text(written[0], results_json(e)); !r) { return err(r.error()); }
   if (auto r = write_text(written[1], summary_markdown(e)); !r) { return err(r.error()); }

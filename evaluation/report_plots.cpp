@@ -24,11 +24,13 @@ std::string mean_pm(const std::vector<TeacherRun>& runs, F field, int digits) {
 std::string stops(const std::vector<TeacherRun>& runs) {
   std::size_t breakpoint = 0;
   for (const TeacherRun& t : runs) { breakpoint += t.stop == TeacherStop::BREAKPOINT ? 1 : 0; }
-  return std::to_string(breakpoint) + " breakpoint, " + std::to_string(runs.size() - breakpoint) + " lack of data";
+  return std::to_string(breakpoint) + " breakpoint, " + std::to_string(runs.size() - breakpoint) +
+         " lack of data";
 }
 
 void cv_rows(std::ostringstream& md, const Evaluation& e) {
-  md << "| variant | accuracy | micro precision | micro recall | macro precision | macro recall |\n|---|---|---|---|---|---|\n";
+  md << "| variant | accuracy | micro precision | micro recall | macro precision | macro recall "
+        "|\n|---|---|---|---|---|---|\n";
   for (const VariantResult& v : e.variants) {
     std::vector<double> acc, mp, mr, Mp, Mr;
     for (const CvResult& cv : v.cv) {
@@ -48,18 +50,31 @@ void cv_rows(std::ostringstream& md, const Evaluation& e) {
 }
 
 void teacher_rows(std::ostringstream& md, const Evaluation& e) {
-  md << "| variant | NLC | QCI | AIC | GCA | APA | stopping condition |\n|---|---|---|---|---|---|---|\n";
+  md << "| variant | NLC | QCI | AIC | GCA | APA | stopping condition "
+        "|\n|---|---|---|---|---|---|---|\n";
   for (const VariantResult& v : e.variants) {
-    md << "| " << v.variant.name() << " | " << mean_pm(v.teacher, [](const TeacherRun& t) { return t.nlc; }, 1) << " | "
-       << mean_pm(v.teacher, [](const TeacherRun& t) { return t.qci; }, 0) << " | "
-       << mean_pm(v.teacher, [](const TeacherRun& t) { return t.aic; }, 2) << " | "
-       << mean_pm(v.teacher, [](const TeacherRun& t) { return t.gca; }, 3) << " | "
-       << mean_pm(v.teacher, [](const TeacherRun& t) { return t.apa; }, 3) << " | " << stops(v.teacher) << " |\n";
+    md << "| " << v.variant.name() << " | "
+       << mean_pm(
+              v.teacher, [](const TeacherRun& t) { return t.nlc; }, 1)
+       << " | "
+       << mean_pm(
+              v.teacher, [](const TeacherRun& t) { return t.qci; }, 0)
+       << " | "
+       << mean_pm(
+              v.teacher, [](const TeacherRun& t) { return t.aic; }, 2)
+       << " | "
+       << mean_pm(
+              v.teacher, [](const TeacherRun& t) { return t.gca; }, 3)
+       << " | "
+       << mean_pm(
+              v.teacher, [](const TeacherRun& t) { return t.apa; }, 3)
+       << " | " << stops(v.teacher) << " |\n";
   }
 }
 
 void context_rows(std::ostringstream& md, const Evaluation& e) {
-  md << "| variant | ALC (no change) | rho | ALC_A | ALC_B | adaptability | stopping condition |\n|---|---|---|---|---|---|---|\n";
+  md << "| variant | ALC (no change) | rho | ALC_A | ALC_B | adaptability | stopping condition "
+        "|\n|---|---|---|---|---|---|---|\n";
   for (const VariantResult& v : e.variants) {
     double a = 0.0, b = 0.0, rho = 0.0;
     std::size_t n = 0;
@@ -72,8 +87,12 @@ void context_rows(std::ostringstream& md, const Evaluation& e) {
       }
     }
     md << "| " << v.variant.name() << " | " << fixed(v.alc, 1) << " | " << fixed(rho, 1) << " | "
-       << mean_pm(v.context, [](const TeacherRun& t) { return t.learned_a; }, 1) << " | "
-       << mean_pm(v.context, [](const TeacherRun& t) { return t.learned_b; }, 1) << " | "
+       << mean_pm(
+              v.context, [](const TeacherRun& t) { return t.learned_a; }, 1)
+       << " | "
+       << mean_pm(
+              v.context, [](const TeacherRun& t) { return t.learned_b; }, 1)
+       << " | "
        << (n == 0 || a == 0.0 ? std::string("n/a (no run ended at the breakpoint after switching)")
                               : fixed(b / a, 3) + " (" + std::to_string(n) + " runs)")
        << " | " << stops(v.context) << " |\n";
@@ -84,7 +103,8 @@ void level_rows(std::ostringstream& md, const Evaluation& e) {
   if (e.variants.empty() || e.variants[0].levels.empty()) { return; }
   md << "| variant";
   for (const LevelResult& l : e.variants[0].levels) {
-    md << " | " << (l.amount_m == 0.0 ? std::string("clean") : fixed(l.amount_m * 1000.0, 0) + " mm");
+    md << " | "
+       << (l.amount_m == 0.0 ? std::string("clean") : fixed(l.amount_m * 1000.0, 0) + " mm");
   }
   md << " |\n|---";
   for (std::size_t i = 0; i < e.variants[0].levels.size(); ++i) { md << "|---"; }
@@ -136,20 +156,33 @@ Series learning_series(const std::string& name, const TeacherRun& run) {
 
 std::string summary_markdown(const Evaluation& e) {
   std::ostringstream md;
-  md << "### " << to_string(e.options.protocol) << ": " << e.categories.size() << " categories, " << e.instances
-     << " instances, " << e.views << " views; " << e.options.runs << " runs, seed " << e.options.seed;
+  md << "### " << to_string(e.options.protocol) << ": " << e.categories.size() << " categories, "
+     << e.instances << " instances, " << e.views << " views; " << e.options.runs << " runs, seed "
+     << e.options.seed;
   if (e.options.protocol == Protocol::TEACHER || e.options.protocol == Protocol::TEACHER_CONTEXT) {
-    md << "; tau " << fixed(e.options.teacher.tau, 2) << ", breakpoint " << e.options.teacher.breakpoint;
+    md << "; tau " << fixed(e.options.teacher.tau, 2) << ", breakpoint "
+       << e.options.teacher.breakpoint;
   }
   md << "\n\n";
   switch (e.options.protocol) {
-    case Protocol::CV10: cv_rows(md, e); break;
-    case Protocol::TEACHER: teacher_rows(md, e); break;
-    case Protocol::TEACHER_CONTEXT: teacher_rows(md, e); md << "\n"; context_rows(md, e); break;
+    case Protocol::CV10:
+      cv_rows(md, e);
+      break;
+    case Protocol::TEACHER:
+      teacher_rows(md, e);
+      break;
+    case Protocol::TEACHER_CONTEXT:
+      teacher_rows(md, e);
+      md << "\n";
+      context_rows(md, e);
+      break;
     case Protocol::NOISE:
-    case Protocol::DOWNSAMPLE: level_rows(md, e); break;
+    case Protocol::DOWNSAMPLE:
+      level_rows(md, e);
+      break;
   }
-  md << "\nValues are mean ± sample standard deviation over runs (accuracy columns of robustness tables: means).\n";
+  md << "\nValues are mean ± sample standard deviation over runs (accuracy columns of robustness "
+        "tables: means).\n";
   return md.str();
 }
 
@@ -157,24 +190,55 @@ std::vector<std::pair<std::string, PlotSpec>> evaluation_plots(const Evaluation&
   std::vector<std::pair<std::string, PlotSpec>> plots;
   const Protocol p = e.options.protocol;
   if ((p == Protocol::TEACHER || p == Protocol::TEACHER_CONTEXT) && !e.variants.empty()) {
-    PlotSpec learned{"Learned categories vs question/correction iterations (run 1)", "question/correction iterations", "learned categories", {}, std::nullopt, std::nullopt, 800, 500};
-    PlotSpec gca{"Global classification accuracy vs learned categories (mean ± std over runs)", "learned categories", "global accuracy", {}, 0.0, 1.0, 800, 500};
-    PlotSpec context{"Context change: learned categories vs iterations (run 1)", "question/correction iterations", "learned categories", {}, std::nullopt, std::nullopt, 800, 500};
+    PlotSpec learned{"Learned categories vs question/correction iterations (run 1)",
+                     "question/correction iterations",
+                     "learned categories",
+                     {},
+                     std::nullopt,
+                     std::nullopt,
+                     800,
+                     500};
+    PlotSpec gca{"Global classification accuracy vs learned categories (mean ± std over runs)",
+                 "learned categories",
+                 "global accuracy",
+                 {},
+                 0.0,
+                 1.0,
+                 800,
+                 500};
+    PlotSpec context{"Context change: learned categories vs iterations (run 1)",
+                     "question/correction iterations",
+                     "learned categories",
+                     {},
+                     std::nullopt,
+                     std::nullopt,
+                     800,
+                     500};
     for (const VariantResult& v : e.variants) {
       learned.series.push_back(learning_series(v.variant.name(), v.teacher.front()));
       gca.series.push_back(gca_series(v));
       if (!v.context.empty()) {
-        context.series.push_back(learning_series(v.variant.name() + " (A: " + std::to_string(v.rho.front()) + ")", v.context.front()));
+        context.series.push_back(learning_series(
+            v.variant.name() + " (A: " + std::to_string(v.rho.front()) + ")", v.context.front()));
       }
     }
     plots.emplace_back("learned_categories", std::move(learned));
     plots.emplace_back("accuracy_vs_learned", std::move(gca));
-    if (p == Protocol::TEACHER_CONTEXT) { plots.emplace_back("learned_categories_context", std::move(context)); }
+    if (p == Protocol::TEACHER_CONTEXT) {
+      plots.emplace_back("learned_categories_context", std::move(context));
+    }
   }
   if (p == Protocol::NOISE || p == Protocol::DOWNSAMPLE) {
     const bool noise = p == Protocol::NOISE;
-    PlotSpec acc{noise ? "Accuracy vs Gaussian noise on test views" : "Accuracy vs voxel size of test views",
-                 noise ? "noise sigma (mm)" : "voxel size (mm)", "accuracy", {}, 0.0, 1.0, 800, 500};
+    PlotSpec acc{
+        noise ? "Accuracy vs Gaussian noise on test views" : "Accuracy vs voxel size of test views",
+        noise ? "noise sigma (mm)" : "voxel size (mm)",
+        "accuracy",
+        {},
+        0.0,
+        1.0,
+        800,
+        500};
     for (const VariantResult& v : e.variants) {
       Series s{v.variant.name(), {}, {}, {}, true};
       for (const LevelResult& l : v.levels) {

@@ -12,9 +12,14 @@ namespace {
 /// The teacher's bookkeeping for one experiment.
 class Teacher {
  public:
-  Teacher(const Dataset& ds, const DescriptorTable& d, const Variant& v, std::span<const std::uint32_t> order,
-          const TeacherConfig& cfg, std::uint64_t seed)
-      : ds_(ds), d_(d), order_(order), cfg_(cfg), learner_(v, ds.categories), unseen_(ds.categories.size()) {
+  Teacher(const Dataset& ds, const DescriptorTable& d, const Variant& v,
+          std::span<const std::uint32_t> order, const TeacherConfig& cfg, std::uint64_t seed)
+      : ds_(ds),
+        d_(d),
+        order_(order),
+        cfg_(cfg),
+        learner_(v, ds.categories),
+        unseen_(ds.categories.size()) {
     for (std::uint32_t c = 0; c < ds.categories.size(); ++c) {
       std::vector<std::size_t> views = ds.views_of(c);
       core::Rng rng(seed * 0xD1B54A32D192ED03ULL + c + 1);
@@ -27,7 +32,10 @@ class Teacher {
     if (!introduce()) { return finish(TeacherStop::LACK_OF_DATA); }
     mark_learned();  // Algorithm 7.1 line 1: the first category is known without questions
     while (true) {
-      if (cfg_.context_a > 0 && !in_b_ && learned_ == cfg_.context_a) { in_b_ = true; run_.switched = true; }
+      if (cfg_.context_a > 0 && !in_b_ && learned_ == cfg_.context_a) {
+        in_b_ = true;
+        run_.switched = true;
+      }
       if (!introduce()) { return finish(TeacherStop::LACK_OF_DATA); }
       const auto outcome = question_round();
       if (outcome) { return finish(*outcome); }
@@ -59,7 +67,8 @@ class Teacher {
     out.insert(out.end(), row.begin(), row.end());
   }
 
-  /// Question/correction iterations until the newest category is learned; the stop reason otherwise.
+  /// Question/correction iterations until the newest category is learned; the stop reason
+  /// otherwise.
   std::optional<TeacherStop> question_round() {
     window_.clear();
     const std::size_t n = introduced_;
@@ -97,25 +106,37 @@ class Teacher {
 
   double window_accuracy(std::size_t k) const {
     std::size_t good = 0;
-    for (std::size_t i = window_.size() - k; i < window_.size(); ++i) { good += window_[i] ? 1 : 0; }
+    for (std::size_t i = window_.size() - k; i < window_.size(); ++i) {
+      good += window_[i] ? 1 : 0;
+    }
     return static_cast<double>(good) / static_cast<double>(k);
   }
 
   void mark_learned() {
     ++learned_;
-    if (in_b_) { ++run_.learned_b; } else { ++run_.learned_a; }
+    if (in_b_) {
+      ++run_.learned_b;
+    } else {
+      ++run_.learned_a;
+    }
     run_.curve.push_back(LearnedPoint{run_.qci, learned_, gca()});
   }
 
-  double gca() const { return run_.qci == 0 ? 0.0 : static_cast<double>(correct_) / static_cast<double>(run_.qci); }
+  double gca() const {
+    return run_.qci == 0 ? 0.0 : static_cast<double>(correct_) / static_cast<double>(run_.qci);
+  }
 
   TeacherRun finish(TeacherStop stop) {
     run_.stop = stop;
     run_.nlc = learned_;
     run_.gca = gca();
     run_.apa = run_.qci == 0 ? 0.0 : accuracy_sum_ / static_cast<double>(run_.qci);
-    run_.aic = introduced_ == 0 ? 0.0 : static_cast<double>(stored_) / static_cast<double>(introduced_);
-    if (cfg_.context_a == 0) { run_.learned_a = learned_; run_.learned_b = 0; }
+    run_.aic =
+        introduced_ == 0 ? 0.0 : static_cast<double>(stored_) / static_cast<double>(introduced_);
+    if (cfg_.context_a == 0) {
+      run_.learned_a = learned_;
+      run_.learned_b = 0;
+    }
     return run_;
   }
 
@@ -138,8 +159,9 @@ const char* to_string(TeacherStop stop) noexcept {
   return stop == TeacherStop::BREAKPOINT ? "breakpoint" : "lack of data";
 }
 
-TeacherRun run_teacher(const Dataset& dataset, const DescriptorTable& descriptors, const Variant& variant,
-                       std::span<const std::uint32_t> order, const TeacherConfig& config, std::uint64_t view_seed) {
+TeacherRun run_teacher(const Dataset& dataset, const DescriptorTable& descriptors,
+                       const Variant& variant, std::span<const std::uint32_t> order,
+                       const TeacherConfig& config, std::uint64_t view_seed) {
   Teacher teacher(dataset, descriptors, variant, order, config, view_seed);
   return teacher.run();
 }

@@ -1,15 +1,17 @@
 #include "evaluation/variant.hpp"
 
+#include "core/assert.hpp"
 #include "learning/bayes_learner.hpp"
 #include "learning/instance_learner.hpp"
-#include "core/assert.hpp"
 
 namespace orthoflow::evaluation {
 
 std::string Variant::name() const {
   std::string n = learner == LearnerKind::BAYES ? "bayes" : "instance";
   if (learner == LearnerKind::INSTANCE) {
-    n += rule == InstanceRule::NEAREST ? "-nn" : rule == InstanceRule::APPROACH_1 ? "-nocd1" : "-nocd2";
+    n += rule == InstanceRule::NEAREST      ? "-nn"
+         : rule == InstanceRule::APPROACH_1 ? "-nocd1"
+                                            : "-nocd2";
   }
   n += mode == kernels::GoodMode::INVARIANT ? "/invariant/" : "/reference/";
   return n + std::to_string(bins);
@@ -29,7 +31,8 @@ std::unique_ptr<learning::Learner> Variant::make_learner() const {
   learning::InstanceConfig cfg;
   cfg.descriptor_length = length;
   cfg.normalise = rule != InstanceRule::NEAREST;
-  cfg.approach = rule == InstanceRule::APPROACH_2 ? learning::NocdApproach::MEAN_DISTANCE : learning::NocdApproach::MIN_DISTANCE;
+  cfg.approach = rule == InstanceRule::APPROACH_2 ? learning::NocdApproach::MEAN_DISTANCE
+                                                  : learning::NocdApproach::MIN_DISTANCE;
   return std::make_unique<learning::InstanceLearner>(cfg);
 }
 
@@ -39,7 +42,8 @@ ClassLearner::ClassLearner(const Variant& variant, const std::vector<std::string
 void ClassLearner::teach(std::uint32_t cls, std::span<const float> views) {
   const std::size_t length = learner_->descriptor_length();
   auto id = learner_->teach(categories_[cls], learning::DescriptorBatch{views, length});
-  // The dataset scan validated labels and describe_dataset() produced finite histograms of this length.
+  // The dataset scan validated labels and describe_dataset() produced finite histograms of this
+  // length.
   OF_ENFORCE(id.has_value(), "evaluation: teach refused a dataset view");
   class_of_[*id] = cls;
 }

@@ -1,8 +1,8 @@
 #pragma once
 /// @file
-/// @brief One approach under comparison: a learner (instance-based with its recognition rule, or naive
-/// Bayes) on GOOD descriptors of one mode and bin count. Every variant of an evaluation sees the same
-/// category orders, folds and view orders (they depend on the seed and the run only).
+/// @brief One approach under comparison: a learner (instance-based with its recognition rule, or
+/// naive Bayes) on GOOD descriptors of one mode and bin count. Every variant of an evaluation sees
+/// the same category orders, folds and view orders (they depend on the seed and the run only).
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -14,8 +14,9 @@
 namespace orthoflow::evaluation {
 
 enum class LearnerKind : std::uint8_t { INSTANCE, BAYES };
-/// @brief Recognition rule of the instance-based learner: plain nearest neighbour (L2), or the thesis's
-/// normalised distances, approach I (min) and approach II (mean), with no Unknown threshold.
+/// @brief Recognition rule of the instance-based learner: plain nearest neighbour (L2), or the
+/// thesis's normalised distances, approach I (min) and approach II (mean), with no Unknown
+/// threshold.
 enum class InstanceRule : std::uint8_t { NEAREST, APPROACH_1, APPROACH_2 };
 
 struct Variant {
@@ -26,8 +27,8 @@ struct Variant {
   /// @brief "instance-nn/invariant/15", "bayes/reference/5", ...
   [[nodiscard]] std::string name() const;
   /// @brief The descriptor parameters of this variant with perturbation @p p of @p amount_m.
-  [[nodiscard]] ViewDescription descriptor(Perturbation p = Perturbation::NONE, double amount_m = 0.0,
-                                          std::uint64_t seed = 0) const;
+  [[nodiscard]] ViewDescription descriptor(Perturbation p = Perturbation::NONE,
+                                           double amount_m = 0.0, std::uint64_t seed = 0) const;
   /// @brief A fresh, empty learner.
   [[nodiscard]] std::unique_ptr<learning::Learner> make_learner() const;
 };

@@ -29,18 +29,24 @@ Result<std::vector<char>, IoError> read_file_bytes(const std::filesystem::path& 
   std::vector<char> bytes;
   char chunk[1 << 16];
   std::size_t got = 0;
-  while ((got = std::fread(chunk, 1, sizeof(chunk), file.get())) > 0) { bytes.insert(bytes.end(), chunk, chunk + got); }
-  if (std::ferror(file.get()) != 0) { return err(io_error(IoError::Code::OPEN_FAILED, path, "read failed")); }
+  while ((got = std::fread(chunk, 1, sizeof(chunk), file.get())) > 0) {
+    bytes.insert(bytes.end(), chunk, chunk + got);
+  }
+  if (std::ferror(file.get()) != 0) {
+    return err(io_error(IoError::Code::OPEN_FAILED, path, "read failed"));
+  }
   return bytes;
 }
 
-Result<void, IoError> write_file_atomically(const std::filesystem::path& path, std::string_view bytes) {
+Result<void, IoError> write_file_atomically(const std::filesystem::path& path,
+                                            std::string_view bytes) {
   std::filesystem::path tmp = path;
   tmp += ".tmp";
   {
     File file(std::fopen(tmp.c_str(), "wb"));
     if (!file) { return err(io_error(IoError::Code::WRITE_FAILED, tmp, "cannot create")); }
-    if (std::fwrite(bytes.data(), 1, bytes.size(), file.get()) != bytes.size() || std::fflush(file.get()) != 0) {
+    if (std::fwrite(bytes.data(), 1, bytes.size(), file.get()) != bytes.size() ||
+        std::fflush(file.get()) != 0) {
       auto e = io_error(IoError::Code::WRITE_FAILED, tmp, "write failed");
       std::remove(tmp.c_str());
       return err(e);

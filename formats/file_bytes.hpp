@@ -5,8 +5,8 @@
 #include <string_view>
 #include <vector>
 
-#include "formats/io_error.hpp"
 #include "core/result.hpp"
+#include "formats/io_error.hpp"
 
 namespace orthoflow::formats {
 
@@ -15,6 +15,7 @@ namespace orthoflow::formats {
 
 /// @brief Writes @p bytes to a temporary file beside @p path, then renames it over @p path,
 /// so that readers never see a half-written file.
-[[nodiscard]] Result<void, IoError> write_file_atomically(const std::filesystem::path& path, std::string_view bytes);
+[[nodiscard]] Result<void, IoError> write_file_atomically(const std::filesystem::path& path,
+                                                          std::string_view bytes);
 
 }  // namespace orthoflow::formats

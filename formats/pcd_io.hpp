@@ -13,10 +13,10 @@
 #include <span>
 #include <string_view>
 
+#include "core/result.hpp"
 #include "formats/io_error.hpp"
 #include "formats/pcd_header.hpp"
 #include "kernels/point_cloud.hpp"
-#include "core/result.hpp"
 
 namespace orthoflow::formats {
 
@@ -24,15 +24,16 @@ namespace orthoflow::formats {
 [[nodiscard]] Result<kernels::PointCloud, IoError> read_pcd(const std::filesystem::path& path);
 
 /// @brief Reads PCD bytes held in memory; @p name prefixes error messages.
-[[nodiscard]] Result<kernels::PointCloud, IoError> read_pcd_buffer(std::span<const char> bytes,
-                                                                   std::string_view name = "<memory>");
+[[nodiscard]] Result<kernels::PointCloud, IoError> read_pcd_buffer(
+    std::span<const char> bytes, std::string_view name = "<memory>");
 
 /// @brief Reads only the header of a PCD file (fields, sizes, encoding) without its data.
 [[nodiscard]] Result<PcdHeader, IoError> read_pcd_header(const std::filesystem::path& path);
 
 /// @brief Writes @p cloud; the file appears whole or not at all (written beside it, then renamed).
-[[nodiscard]] Result<void, IoError> write_pcd(const kernels::PointCloud& cloud, const std::filesystem::path& path,
-                                              PcdEncoding encoding = PcdEncoding::BINARY_COMPRESSED);
+[[nodiscard]] Result<void, IoError> write_pcd(
+    const kernels::PointCloud& cloud, const std::filesystem::path& path,
+    PcdEncoding encoding = PcdEncoding::BINARY_COMPRESSED);
 
 /// @brief The bytes write_pcd() would write.
 [[nodiscard]] std::string encode_pcd(const kernels::PointCloud& cloud, PcdEncoding encoding);

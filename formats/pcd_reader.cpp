@@ -16,7 +16,8 @@ namespace {
 /// by more than this factor; a larger declared size is corrupt and never allocated.
 constexpr std::uint64_t LZF_MAX_EXPANSION = 88;
 
-IoError at_byte(IoError::Code code, std::string_view name, std::size_t byte, const std::string& what) {
+IoError at_byte(IoError::Code code, std::string_view name, std::size_t byte,
+                const std::string& what) {
   return IoError{code, std::string(name) + ": byte " + std::to_string(byte) + ": " + what};
 }
 
@@ -25,25 +26,27 @@ void shape(const PcdHeader& h, kernels::PointCloud& cloud) {
   add_fields_for(h.fields, cloud);
 }
 
-Result<void, IoError> read_binary(std::span<const char> bytes, const PcdHeader& h, std::string_view name,
-                                  kernels::PointCloud& cloud) {
+Result<void, IoError> read_binary(std::span<const char> bytes, const PcdHeader& h,
+                                  std::string_view name, kernels::PointCloud& cloud) {
   const std::uint64_t need = h.points * h.point_size();
   const std::size_t have = bytes.size() - h.data_offset;
   if (need > have) {
     return err(at_byte(IoError::Code::TRUNCATED, name, bytes.size(),
                        "binary data holds " + std::to_string(have) + " bytes, header declares " +
-                           std::to_string(h.points) + " points x " + std::to_string(h.point_size()) + " bytes"));
+                           std::to_string(h.points) + " points x " +
+                           std::to_string(h.point_size()) + " bytes"));
   }
   shape(h, cloud);
   decode_records(bytes.subspan(h.data_offset, need), h.fields, h.point_size(), cloud);
   return {};
 }
 
-Result<void, IoError> read_compressed(std::span<const char> bytes, const PcdHeader& h, std::string_view name,
-                                      kernels::PointCloud& cloud) {
+Result<void, IoError> read_compressed(std::span<const char> bytes, const PcdHeader& h,
+                                      std::string_view name, kernels::PointCloud& cloud) {
   const std::size_t at = h.data_offset;
   if (bytes.size() - at < 8) {
-    return err(at_byte(IoError::Code::TRUNCATED, name, bytes.size(), "no compressed block sizes after DATA"));
+    return err(at_byte(IoError::Code::TRUNCATED, name, bytes.size(),
+                       "no compressed block sizes after DATA"));
   }
   std::uint32_t packed = 0;
   std::uint32_t unpacked = 0;
@@ -52,8 +55,9 @@ Result<void, IoError> read_compressed(std::span<const char> bytes, const PcdHead
   const std::uint64_t need = h.points * h.point_size();
   if (unpacked != need) {
     return err(at_byte(IoError::Code::SIZE_MISMATCH, name, at + 4,
-                       "uncompressed size " + std::to_string(unpacked) + " != " + std::to_string(h.points) +
-                           " points x " + std::to_string(h.point_size()) + " bytes"));
+                       "uncompressed size " + std::to_string(unpacked) +
+                           " != " + std::to_string(h.points) + " points x " +
+                           std::to_string(h.point_size()) + " bytes"));
   }
   if (packed > bytes.size() - at - 8) {
     return err(at_byte(IoError::Code::TRUNCATED, name, bytes.size(),
@@ -61,19 +65,22 @@ Result<void, IoError> read_compressed(std::span<const char> bytes, const PcdHead
   }
   if (need > static_cast<std::uint64_t>(packed) * LZF_MAX_EXPANSION) {
     return err(at_byte(IoError::Code::CORRUPT_DATA, name, at,
-                       "compressed block of " + std::to_string(packed) + " bytes cannot expand to " +
-                           std::to_string(need)));
+                       "compressed block of " + std::to_string(packed) +
+                           " bytes cannot expand to " + std::to_string(need)));
   }
   std::vector<char> soa(need);
   if (need > 0) {
-    const unsigned got = lzf_decompress(bytes.data() + at + 8, packed, soa.data(), static_cast<unsigned>(need));
+    const unsigned got =
+        lzf_decompress(bytes.data() + at + 8, packed, soa.data(), static_cast<unsigned>(need));
     if (got != need) {
-      return err(at_byte(IoError::Code::CORRUPT_DATA, name, at + 8, "LZF block does not decompress to the declared size"));
+      return err(at_byte(IoError::Code::CORRUPT_DATA, name, at + 8,
+                         "LZF block does not decompress to the declared size"));
     }
   }
   shape(h, cloud);
   if (need == 0) { return {}; }
-  for (const PointField& f : h.fields) {  // field-major: all points' values of one field, then the next
+  for (const PointField& f :
+       h.fields) {  // field-major: all points' values of one field, then the next
     decode_field(soa.data() + h.points * f.offset, f.bytes(), f, cloud);
   }
   return {};
@@ -96,18 +103,21 @@ bool store_token(std::string_view token, ScalarType type, char* dst) {
   std::int64_t v = 0;
   if (!parse_number(token, v)) { return false; }
   const std::uint32_t size = scalar_size(type);
-  const bool is_signed = type == ScalarType::INT8 || type == ScalarType::INT16 || type == ScalarType::INT32;
+  const bool is_signed =
+      type == ScalarType::INT8 || type == ScalarType::INT16 || type == ScalarType::INT32;
   const int bits = static_cast<int>(size * 8);
   const std::int64_t lo = is_signed ? -(std::int64_t{1} << (bits - 1)) : 0;
-  const std::int64_t hi = is_signed ? (std::int64_t{1} << (bits - 1)) - 1 : (std::int64_t{1} << bits) - 1;
+  const std::int64_t hi =
+      is_signed ? (std::int64_t{1} << (bits - 1)) - 1 : (std::int64_t{1} << bits) - 1;
   if (v < lo || v > hi) { return false; }
   const auto u = static_cast<std::uint64_t>(v);  // two's complement: the low bytes are the value
   std::memcpy(dst, &u, size);
   return true;
 }
 
-Result<void, IoError> parse_ascii_line(std::string_view line, std::span<std::string_view> tokens, const PcdHeader& h,
-                                       char* record, std::string_view name, std::size_t line_no) {
+Result<void, IoError> parse_ascii_line(std::string_view line, std::span<std::string_view> tokens,
+                                       const PcdHeader& h, char* record, std::string_view name,
+                                       std::size_t line_no) {
   bool more = false;
   const std::size_t n = split_ws(line, tokens, more);
   const std::size_t expected = tokens.size();
@@ -115,7 +125,8 @@ Result<void, IoError> parse_ascii_line(std::string_view line, std::span<std::str
     return err(IoError{c, std::string(name) + ": line " + std::to_string(line_no) + ": " + what});
   };
   if (more || n != expected) {
-    return fail(IoError::Code::SIZE_MISMATCH, "expected " + std::to_string(expected) + " values, found " +
+    return fail(IoError::Code::SIZE_MISMATCH, "expected " + std::to_string(expected) +
+                                                  " values, found " +
                                                   (more ? "more" : std::to_string(n)));
   }
   std::size_t t = 0;
@@ -123,23 +134,24 @@ Result<void, IoError> parse_ascii_line(std::string_view line, std::span<std::str
     const std::uint32_t size = scalar_size(f.type);
     for (std::uint32_t c = 0; c < f.count; ++c, ++t) {
       if (!store_token(tokens[t], f.type, record + f.offset + c * size)) {
-        return fail(IoError::Code::BAD_NUMBER, "'" + std::string(tokens[t]) + "' is not a valid value for field '" +
-                                                   f.name + "'");
+        return fail(
+            IoError::Code::BAD_NUMBER,
+            "'" + std::string(tokens[t]) + "' is not a valid value for field '" + f.name + "'");
       }
     }
   }
   return {};
 }
 
-Result<void, IoError> read_ascii(std::span<const char> bytes, const PcdHeader& h, std::string_view name,
-                                 kernels::PointCloud& cloud) {
+Result<void, IoError> read_ascii(std::span<const char> bytes, const PcdHeader& h,
+                                 std::string_view name, kernels::PointCloud& cloud) {
   std::size_t per_point = 0;
   for (const PointField& f : h.fields) { per_point += f.count; }
   const std::size_t have = bytes.size() - h.data_offset;
   if (h.points * per_point > have / 2 + 1) {  // every value takes a character and a separator
     return err(at_byte(IoError::Code::TRUNCATED, name, bytes.size(),
-                       "ascii data of " + std::to_string(have) + " bytes cannot hold " + std::to_string(h.points) +
-                           " points"));
+                       "ascii data of " + std::to_string(have) + " bytes cannot hold " +
+                           std::to_string(h.points) + " points"));
   }
   std::vector<char> records(h.points * h.point_size());
   std::vector<std::string_view> tokens(per_point);
@@ -149,11 +161,13 @@ Result<void, IoError> read_ascii(std::span<const char> bytes, const PcdHeader& h
     bool got = false;
     while ((got = cursor.next(line)) && line.find_first_not_of(" \t") == std::string_view::npos) {}
     if (!got) {
-      return err(IoError{IoError::Code::TRUNCATED, std::string(name) + ": line " + std::to_string(cursor.line_number()) +
-                                                       ": file ends after " + std::to_string(i) + " of " +
-                                                       std::to_string(h.points) + " points"});
+      return err(IoError{IoError::Code::TRUNCATED,
+                         std::string(name) + ": line " + std::to_string(cursor.line_number()) +
+                             ": file ends after " + std::to_string(i) + " of " +
+                             std::to_string(h.points) + " points"});
     }
-    auto r = parse_ascii_line(line, tokens, h, records.data() + i * h.point_size(), name, cursor.line_number());
+    auto r = parse_ascii_line(line, tokens, h, records.data() + i * h.point_size(), name,
+                              cursor.line_number());
     if (!r) { return err(r.error()); }
   }
   shape(h, cloud);
@@ -163,16 +177,23 @@ Result<void, IoError> read_ascii(std::span<const char> bytes, const PcdHeader& h
 
 }  // namespace
 
-Result<kernels::PointCloud, IoError> read_pcd_buffer(std::span<const char> bytes, std::string_view name) {
+Result<kernels::PointCloud, IoError> read_pcd_buffer(std::span<const char> bytes,
+                                                     std::string_view name) {
   auto header_result = parse_pcd_header(bytes, name);
   if (!header_result) { return err(header_result.error()); }
   const PcdHeader& h = *header_result;
   kernels::PointCloud cloud;
   Result<void, IoError> body_result;
   switch (h.encoding) {
-    case PcdEncoding::BINARY: body_result = read_binary(bytes, h, name, cloud); break;
-    case PcdEncoding::BINARY_COMPRESSED: body_result = read_compressed(bytes, h, name, cloud); break;
-    case PcdEncoding::ASCII: body_result = read_ascii(bytes, h, name, cloud); break;
+    case PcdEncoding::BINARY:
+      body_result = read_binary(bytes, h, name, cloud);
+      break;
+    case PcdEncoding::BINARY_COMPRESSED:
+      body_result = read_compressed(bytes, h, name, cloud);
+      break;
+    case PcdEncoding::ASCII:
+      body_result = read_ascii(bytes, h, name, cloud);
+      break;
   }
   if (!body_result) { return err(body_result.error()); }
   cloud.info.viewpoint = h.viewpoint;

@@ -6,23 +6,27 @@
 
 #include <lzf.h>
 
+#include "core/assert.hpp"
 #include "formats/file_bytes.hpp"
 #include "formats/pcd_io.hpp"
-#include "core/assert.hpp"
 
 namespace orthoflow::formats {
 namespace {
 
-void append_binary(const kernels::PointCloud& cloud, std::span<const PointField> fields, std::string& out) {
+void append_binary(const kernels::PointCloud& cloud, std::span<const PointField> fields,
+                   std::string& out) {
   const std::size_t at = out.size();
   out.resize(at + cloud.size() * packed_size(fields));
   encode_records(cloud, fields, std::span<char>(out.data() + at, out.size() - at));
 }
 
-void append_compressed(const kernels::PointCloud& cloud, std::span<const PointField> fields, std::string& out) {
+void append_compressed(const kernels::PointCloud& cloud, std::span<const PointField> fields,
+                       std::string& out) {
   const std::size_t n = cloud.size();
   std::vector<char> soa(n * packed_size(fields));
-  for (const PointField& f : n == 0 ? std::span<const PointField>{} : fields) { encode_field(cloud, f, soa.data() + n * f.offset, f.bytes()); }
+  for (const PointField& f : n == 0 ? std::span<const PointField>{} : fields) {
+    encode_field(cloud, f, soa.data() + n * f.offset, f.bytes());
+  }
   // LZF may grow incompressible data slightly: one control byte per 32 literals.
   std::vector<char> packed(soa.size() + soa.size() / 16 + 64);
   unsigned packed_size_bytes = 0;
@@ -31,7 +35,8 @@ void append_compressed(const kernels::PointCloud& cloud, std::span<const PointFi
                                      static_cast<unsigned>(packed.size()));
     OF_ENFORCE(packed_size_bytes > 0, "LZF output buffer too small");
   }
-  const auto sizes = std::array<std::uint32_t, 2>{packed_size_bytes, static_cast<std::uint32_t>(soa.size())};
+  const auto sizes =
+      std::array<std::uint32_t, 2>{packed_size_bytes, static_cast<std::uint32_t>(soa.size())};
   out.append(reinterpret_cast<const char*>(sizes.data()), sizeof(sizes));
   out.append(packed.data(), packed_size_bytes);
 }
@@ -48,7 +53,8 @@ void append_number(std::uint32_t v, std::string& out) {
   out.append(buf, r.ptr);
 }
 
-void append_ascii(const kernels::PointCloud& cloud, std::span<const PointField> fields, std::string& out) {
+void append_ascii(const kernels::PointCloud& cloud, std::span<const PointField> fields,
+                  std::string& out) {
   struct Column {
     std::span<const float> floats;
     std::span<const std::uint32_t> words;
@@ -79,9 +85,15 @@ std::string encode_pcd(const kernels::PointCloud& cloud, PcdEncoding encoding) {
   const std::vector<PointField> fields = fields_for(cloud);
   std::string out = format_pcd_header(cloud, fields, encoding);
   switch (encoding) {
-    case PcdEncoding::BINARY: append_binary(cloud, fields, out); break;
-    case PcdEncoding::BINARY_COMPRESSED: append_compressed(cloud, fields, out); break;
-    case PcdEncoding::ASCII: append_ascii(cloud, fields, out); break;
+    case PcdEncoding::BINARY:
+      append_binary(cloud, fields, out);
+      break;
+    case PcdEncoding::BINARY_COMPRESSED:
+      append_compressed(cloud, fields, out);
+      break;
+    case PcdEncoding::ASCII:
+      append_ascii(cloud, fields, out);
+      break;
   }
   return out;
 }

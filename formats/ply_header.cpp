@@ -11,9 +11,9 @@ bool ply_type(std::string_view t, ScalarType& out) {
     ScalarType type;
   };
   static constexpr Name NAMES[] = {
-      {"char", "int8", ScalarType::INT8},      {"uchar", "uint8", ScalarType::UINT8},
-      {"short", "int16", ScalarType::INT16},   {"ushort", "uint16", ScalarType::UINT16},
-      {"int", "int32", ScalarType::INT32},     {"uint", "uint32", ScalarType::UINT32},
+      {"char", "int8", ScalarType::INT8},        {"uchar", "uint8", ScalarType::UINT8},
+      {"short", "int16", ScalarType::INT16},     {"ushort", "uint16", ScalarType::UINT16},
+      {"int", "int32", ScalarType::INT32},       {"uint", "uint32", ScalarType::UINT32},
       {"float", "float32", ScalarType::FLOAT32}, {"double", "float64", ScalarType::FLOAT64}};
   for (const Name& n : NAMES) {
     if (t == n.a || t == n.b) {
@@ -29,23 +29,38 @@ Result<void, IoError> apply(std::span<const std::string_view> tok, PlyHeader& h,
   if (key == "comment" || key == "obj_info") { return {}; }
   auto bad = [](IoError::Code c, const std::string& what) { return err(IoError{c, what}); };
   if (key == "format") {
-    if (tok.size() != 3 || tok[2] != "1.0") { return bad(IoError::Code::BAD_HEADER, "format needs a type and 1.0"); }
-    if (tok[1] == "ascii") { h.format = PlyFormat::ASCII; }
-    else if (tok[1] == "binary_little_endian") { h.format = PlyFormat::BINARY_LE; }
-    else if (tok[1] == "binary_big_endian") { h.format = PlyFormat::BINARY_BE; }
-    else { return bad(IoError::Code::UNSUPPORTED, "unknown format '" + std::string(tok[1]) + "'"); }
+    if (tok.size() != 3 || tok[2] != "1.0") {
+      return bad(IoError::Code::BAD_HEADER, "format needs a type and 1.0");
+    }
+    if (tok[1] == "ascii") {
+      h.format = PlyFormat::ASCII;
+    } else if (tok[1] == "binary_little_endian") {
+      h.format = PlyFormat::BINARY_LE;
+    } else if (tok[1] == "binary_big_endian") {
+      h.format = PlyFormat::BINARY_BE;
+    } else {
+      return bad(IoError::Code::UNSUPPORTED, "unknown format '" + std::string(tok[1]) + "'");
+    }
     has_format = true;
   } else if (key == "element") {
     PlyElement e;
-    if (tok.size() != 3 || !parse_number(tok[2], e.count)) { return bad(IoError::Code::BAD_HEADER, "element needs a name and a count"); }
-    if (e.count > MAX_PLY_VERTICES) { return bad(IoError::Code::TOO_LARGE, "element count above 2^31"); }
+    if (tok.size() != 3 || !parse_number(tok[2], e.count)) {
+      return bad(IoError::Code::BAD_HEADER, "element needs a name and a count");
+    }
+    if (e.count > MAX_PLY_VERTICES) {
+      return bad(IoError::Code::TOO_LARGE, "element count above 2^31");
+    }
     e.name = std::string(tok[1]);
     h.elements.push_back(std::move(e));
   } else if (key == "property") {
-    if (h.elements.empty()) { return bad(IoError::Code::BAD_HEADER, "property before any element"); }
+    if (h.elements.empty()) {
+      return bad(IoError::Code::BAD_HEADER, "property before any element");
+    }
     PlyProperty p;
     const bool list = tok.size() == 5 && tok[1] == "list";
-    if (!list && tok.size() != 3) { return bad(IoError::Code::BAD_HEADER, "property needs a type and a name"); }
+    if (!list && tok.size() != 3) {
+      return bad(IoError::Code::BAD_HEADER, "property needs a type and a name");
+    }
     if (list && (!ply_type(tok[2], p.count_type) || !ply_type(tok[3], p.type))) {
       return bad(IoError::Code::UNSUPPORTED, "unknown list property type");
     }
@@ -71,7 +86,8 @@ Result<PlyHeader, IoError> parse_ply_header(std::span<const char> bytes, std::st
   LineCursor cursor(bytes);
   std::string_view line;
   auto at = [&](IoError e) {
-    e.message = std::string(name) + ": line " + std::to_string(cursor.line_number()) + ": " + e.message;
+    e.message =
+        std::string(name) + ": line " + std::to_string(cursor.line_number()) + ": " + e.message;
     return err(std::move(e));
   };
   if (!cursor.next(line) || line != "ply") {

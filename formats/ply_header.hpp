@@ -6,9 +6,9 @@
 #include <string_view>
 #include <vector>
 
+#include "core/result.hpp"
 #include "formats/io_error.hpp"
 #include "formats/point_fields.hpp"
-#include "core/result.hpp"
 
 namespace orthoflow::formats {
 
@@ -16,9 +16,9 @@ enum class PlyFormat : std::uint8_t { ASCII, BINARY_LE, BINARY_BE };
 
 struct PlyProperty {
   std::string name;
-  ScalarType type = ScalarType::FLOAT32;        ///< the value type (the item type of a list)
+  ScalarType type = ScalarType::FLOAT32;  ///< the value type (the item type of a list)
   bool is_list = false;
-  ScalarType count_type = ScalarType::UINT8;    ///< type of a list's length prefix
+  ScalarType count_type = ScalarType::UINT8;  ///< type of a list's length prefix
 };
 
 struct PlyElement {
@@ -38,6 +38,7 @@ struct PlyHeader {
 inline constexpr std::uint64_t MAX_PLY_VERTICES = 1ULL << 31;
 
 /// Parses "ply" ... "end_header"; errors name the line.
-[[nodiscard]] Result<PlyHeader, IoError> parse_ply_header(std::span<const char> bytes, std::string_view name);
+[[nodiscard]] Result<PlyHeader, IoError> parse_ply_header(std::span<const char> bytes,
+                                                          std::string_view name);
 
 }  // namespace orthoflow::formats

@@ -25,14 +25,22 @@ double as_double(const unsigned char* p, ScalarType t) {
     return static_cast<double>(v);
   };
   switch (t) {
-    case ScalarType::INT8: return get(std::int8_t{});
-    case ScalarType::UINT8: return get(std::uint8_t{});
-    case ScalarType::INT16: return get(std::int16_t{});
-    case ScalarType::UINT16: return get(std::uint16_t{});
-    case ScalarType::INT32: return get(std::int32_t{});
-    case ScalarType::UINT32: return get(std::uint32_t{});
-    case ScalarType::FLOAT32: return get(float{});
-    case ScalarType::FLOAT64: return get(double{});
+    case ScalarType::INT8:
+      return get(std::int8_t{});
+    case ScalarType::UINT8:
+      return get(std::uint8_t{});
+    case ScalarType::INT16:
+      return get(std::int16_t{});
+    case ScalarType::UINT16:
+      return get(std::uint16_t{});
+    case ScalarType::INT32:
+      return get(std::int32_t{});
+    case ScalarType::UINT32:
+      return get(std::uint32_t{});
+    case ScalarType::FLOAT32:
+      return get(float{});
+    case ScalarType::FLOAT64:
+      return get(double{});
   }
   return 0.0;
 }
@@ -43,13 +51,20 @@ enum class Read : std::uint8_t { OK, END, NOT_A_NUMBER };
 /// Whether an integer value fits the declared PLY type.
 bool fits(double v, ScalarType t) {
   switch (t) {
-    case ScalarType::INT8: return v >= -128 && v <= 127;
-    case ScalarType::UINT8: return v >= 0 && v <= 255;
-    case ScalarType::INT16: return v >= -32768 && v <= 32767;
-    case ScalarType::UINT16: return v >= 0 && v <= 65535;
-    case ScalarType::INT32: return v >= -2147483648.0 && v <= 2147483647.0;
-    case ScalarType::UINT32: return v >= 0 && v <= 4294967295.0;
-    default: return true;
+    case ScalarType::INT8:
+      return v >= -128 && v <= 127;
+    case ScalarType::UINT8:
+      return v >= 0 && v <= 255;
+    case ScalarType::INT16:
+      return v >= -32768 && v <= 32767;
+    case ScalarType::UINT16:
+      return v >= 0 && v <= 65535;
+    case ScalarType::INT32:
+      return v >= -2147483648.0 && v <= 2147483647.0;
+    case ScalarType::UINT32:
+      return v >= 0 && v <= 4294967295.0;
+    default:
+      return true;
   }
 }
 
@@ -97,14 +112,18 @@ class AsciiSource {
   Read read(ScalarType t, double& v) {
     if (next_ >= tokens_.size()) { return Read::END; }
     const std::string_view tok = tokens_[next_++];
-    if (t == ScalarType::FLOAT32 || t == ScalarType::FLOAT64) { return parse_number(tok, v) ? Read::OK : Read::NOT_A_NUMBER; }
+    if (t == ScalarType::FLOAT32 || t == ScalarType::FLOAT64) {
+      return parse_number(tok, v) ? Read::OK : Read::NOT_A_NUMBER;
+    }
     std::int64_t i = 0;
     if (!parse_number(tok, i)) { return Read::NOT_A_NUMBER; }
     v = static_cast<double>(i);
     return fits(v, t) ? Read::OK : Read::NOT_A_NUMBER;
   }
   [[nodiscard]] std::size_t remaining() const { return remaining_; }
-  [[nodiscard]] std::string where() const { return "line " + std::to_string(cursor_.line_number()); }
+  [[nodiscard]] std::string where() const {
+    return "line " + std::to_string(cursor_.line_number());
+  }
 
  private:
   LineCursor cursor_;
@@ -116,10 +135,10 @@ class AsciiSource {
 enum class Slot : std::uint8_t { NONE, X, Y, Z, NX, NY, NZ, R, G, B, A };
 
 Slot slot_of(const std::string& n) {
-  static const std::pair<const char*, Slot> NAMES[] = {{"x", Slot::X},   {"y", Slot::Y},     {"z", Slot::Z},
-                                                       {"nx", Slot::NX}, {"ny", Slot::NY},   {"nz", Slot::NZ},
-                                                       {"red", Slot::R}, {"green", Slot::G}, {"blue", Slot::B},
-                                                       {"alpha", Slot::A}};
+  static const std::pair<const char*, Slot> NAMES[] = {
+      {"x", Slot::X},    {"y", Slot::Y},    {"z", Slot::Z},   {"nx", Slot::NX},
+      {"ny", Slot::NY},  {"nz", Slot::NZ},  {"red", Slot::R}, {"green", Slot::G},
+      {"blue", Slot::B}, {"alpha", Slot::A}};
   for (const auto& [name, slot] : NAMES) {
     if (n == name) { return slot; }
   }
@@ -127,7 +146,9 @@ Slot slot_of(const std::string& n) {
 }
 
 /// A colour channel clamped to 0..255 (a float property may hold NaN or anything else).
-std::uint32_t channel(double v) { return v >= 0.0 ? static_cast<std::uint32_t>(std::min(v, 255.0)) : 0U; }
+std::uint32_t channel(double v) {
+  return v >= 0.0 ? static_cast<std::uint32_t>(std::min(v, 255.0)) : 0U;
+}
 
 void store(kernels::PointCloud& c, std::size_t i, const std::array<double, 11>& v) {
   c.x()[i] = static_cast<float>(v[1]);
@@ -139,73 +160,91 @@ void store(kernels::PointCloud& c, std::size_t i, const std::array<double, 11>& 
     c.normal_z()[i] = static_cast<float>(v[6]);
   }
   if (c.has(kernels::Field::RGB)) {
-    c.rgb()[i] = (channel(v[10]) << 24) | (channel(v[7]) << 16) | (channel(v[8]) << 8) | channel(v[9]);
+    c.rgb()[i] =
+        (channel(v[10]) << 24) | (channel(v[7]) << 16) | (channel(v[8]) << 8) | channel(v[9]);
   }
 }
 
 /// Checks that the element's instances can fit in what is left before anything is allocated.
 bool plausible(const PlyElement& e, std::size_t remaining, bool ascii) {
   std::uint64_t min_bytes = 0;
-  for (const PlyProperty& p : e.properties) { min_bytes += p.is_list ? scalar_size(p.count_type) : scalar_size(p.type); }
+  for (const PlyProperty& p : e.properties) {
+    min_bytes += p.is_list ? scalar_size(p.count_type) : scalar_size(p.type);
+  }
   // ASCII: every instance is at least a line break, even with no property.
   if (ascii) { min_bytes = std::max<std::uint64_t>(1, 2 * e.properties.size()); }
   return min_bytes == 0 || e.count <= remaining / min_bytes;
 }
 
 template <class Source>
-Result<void, IoError> read_element(Source& src, const PlyElement& e, bool is_vertex, kernels::PointCloud& cloud,
-                                   std::string_view name) {
+Result<void, IoError> read_element(Source& src, const PlyElement& e, bool is_vertex,
+                                   kernels::PointCloud& cloud, std::string_view name) {
   auto fail = [&](IoError::Code c, const std::string& what) {
     return err(IoError{c, std::string(name) + ": " + src.where() + ": " + what});
   };
-  // A binary element without properties occupies no bytes, whatever its count: nothing to walk (a count
-  // of 10^9 must not mean 10^9 empty iterations; found by fuzz_ply_reader).
+  // A binary element without properties occupies no bytes, whatever its count: nothing to walk (a
+  // count of 10^9 must not mean 10^9 empty iterations; found by fuzz_ply_reader).
   if (e.properties.empty() && std::is_same_v<Source, BinarySource>) { return {}; }
   std::vector<Slot> slots;
-  for (const PlyProperty& p : e.properties) { slots.push_back(is_vertex && !p.is_list ? slot_of(p.name) : Slot::NONE); }
+  for (const PlyProperty& p : e.properties) {
+    slots.push_back(is_vertex && !p.is_list ? slot_of(p.name) : Slot::NONE);
+  }
   for (std::uint64_t i = 0; i < e.count; ++i) {
     std::array<double, 11> v{0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 255};
-    if (!src.begin_instance()) { return fail(IoError::Code::TRUNCATED, "file ends inside element '" + e.name + "'"); }
+    if (!src.begin_instance()) {
+      return fail(IoError::Code::TRUNCATED, "file ends inside element '" + e.name + "'");
+    }
     for (std::size_t k = 0; k < e.properties.size(); ++k) {
       const PlyProperty& p = e.properties[k];
       double value = 0;
       const Read got = src.read(p.is_list ? p.count_type : p.type, value);
       if (got != Read::OK) {
         return fail(got == Read::END ? IoError::Code::TRUNCATED : IoError::Code::BAD_NUMBER,
-                    "element '" + e.name + "' #" + std::to_string(i) + ", property '" + p.name + "': " +
-                        (got == Read::END ? "ends early" : "not a valid value"));
+                    "element '" + e.name + "' #" + std::to_string(i) + ", property '" + p.name +
+                        "': " + (got == Read::END ? "ends early" : "not a valid value"));
       }
       if (p.is_list) {
-        if (!(value >= 0.0 && value <= static_cast<double>(MAX_LIST_LENGTH))) { return fail(IoError::Code::CORRUPT_DATA, "list length out of range"); }
+        if (!(value >= 0.0 && value <= static_cast<double>(MAX_LIST_LENGTH))) {
+          return fail(IoError::Code::CORRUPT_DATA, "list length out of range");
+        }
         for (auto n = static_cast<std::uint64_t>(value); n > 0; --n) {
           double item = 0;
-          if (src.read(p.type, item) != Read::OK) { return fail(IoError::Code::TRUNCATED, "list of '" + p.name + "' ends early or holds a non-number"); }
+          if (src.read(p.type, item) != Read::OK) {
+            return fail(IoError::Code::TRUNCATED,
+                        "list of '" + p.name + "' ends early or holds a non-number");
+          }
         }
       } else {
         v[static_cast<std::size_t>(slots[k])] = value;
       }
     }
-    if (!src.end_instance()) { return fail(IoError::Code::SIZE_MISMATCH, "more values than the element declares"); }
+    if (!src.end_instance()) {
+      return fail(IoError::Code::SIZE_MISMATCH, "more values than the element declares");
+    }
     if (is_vertex) { store(cloud, static_cast<std::size_t>(i), v); }
   }
   return {};
 }
 
 template <class Source>
-Result<void, IoError> read_body(Source& src, const PlyHeader& h, kernels::PointCloud& cloud, std::string_view name) {
+Result<void, IoError> read_body(Source& src, const PlyHeader& h, kernels::PointCloud& cloud,
+                                std::string_view name) {
   bool seen_vertex = false;
   for (const PlyElement& e : h.elements) {
     const bool is_vertex = e.name == "vertex" && !seen_vertex;
     if (!plausible(e, src.remaining(), h.format == PlyFormat::ASCII)) {
-      return err(IoError{IoError::Code::TRUNCATED, std::string(name) + ": element '" + e.name + "' declares " +
-                                                       std::to_string(e.count) + " entries, more than the file holds"});
+      return err(IoError{IoError::Code::TRUNCATED, std::string(name) + ": element '" + e.name +
+                                                       "' declares " + std::to_string(e.count) +
+                                                       " entries, more than the file holds"});
     }
     if (is_vertex) {
       seen_vertex = true;
       cloud.resize_unorganized(static_cast<std::size_t>(e.count));
       for (const PlyProperty& p : e.properties) {
         const Slot s = slot_of(p.name);
-        if (s == Slot::NX || s == Slot::NY || s == Slot::NZ) { cloud.add_field(kernels::Field::NORMALS); }
+        if (s == Slot::NX || s == Slot::NY || s == Slot::NZ) {
+          cloud.add_field(kernels::Field::NORMALS);
+        }
         if (s == Slot::R || s == Slot::G || s == Slot::B) { cloud.add_field(kernels::Field::RGB); }
       }
     }
@@ -218,9 +257,13 @@ Result<void, IoError> check_vertex(const PlyHeader& h, std::string_view name) {
   for (const PlyElement& e : h.elements) {
     if (e.name != "vertex") { continue; }
     for (const char* axis : {"x", "y", "z"}) {
-      const bool found = std::any_of(e.properties.begin(), e.properties.end(),
-                                     [axis](const PlyProperty& p) { return !p.is_list && p.name == axis; });
-      if (!found) { return err(IoError{IoError::Code::BAD_HEADER, std::string(name) + ": vertex has no '" + axis + "'"}); }
+      const bool found =
+          std::any_of(e.properties.begin(), e.properties.end(),
+                      [axis](const PlyProperty& p) { return !p.is_list && p.name == axis; });
+      if (!found) {
+        return err(IoError{IoError::Code::BAD_HEADER,
+                           std::string(name) + ": vertex has no '" + axis + "'"});
+      }
     }
     return {};
   }
@@ -229,7 +272,8 @@ Result<void, IoError> check_vertex(const PlyHeader& h, std::string_view name) {
 
 }  // namespace
 
-Result<kernels::PointCloud, IoError> read_ply_buffer(std::span<const char> bytes, std::string_view name) {
+Result<kernels::PointCloud, IoError> read_ply_buffer(std::span<const char> bytes,
+                                                     std::string_view name) {
   auto header_result = parse_ply_header(bytes, name);
   if (!header_result) { return err(header_result.error()); }
   const PlyHeader& h = *header_result;

@@ -8,9 +8,9 @@
 #include <span>
 #include <string_view>
 
+#include "core/result.hpp"
 #include "formats/io_error.hpp"
 #include "kernels/point_cloud.hpp"
-#include "core/result.hpp"
 
 namespace orthoflow::formats {
 
@@ -18,7 +18,7 @@ namespace orthoflow::formats {
 [[nodiscard]] Result<kernels::PointCloud, IoError> read_ply(const std::filesystem::path& path);
 
 /// @brief Reads PLY bytes held in memory; @p name prefixes error messages.
-[[nodiscard]] Result<kernels::PointCloud, IoError> read_ply_buffer(std::span<const char> bytes,
-                                                                   std::string_view name = "<memory>");
+[[nodiscard]] Result<kernels::PointCloud, IoError> read_ply_buffer(
+    std::span<const char> bytes, std::string_view name = "<memory>");
 
 }  // namespace orthoflow::formats

@@ -15,21 +15,32 @@ T load(const char* p) noexcept {
 /// Reads one scalar of any type as double (exact for every integer type up to 32 bits).
 double load_as_double(const char* p, ScalarType type) noexcept {
   switch (type) {
-    case ScalarType::INT8: return load<std::int8_t>(p);
-    case ScalarType::UINT8: return load<std::uint8_t>(p);
-    case ScalarType::INT16: return load<std::int16_t>(p);
-    case ScalarType::UINT16: return load<std::uint16_t>(p);
-    case ScalarType::INT32: return load<std::int32_t>(p);
-    case ScalarType::UINT32: return load<std::uint32_t>(p);
-    case ScalarType::FLOAT32: return static_cast<double>(load<float>(p));
-    case ScalarType::FLOAT64: return load<double>(p);
+    case ScalarType::INT8:
+      return load<std::int8_t>(p);
+    case ScalarType::UINT8:
+      return load<std::uint8_t>(p);
+    case ScalarType::INT16:
+      return load<std::int16_t>(p);
+    case ScalarType::UINT16:
+      return load<std::uint16_t>(p);
+    case ScalarType::INT32:
+      return load<std::int32_t>(p);
+    case ScalarType::UINT32:
+      return load<std::uint32_t>(p);
+    case ScalarType::FLOAT32:
+      return static_cast<double>(load<float>(p));
+    case ScalarType::FLOAT64:
+      return load<double>(p);
   }
   return 0.0;
 }
 
-void decode_float(const char* base, std::size_t stride, ScalarType type, std::span<float> out) noexcept {
+void decode_float(const char* base, std::size_t stride, ScalarType type,
+                  std::span<float> out) noexcept {
   if (type == ScalarType::FLOAT32) {  // bit copy: keeps NaN payloads and signed zeros
-    for (std::size_t i = 0; i < out.size(); ++i) { std::memcpy(&out[i], base + i * stride, sizeof(float)); }
+    for (std::size_t i = 0; i < out.size(); ++i) {
+      std::memcpy(&out[i], base + i * stride, sizeof(float));
+    }
     return;
   }
   for (std::size_t i = 0; i < out.size(); ++i) {
@@ -37,7 +48,8 @@ void decode_float(const char* base, std::size_t stride, ScalarType type, std::sp
   }
 }
 
-void decode_u32(const char* base, std::size_t stride, ScalarType type, std::span<std::uint32_t> out) noexcept {
+void decode_u32(const char* base, std::size_t stride, ScalarType type,
+                std::span<std::uint32_t> out) noexcept {
   if (scalar_size(type) == 4) {  // rgb is declared F 4 by PCL: keep the bits whatever the type
     for (std::size_t i = 0; i < out.size(); ++i) { std::memcpy(&out[i], base + i * stride, 4); }
     return;
@@ -52,13 +64,20 @@ void decode_u32(const char* base, std::size_t stride, ScalarType type, std::span
 
 std::span<const float> float_buffer(const kernels::PointCloud& cloud, FieldTarget t) noexcept {
   switch (t) {
-    case FieldTarget::X: return cloud.x();
-    case FieldTarget::Y: return cloud.y();
-    case FieldTarget::Z: return cloud.z();
-    case FieldTarget::NORMAL_X: return cloud.normal_x();
-    case FieldTarget::NORMAL_Y: return cloud.normal_y();
-    case FieldTarget::NORMAL_Z: return cloud.normal_z();
-    default: return {};
+    case FieldTarget::X:
+      return cloud.x();
+    case FieldTarget::Y:
+      return cloud.y();
+    case FieldTarget::Z:
+      return cloud.z();
+    case FieldTarget::NORMAL_X:
+      return cloud.normal_x();
+    case FieldTarget::NORMAL_Y:
+      return cloud.normal_y();
+    case FieldTarget::NORMAL_Z:
+      return cloud.normal_z();
+    default:
+      return {};
   }
 }
 
@@ -75,13 +94,17 @@ std::span<float> float_target(kernels::PointCloud& cloud, FieldTarget t) noexcep
 std::uint32_t scalar_size(ScalarType type) noexcept {
   switch (type) {
     case ScalarType::INT8:
-    case ScalarType::UINT8: return 1;
+    case ScalarType::UINT8:
+      return 1;
     case ScalarType::INT16:
-    case ScalarType::UINT16: return 2;
+    case ScalarType::UINT16:
+      return 2;
     case ScalarType::INT32:
     case ScalarType::UINT32:
-    case ScalarType::FLOAT32: return 4;
-    case ScalarType::FLOAT64: return 8;
+    case ScalarType::FLOAT32:
+      return 4;
+    case ScalarType::FLOAT64:
+      return 8;
   }
   return 0;
 }
@@ -126,17 +149,25 @@ std::uint32_t packed_size(std::span<const PointField> fields) noexcept {
 void add_fields_for(std::span<const PointField> fields, kernels::PointCloud& cloud) {
   for (const PointField& f : fields) {
     switch (field_target(f.name)) {
-      case FieldTarget::RGB: cloud.add_field(kernels::Field::RGB); break;
-      case FieldTarget::LABEL: cloud.add_field(kernels::Field::LABEL); break;
+      case FieldTarget::RGB:
+        cloud.add_field(kernels::Field::RGB);
+        break;
+      case FieldTarget::LABEL:
+        cloud.add_field(kernels::Field::LABEL);
+        break;
       case FieldTarget::NORMAL_X:
       case FieldTarget::NORMAL_Y:
-      case FieldTarget::NORMAL_Z: cloud.add_field(kernels::Field::NORMALS); break;
-      default: break;
+      case FieldTarget::NORMAL_Z:
+        cloud.add_field(kernels::Field::NORMALS);
+        break;
+      default:
+        break;
     }
   }
 }
 
-void decode_field(const char* base, std::size_t stride, const PointField& field, kernels::PointCloud& cloud) noexcept {
+void decode_field(const char* base, std::size_t stride, const PointField& field,
+                  kernels::PointCloud& cloud) noexcept {
   const FieldTarget t = field_target(field.name);
   if (t == FieldTarget::RGB) {
     decode_u32(base, stride, field.type, cloud.rgb());
@@ -147,11 +178,13 @@ void decode_field(const char* base, std::size_t stride, const PointField& field,
   }
 }
 
-void encode_field(const kernels::PointCloud& cloud, const PointField& field, char* base, std::size_t stride) noexcept {
+void encode_field(const kernels::PointCloud& cloud, const PointField& field, char* base,
+                  std::size_t stride) noexcept {
   const FieldTarget t = field_target(field.name);
   const std::size_t n = cloud.size();
   if (t == FieldTarget::RGB || t == FieldTarget::LABEL) {
-    const std::span<const std::uint32_t> src = (t == FieldTarget::RGB) ? cloud.rgb() : cloud.label();
+    const std::span<const std::uint32_t> src =
+        (t == FieldTarget::RGB) ? cloud.rgb() : cloud.label();
     for (std::size_t i = 0; i < n; ++i) { std::memcpy(base + i * stride, &src[i], 4); }
     return;
   }
@@ -159,13 +192,14 @@ void encode_field(const kernels::PointCloud& cloud, const PointField& field, cha
   for (std::size_t i = 0; i < src.size(); ++i) { std::memcpy(base + i * stride, &src[i], 4); }
 }
 
-void decode_records(std::span<const char> data, std::span<const PointField> fields, std::size_t point_step,
-                    kernels::PointCloud& cloud) noexcept {
+void decode_records(std::span<const char> data, std::span<const PointField> fields,
+                    std::size_t point_step, kernels::PointCloud& cloud) noexcept {
   if (cloud.empty()) { return; }  // an empty buffer may have no address to offset from
   for (const PointField& f : fields) { decode_field(data.data() + f.offset, point_step, f, cloud); }
 }
 
-void encode_records(const kernels::PointCloud& cloud, std::span<const PointField> fields, std::span<char> out) noexcept {
+void encode_records(const kernels::PointCloud& cloud, std::span<const PointField> fields,
+                    std::span<char> out) noexcept {
   if (cloud.empty()) { return; }
   const std::size_t step = packed_size(fields);
   for (const PointField& f : fields) { encode_field(cloud, f, out.data() + f.offset, step); }

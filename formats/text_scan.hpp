@@ -13,7 +13,8 @@ namespace orthoflow::formats {
 /// @brief Walks a byte buffer line by line ('\n', with an optional '\r' stripped).
 class LineCursor {
  public:
-  explicit LineCursor(std::span<const char> bytes, std::size_t offset = 0, std::size_t first_line = 1) noexcept
+  explicit LineCursor(std::span<const char> bytes, std::size_t offset = 0,
+                      std::size_t first_line = 1) noexcept
       : bytes_(bytes), offset_(offset), next_line_(first_line) {}
   /// @brief Gets the next line; false at the end of the buffer.
   bool next(std::string_view& line) noexcept;
@@ -32,7 +33,8 @@ class LineCursor {
 /// and sets @p more when tokens were left over.
 std::size_t split_ws(std::string_view line, std::span<std::string_view> out, bool& more) noexcept;
 
-/// @brief Parses the whole token as T (integers: decimal; floats: also "nan", "inf"). False otherwise.
+/// @brief Parses the whole token as T (integers: decimal; floats: also "nan", "inf"). False
+/// otherwise.
 template <class T>
 bool parse_number(std::string_view token, T& value) noexcept {
   if (token.empty()) { return false; }

@@ -22,7 +22,8 @@ Layout layout(std::size_t capacity) noexcept {
   const std::size_t floats = align_up(capacity * sizeof(float));
   Layout l;
   // the raw frame with every optional field (rgb and label), as frame_payload lays it out
-  l.state = align_up(sizeof(engine::FrameHeader) + 3 * floats + 2 * align_up(capacity * sizeof(std::uint32_t)));
+  l.state = align_up(sizeof(engine::FrameHeader) + 3 * floats +
+                     2 * align_up(capacity * sizeof(std::uint32_t)));
   l.voxels = l.state + align_up(sizeof(FrameState));
   l.hull = l.voxels + 3 * floats;
   l.objects = l.hull + 2 * align_up(MAX_HULL * sizeof(double));
@@ -61,11 +62,13 @@ std::size_t FrameBlock::capacity_for(std::size_t block_bytes) noexcept {
   return lo;
 }
 
-FrameBlock::FrameBlock(std::span<std::byte> block, std::size_t capacity) noexcept : capacity_(capacity) {
+FrameBlock::FrameBlock(std::span<std::byte> block, std::size_t capacity) noexcept
+    : capacity_(capacity) {
   const Layout l = layout(capacity);
   std::byte* base = block.data();
   raw_ = block.first(l.state);
-  // FrameState is an implicit-lifetime aggregate of trivially copyable parts; the block outlives it.
+  // FrameState is an implicit-lifetime aggregate of trivially copyable parts; the block outlives
+  // it.
   state_ = std::launder(reinterpret_cast<FrameState*>(base + l.state));  // NOLINT
   voxels_ = xyz_at(base, l.voxels, capacity);
   hull_u_ = at<double>(base, l.hull, MAX_HULL);
@@ -78,7 +81,9 @@ Result<engine::FrameView, engine::FrameError> FrameBlock::frame() const noexcept
   return engine::view_frame(engine::resolve_frame_bytes(raw_));  // in the block, or in an IPC chunk
 }
 
-bool FrameBlock::external() const noexcept { return engine::resolve_frame_bytes(raw_).data() != raw_.data(); }
+bool FrameBlock::external() const noexcept {
+  return engine::resolve_frame_bytes(raw_).data() != raw_.data();
+}
 
 kernels::PointsView FrameBlock::object_view(std::size_t i) const noexcept {
   const ObjectRecord& o = state_->objects[i];

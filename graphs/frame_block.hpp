@@ -4,8 +4,8 @@
 /// (engine/frame_payload.hpp layout) sits at offset 0, so a source fills it in place; every stage
 /// then writes its results into its own region of the same block (nothing is copied between
 /// stages and nothing is allocated). Regions, each 64-byte aligned:
-///   raw frame | FrameState (counts, plane, objects, truth) | voxel centroids | hull | object points
-///   | descriptors.
+///   raw frame | FrameState (counts, plane, objects, truth) | voxel centroids | hull | object
+///   points | descriptors.
 /// Capacity (points per frame) follows from the pool's block size: capacity_for(block_bytes).
 #include <array>
 #include <cstddef>
@@ -15,19 +15,19 @@
 #include <string_view>
 
 #include "core/fixed_text.hpp"
+#include "core/result.hpp"
 #include "engine/frame_payload.hpp"
 #include "kernels/cluster_stats.hpp"
 #include "kernels/plane_distance.hpp"
 #include "kernels/tabletop_stages.hpp"
-#include "core/result.hpp"
 
 namespace orthoflow::graphs {
 
-inline constexpr std::size_t MAX_OBJECTS = 64;      ///< candidate objects kept per frame
-inline constexpr std::size_t MAX_HULL = 2048;       ///< support-polygon vertices kept
-inline constexpr std::size_t MAX_GOOD_BINS = 20;    ///< descriptor room: 3 * 20^2 floats per object
+inline constexpr std::size_t MAX_OBJECTS = 64;    ///< candidate objects kept per frame
+inline constexpr std::size_t MAX_HULL = 2048;     ///< support-polygon vertices kept
+inline constexpr std::size_t MAX_GOOD_BINS = 20;  ///< descriptor room: 3 * 20^2 floats per object
 inline constexpr std::size_t MAX_DESCRIPTOR = 3 * MAX_GOOD_BINS * MAX_GOOD_BINS;
-inline constexpr std::size_t MAX_TRUTH = 64;        ///< ground-truth objects a source can describe
+inline constexpr std::size_t MAX_TRUTH = 64;  ///< ground-truth objects a source can describe
 
 /// @brief Fixed-capacity text (labels, categories, node names): copying never allocates.
 using Text = core::Text;
@@ -46,8 +46,8 @@ struct ObjectRecord {
   std::uint32_t track_id = 0;  ///< 0 until the tracker assigns one
   bool new_track = false;      ///< the track started with this view
   bool moving = false;
-  bool key_view = false;       ///< thesis Table 3.1: tracking started, or static again after moving
-  bool fragment = false;       ///< a piece of an object whose main cluster has the same track id
+  bool key_view = false;  ///< thesis Table 3.1: tracking started, or static again after moving
+  bool fragment = false;  ///< a piece of an object whose main cluster has the same track id
   std::uint32_t truth_label = 0;  ///< majority ground-truth label of its points (0 = none)
   Text truth_category;            ///< category of that ground-truth object, if known
   // describe
@@ -59,22 +59,23 @@ struct ObjectRecord {
   // recognise
   bool recognised = false;
   bool unknown = true;
-  Text label;      ///< this frame's answer (smoothed over the track)
+  Text label;  ///< this frame's answer (smoothed over the track)
   float score = 0.0F;
-  Text nearest;    ///< the best category even when the answer is Unknown
+  Text nearest;  ///< the best category even when the answer is Unknown
   Text runner_up;
   bool taught = false;  ///< this view was taught in this frame
   Text taught_as;       ///< ... under this label
 };
 
 /// @brief Why a frame produced nothing (or less than it should). Plain data: set on the frame path
-/// without allocating. One rule: the first error a frame meets is the one it reports (set() keeps it;
-/// later stages see a frame that already failed and do not overwrite it).
+/// without allocating. One rule: the first error a frame meets is the one it reports (set() keeps
+/// it; later stages see a frame that already failed and do not overwrite it).
 struct FrameError {
   enum class Code : std::uint8_t {
     NONE,
     FRAME_TOO_LARGE,  ///< source: more points than the pool block holds (value: the point count)
-    FILE_UNREADABLE,  ///< pcd_source: the file did not parse (cause: formats::IoError::Code; detail: message)
+    FILE_UNREADABLE,  ///< pcd_source: the file did not parse (cause: formats::IoError::Code;
+                      ///< detail: message)
     INVALID_FRAME,    ///< the block holds no valid frame (cause: engine::FrameError)
     SEGMENTATION,     ///< a segmentation stage failed: segmentation holds the stage's typed reason
   };
@@ -99,20 +100,23 @@ struct FrameError {
 struct FrameState {
   std::uint32_t truth_count = 0;
   std::array<TruthObject, MAX_TRUTH> truth{};
-  std::uint32_t kept = 0;    ///< finite points inside the ROI that fed the plane input
-  std::uint32_t voxels = 0;  ///< plane input: dense sample (organized) or voxel centroids, at voxels()[0, voxels)
-  std::uint32_t sparse = 0;  ///< plane input: RANSAC's scoring sample, at voxels()[voxels, voxels + sparse)
-  bool organized_path = false;  ///< preprocess took the organized path (kernels::takes_organized_path)
-  kernels::AxisBox roi{};       ///< the region of interest preprocess applied (the prism applies it too)
+  std::uint32_t kept = 0;  ///< finite points inside the ROI that fed the plane input
+  std::uint32_t voxels =
+      0;  ///< plane input: dense sample (organized) or voxel centroids, at voxels()[0, voxels)
+  std::uint32_t sparse =
+      0;  ///< plane input: RANSAC's scoring sample, at voxels()[voxels, voxels + sparse)
+  bool organized_path =
+      false;               ///< preprocess took the organized path (kernels::takes_organized_path)
+  kernels::AxisBox roi{};  ///< the region of interest preprocess applied (the prism applies it too)
   bool table_found = false;
   kernels::Plane plane{};
   std::uint32_t plane_inliers = 0;
   std::uint32_t hull_count = 0;
-  std::uint32_t clusters = 0;        ///< clusters before the candidate constraints
-  std::uint32_t rejected_size = 0;   ///< failed C_size
-  std::uint32_t rejected_edge = 0;   ///< failed C_edge
+  std::uint32_t clusters = 0;           ///< clusters before the candidate constraints
+  std::uint32_t rejected_size = 0;      ///< failed C_size
+  std::uint32_t rejected_edge = 0;      ///< failed C_edge
   std::uint32_t rejected_capacity = 0;  ///< passed both but found the MAX_OBJECTS records full
-  std::uint32_t object_count = 0;    ///< candidates kept in objects
+  std::uint32_t object_count = 0;       ///< candidates kept in objects
   std::array<ObjectRecord, MAX_OBJECTS> objects{};
   FrameError error;  ///< why a stage produced nothing for this frame (empty = fine)
 };
@@ -124,7 +128,8 @@ class FrameBlock {
   [[nodiscard]] static std::size_t bytes_for(std::size_t capacity) noexcept;
   /// @brief Largest capacity a block of @p block_bytes holds (0 if not even one point).
   [[nodiscard]] static std::size_t capacity_for(std::size_t block_bytes) noexcept;
-  /// @brief Views @p block. @pre block.size() >= bytes_for(capacity), 64-byte aligned (pool blocks are).
+  /// @brief Views @p block. @pre block.size() >= bytes_for(capacity), 64-byte aligned (pool blocks
+  /// are).
   FrameBlock(std::span<std::byte> block, std::size_t capacity) noexcept;
 
   /// @brief Where a source writes the raw frame (engine::write_frame / layout_frame).

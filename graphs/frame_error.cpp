@@ -1,4 +1,5 @@
-// FrameError (graphs/frame_block.hpp): the typed per-frame error and its one rule (first error wins).
+// FrameError (graphs/frame_block.hpp): the typed per-frame error and its one rule (first error
+// wins).
 #include <string>
 
 #include "graphs/frame_block.hpp"
@@ -7,11 +8,16 @@ namespace orthoflow::graphs {
 
 std::string_view FrameError::name(Code code) noexcept {
   switch (code) {
-    case FrameError::Code::NONE: return "NONE";
-    case FrameError::Code::FRAME_TOO_LARGE: return "FRAME_TOO_LARGE";
-    case FrameError::Code::FILE_UNREADABLE: return "FILE_UNREADABLE";
-    case FrameError::Code::INVALID_FRAME: return "INVALID_FRAME";
-    case FrameError::Code::SEGMENTATION: return "SEGMENTATION";
+    case FrameError::Code::NONE:
+      return "NONE";
+    case FrameError::Code::FRAME_TOO_LARGE:
+      return "FRAME_TOO_LARGE";
+    case FrameError::Code::FILE_UNREADABLE:
+      return "FILE_UNREADABLE";
+    case FrameError::Code::INVALID_FRAME:
+      return "INVALID_FRAME";
+    case FrameError::Code::SEGMENTATION:
+      return "SEGMENTATION";
   }
   return "UNKNOWN";
 }
@@ -34,11 +40,16 @@ bool FrameError::set(std::string_view node, const kernels::SegmentationError& e)
 std::string FrameError::to_string() const {
   std::string out = std::string(stage.view()) + ": " + std::string(name(code));
   switch (code) {
-    case Code::NONE: return "no error";
-    case Code::SEGMENTATION: return out + ": " + segmentation.to_string();
-    case Code::FRAME_TOO_LARGE: return out + ": " + std::to_string(static_cast<std::uint64_t>(value)) + " points";
-    case Code::FILE_UNREADABLE: return out + ": " + std::string(detail.view());
-    case Code::INVALID_FRAME: return out + ": frame error " + std::to_string(cause);
+    case Code::NONE:
+      return "no error";
+    case Code::SEGMENTATION:
+      return out + ": " + segmentation.to_string();
+    case Code::FRAME_TOO_LARGE:
+      return out + ": " + std::to_string(static_cast<std::uint64_t>(value)) + " points";
+    case Code::FILE_UNREADABLE:
+      return out + ": " + std::string(detail.view());
+    case Code::INVALID_FRAME:
+      return out + ": frame error " + std::to_string(cause);
   }
   return out;
 }

@@ -8,10 +8,14 @@ namespace orthoflow::graphs {
 
 std::string_view to_string(LearningCommand::Kind kind) noexcept {
   switch (kind) {
-    case LearningCommand::Kind::TEACH: return "teach";
-    case LearningCommand::Kind::CORRECT: return "correct";
-    case LearningCommand::Kind::FORGET: return "forget";
-    case LearningCommand::Kind::ASK: return "ask";
+    case LearningCommand::Kind::TEACH:
+      return "teach";
+    case LearningCommand::Kind::CORRECT:
+      return "correct";
+    case LearningCommand::Kind::FORGET:
+      return "forget";
+    case LearningCommand::Kind::ASK:
+      return "ask";
   }
   return "unknown";
 }
@@ -19,16 +23,26 @@ std::string_view to_string(LearningCommand::Kind kind) noexcept {
 std::string_view to_string(LearningAck::Outcome outcome) noexcept {
   using O = LearningAck::Outcome;
   switch (outcome) {
-    case O::STORED: return "stored";
-    case O::LEARNED: return "learned";
-    case O::ANSWERED: return "answered";
-    case O::NO_SUCH_TRACK: return "no_such_track";
-    case O::NOT_DESCRIBED: return "not_described";
-    case O::BAD_LABEL: return "bad_label";
-    case O::REJECTED: return "rejected";
-    case O::UNKNOWN_LABEL: return "unknown_label";
-    case O::WRITE_FAILED: return "write_failed";
-    case O::BUSY: return "busy";
+    case O::STORED:
+      return "stored";
+    case O::LEARNED:
+      return "learned";
+    case O::ANSWERED:
+      return "answered";
+    case O::NO_SUCH_TRACK:
+      return "no_such_track";
+    case O::NOT_DESCRIBED:
+      return "not_described";
+    case O::BAD_LABEL:
+      return "bad_label";
+    case O::REJECTED:
+      return "rejected";
+    case O::UNKNOWN_LABEL:
+      return "unknown_label";
+    case O::WRITE_FAILED:
+      return "write_failed";
+    case O::BUSY:
+      return "busy";
   }
   return "unknown";
 }
@@ -48,7 +62,9 @@ std::unique_ptr<LearningClient> LearningService::connect() {
   return nullptr;
 }
 
-void LearningService::disconnect(std::uint32_t slot) noexcept { clients_[slot].active.store(false); }
+void LearningService::disconnect(std::uint32_t slot) noexcept {
+  clients_[slot].active.store(false);
+}
 
 std::uint64_t LearningService::enqueue(LearningCommand command) noexcept {
   const std::lock_guard senders(senders_);
@@ -81,6 +97,8 @@ std::uint64_t LearningClient::send(LearningCommand command) noexcept {
   return queued;
 }
 
-bool LearningClient::poll(LearningAck& ack) noexcept { return service_.clients_[slot_].acks.try_pop(ack); }
+bool LearningClient::poll(LearningAck& ack) noexcept {
+  return service_.clients_[slot_].acks.try_pop(ack);
+}
 
 }  // namespace orthoflow::graphs

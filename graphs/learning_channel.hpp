@@ -1,13 +1,15 @@
 #pragma once
 /// @file
 /// @brief The learning channel: how a person (a UI, a DDS bridge, a test, a second thread) teaches,
-/// corrects, asks and makes the robot forget while the tabletop graph runs (thesis chapter 5: teach,
-/// ask, correct). Each sender connects once and gets a LearningClient; its commands go into one bounded
-/// queue the recognise node drains every frame, and every command is acknowledged back to its sender
-/// with its outcome: stored durably (after the synced write), learned in memory, answered, or the error.
+/// corrects, asks and makes the robot forget while the tabletop graph runs (thesis chapter 5:
+/// teach, ask, correct). Each sender connects once and gets a LearningClient; its commands go into
+/// one bounded queue the recognise node drains every frame, and every command is acknowledged back
+/// to its sender with its outcome: stored durably (after the synced write), learned in memory,
+/// answered, or the error.
 ///
-/// Real time: the recognise node's side (poll, acknowledge) is lock-free apart from a spin lock held
-/// for one record copy; senders take a mutex among themselves (they are not on the frame path).
+/// Real time: the recognise node's side (poll, acknowledge) is lock-free apart from a spin lock
+/// held for one record copy; senders take a mutex among themselves (they are not on the frame
+/// path).
 #include <array>
 #include <cstdint>
 #include <string>
@@ -20,7 +22,8 @@ namespace orthoflow::graphs {
 /// @brief What a sender asks of the learning channel.
 struct LearningCommand {
   enum class Kind : std::uint8_t {
-    TEACH,    ///< store the object's key views (and current view) under label; by track or by position
+    TEACH,    ///< store the object's key views (and current view) under label; by track or by
+              ///< position
     CORRECT,  ///< the answer for track was wrong: store its current view under label
     FORGET,   ///< forget category label
     ASK,      ///< what is track? (the current smoothed answer)
@@ -55,14 +58,16 @@ struct LearningAck {
   std::uint32_t sender = 0;
   LearningCommand::Kind kind = LearningCommand::Kind::TEACH;
   Outcome outcome = Outcome::NO_SUCH_TRACK;
-  std::uint32_t track_id = 0;  ///< the object the command applied to (TEACH by position: the one chosen)
-  std::uint32_t views = 0;     ///< TEACH / CORRECT: views stored
-  core::Text label;            ///< TEACH / CORRECT / FORGET: the label; ASK: the answer (empty = Unknown)
-  float score = 0.0F;          ///< ASK: the learner's score for the answer
-  bool unknown = true;         ///< ASK
+  std::uint32_t track_id =
+      0;  ///< the object the command applied to (TEACH by position: the one chosen)
+  std::uint32_t views = 0;  ///< TEACH / CORRECT: views stored
+  core::Text label;     ///< TEACH / CORRECT / FORGET: the label; ASK: the answer (empty = Unknown)
+  float score = 0.0F;   ///< ASK: the learner's score for the answer
+  bool unknown = true;  ///< ASK
   std::uint64_t frame_id = 0;  ///< the frame that handled it
   [[nodiscard]] bool ok() const noexcept {
-    return outcome == Outcome::STORED || outcome == Outcome::LEARNED || outcome == Outcome::ANSWERED;
+    return outcome == Outcome::STORED || outcome == Outcome::LEARNED ||
+           outcome == Outcome::ANSWERED;
   }
 };
 

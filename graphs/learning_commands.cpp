@@ -10,10 +10,12 @@ using Outcome = LearningAck::Outcome;
 }  // namespace
 
 LessonDesk::LessonDesk(LearningService& service, TrackMemories& memories)
-    : service_(service), memories_(memories), lesson_(MAX_TEACH_VIEWS * service.descriptor_length()) {}
+    : service_(service),
+      memories_(memories),
+      lesson_(MAX_TEACH_VIEWS * service.descriptor_length()) {}
 
-// The object a command names: by track id (its main piece, not a fragment, when both are in the frame),
-// or the one whose centroid is nearest to the position. -1 when there is none.
+// The object a command names: by track id (its main piece, not a fragment, when both are in the
+// frame), or the one whose centroid is nearest to the position. -1 when there is none.
 std::int64_t LessonDesk::find_object(const FrameState& s, const LearningCommand& c) const noexcept {
   std::int64_t best = -1;
   float best_d = 1e30F;
@@ -34,8 +36,9 @@ std::int64_t LessonDesk::find_object(const FrameState& s, const LearningCommand&
   return best;
 }
 
-LearningAck LessonDesk::teach_object(const FrameBlock& block, std::uint32_t k, std::string_view label,
-                                     LearningAck ack, std::int64_t stamp) noexcept {
+LearningAck LessonDesk::teach_object(const FrameBlock& block, std::uint32_t k,
+                                     std::string_view label, LearningAck ack,
+                                     std::int64_t stamp) noexcept {
   ObjectRecord& o = block.state().objects[k];
   ack.track_id = o.track_id;
   if (!o.described || o.descriptor_length != service_.descriptor_length()) {
@@ -69,7 +72,8 @@ void LessonDesk::answer(const FrameBlock& block, std::int64_t k, LearningAck ack
 
 // Thesis "correct": the answer was wrong; the current view is stored under the right label and the
 // track's recorded answers are dropped, so the next frames show what the learner now says.
-void LessonDesk::correct(const FrameBlock& block, std::int64_t k, std::string_view label, LearningAck ack) noexcept {
+void LessonDesk::correct(const FrameBlock& block, std::int64_t k, std::string_view label,
+                         LearningAck ack) noexcept {
   ObjectRecord& o = block.state().objects[static_cast<std::size_t>(k)];
   ack.track_id = o.track_id;
   if (!o.described || o.descriptor_length != service_.descriptor_length()) {
@@ -78,14 +82,17 @@ void LessonDesk::correct(const FrameBlock& block, std::int64_t k, std::string_vi
     return;
   }
   const auto stamp = static_cast<std::int64_t>(ack.frame_id);
-  ack = service_.teach(label, block.descriptor(static_cast<std::size_t>(k)).first(o.descriptor_length), o.track_id,
-                       stamp, ack);
+  ack = service_.teach(label,
+                       block.descriptor(static_cast<std::size_t>(k)).first(o.descriptor_length),
+                       o.track_id, stamp, ack);
   o.taught = ack.ok();
   if (o.taught) o.taught_as.assign(label);
-  if (TrackMemory* t = memories_.find(o.track_id); t != nullptr && ack.ok()) TrackMemories::reset_votes(*t);
+  if (TrackMemory* t = memories_.find(o.track_id); t != nullptr && ack.ok())
+    TrackMemories::reset_votes(*t);
 }
 
-void LessonDesk::apply(const FrameBlock& block, const LearningCommand& c, std::uint64_t frame_id) noexcept {
+void LessonDesk::apply(const FrameBlock& block, const LearningCommand& c,
+                       std::uint64_t frame_id) noexcept {
   LearningAck ack;
   ack.sequence = c.sequence;
   ack.sender = c.sender;
@@ -106,7 +113,8 @@ void LessonDesk::apply(const FrameBlock& block, const LearningCommand& c, std::u
   }
   if (c.kind == Kind::ASK) return answer(block, k, ack);
   if (c.kind == Kind::CORRECT) return correct(block, k, c.label.view(), ack);
-  teach_object(block, static_cast<std::uint32_t>(k), c.label.view(), ack, static_cast<std::int64_t>(frame_id));
+  teach_object(block, static_cast<std::uint32_t>(k), c.label.view(), ack,
+               static_cast<std::int64_t>(frame_id));
 }
 
 }  // namespace orthoflow::graphs

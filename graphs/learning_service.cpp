@@ -12,7 +12,8 @@ constexpr auto WORKER_POLL = std::chrono::milliseconds(2);
 using Outcome = LearningAck::Outcome;
 }  // namespace
 
-/// A durable teach or forget waiting for the background writer; fixed size so queueing never allocates.
+/// A durable teach or forget waiting for the background writer; fixed size so queueing never
+/// allocates.
 struct LearningService::Job {
   bool forget = false;
   Text label;
@@ -32,13 +33,15 @@ learning::MemoryConfig live_session_memory_config() noexcept {
 
 LearningService::LearningService() : jobs_(JOBS) {}
 
-Result<std::unique_ptr<LearningService>, std::string> LearningService::open(const LearningSettings& settings) {
+Result<std::unique_ptr<LearningService>, std::string> LearningService::open(
+    const LearningSettings& settings) {
   std::unique_ptr<LearningService> s(new LearningService());
   learning::MemoryConfig cfg = settings.memory;
   if (auto valid = cfg.descriptor.validate(); !valid) return err("learning: " + valid.error());
   s->spec_ = cfg.descriptor;
   const std::size_t length = cfg.descriptor.length();
-  if (length > MAX_DESCRIPTOR) return err("learning: " + cfg.descriptor.describe() + " does not fit the frame block");
+  if (length > MAX_DESCRIPTOR)
+    return err("learning: " + cfg.descriptor.describe() + " does not fit the frame block");
   if (settings.db) {
     auto memory = learning::PerceptualMemory::open(*settings.db, cfg);
     if (!memory) return err("learning: " + memory.error().to_string());
@@ -74,8 +77,9 @@ LearningAck LearningService::finish(LearningAck ack, bool ok, Outcome failure) n
   return ack;
 }
 
-LearningAck LearningService::teach(std::string_view label, std::span<const float> views, std::uint32_t track_id,
-                                   std::int64_t stamp_ns, LearningAck ack) noexcept {
+LearningAck LearningService::teach(std::string_view label, std::span<const float> views,
+                                   std::uint32_t track_id, std::int64_t stamp_ns,
+                                   LearningAck ack) noexcept {
   const std::size_t length = descriptor_length();
   const std::size_t count = std::min(views.size() / length, MAX_TEACH_VIEWS);
   ack.track_id = track_id;
@@ -88,7 +92,8 @@ LearningAck LearningService::teach(std::string_view label, std::span<const float
     return finish(ack, taught, Outcome::REJECTED);
   }
   Job* job = jobs_.claim();
-  if (job == nullptr) return finish(ack, false, Outcome::BUSY);  // the writer is behind: refuse, never wait
+  if (job == nullptr)
+    return finish(ack, false, Outcome::BUSY);  // the writer is behind: refuse, never wait
   job->forget = false;
   job->label.assign(label);
   job->track_id = track_id;
@@ -123,15 +128,17 @@ void LearningService::run_job(const Job& job) noexcept {
   LearningAck ack = job.ack;
   if (job.forget) {
     auto forgotten = memory_->forget(job.label.view());
-    const bool unknown = !forgotten && forgotten.error().code == learning::MemoryError::Code::UNKNOWN_LABEL;
+    const bool unknown =
+        !forgotten && forgotten.error().code == learning::MemoryError::Code::UNKNOWN_LABEL;
     finish(ack, forgotten.has_value(), unknown ? Outcome::UNKNOWN_LABEL : Outcome::WRITE_FAILED);
     return;
   }
   const std::size_t length = descriptor_length();
   std::vector<learning::ViewRecord> records(job.views);  // the writer thread may allocate
   for (std::size_t v = 0; v < job.views; ++v) {
-    records[v].descriptor.assign(job.values.begin() + static_cast<std::ptrdiff_t>(v * length),
-                                 job.values.begin() + static_cast<std::ptrdiff_t>((v + 1) * length));
+    records[v].descriptor.assign(
+        job.values.begin() + static_cast<std::ptrdiff_t>(v * length),
+        job.values.begin() + static_cast<std::ptrdiff_t>((v + 1) * length));
     records[v].track_id = job.track_id;
     records[v].stamp_ns = job.stamp_ns;
   }

@@ -1,14 +1,15 @@
 #pragma once
 /// @file
-/// @brief LearningService: what the tabletop graph asks and teaches. Wraps an in-memory learner or a
-/// durable PerceptualMemory (LevelDB), and carries the learning channel (graphs/learning_channel.hpp):
-/// commands from any number of connected senders in, acknowledgements back to each sender.
+/// @brief LearningService: what the tabletop graph asks and teaches. Wraps an in-memory learner or
+/// a durable PerceptualMemory (LevelDB), and carries the learning channel
+/// (graphs/learning_channel.hpp): commands from any number of connected senders in,
+/// acknowledgements back to each sender.
 ///
-/// Real time: ask() is lock-free and allocation-free (the learner's snapshot read). A teach, correct or
-/// forget from the frame path is applied inline for an in-memory learner (a snapshot rebuild: it
-/// allocates, once per lesson) and handed to a background thread for a durable memory, so the frame path
-/// never waits for a synced disk write; it becomes visible to the asks, and is acknowledged as STORED,
-/// after that write (a few frames later).
+/// Real time: ask() is lock-free and allocation-free (the learner's snapshot read). A teach,
+/// correct or forget from the frame path is applied inline for an in-memory learner (a snapshot
+/// rebuild: it allocates, once per lesson) and handed to a background thread for a durable memory,
+/// so the frame path never waits for a synced disk write; it becomes visible to the asks, and is
+/// acknowledged as STORED, after that write (a few frames later).
 #include <array>
 #include <atomic>
 #include <cstdint>
@@ -30,8 +31,8 @@
 namespace orthoflow::graphs {
 
 /// @brief The live-session default: plain nearest neighbour over GOOD (L2), Unknown beyond this
-/// distance. A category taught from a few views of one still object has an ICD near zero, which makes
-/// the thesis's NOCD explode for every other instance; docs/TABLETOP.md has the measurements.
+/// distance. A category taught from a few views of one still object has an ICD near zero, which
+/// makes the thesis's NOCD explode for every other instance; docs/TABLETOP.md has the measurements.
 inline constexpr float DEFAULT_NN_THRESHOLD = 0.3F;
 /// @brief Senders that can be connected at once.
 inline constexpr std::size_t MAX_LEARNING_CLIENTS = 8;
@@ -43,20 +44,23 @@ inline constexpr std::size_t MAX_TEACH_VIEWS = 8;
 
 /// @brief Learner settings of a service.
 struct LearningSettings {
-  learning::MemoryConfig memory = live_session_memory_config();  ///< descriptor, learner kind, settings
+  learning::MemoryConfig memory =
+      live_session_memory_config();         ///< descriptor, learner kind, settings
   std::optional<std::filesystem::path> db;  ///< durable memory directory; none = in memory only
 };
 
 class LearningService;
 
-/// @brief One sender's end of the learning channel. Thread-compatible: one thread uses a client; other
-/// threads use clients of their own. Disconnects when destroyed. @pre destroyed before its service.
+/// @brief One sender's end of the learning channel. Thread-compatible: one thread uses a client;
+/// other threads use clients of their own. Disconnects when destroyed. @pre destroyed before its
+/// service.
 class LearningClient {
  public:
   ~LearningClient();
   LearningClient(const LearningClient&) = delete;
   LearningClient& operator=(const LearningClient&) = delete;
-  /// @brief Queues @p command; @return its sequence number (acks carry it), or 0 if the queue is full.
+  /// @brief Queues @p command; @return its sequence number (acks carry it), or 0 if the queue is
+  /// full.
   std::uint64_t send(LearningCommand command) noexcept;
   /// @brief Takes the next acknowledgement, if any. Lock-free.
   bool poll(LearningAck& ack) noexcept;
@@ -64,18 +68,21 @@ class LearningClient {
 
  private:
   friend class LearningService;
-  LearningClient(LearningService& service, std::uint32_t slot) noexcept : service_(service), slot_(slot) {}
+  LearningClient(LearningService& service, std::uint32_t slot) noexcept
+      : service_(service), slot_(slot) {}
   LearningService& service_;
   std::uint32_t slot_;
   std::uint64_t next_sequence_ = 1;
 };
 
 /// @brief Learning for one graph. @note connect() and LearningClient::send are thread-safe; poll(),
-/// ask(), teach(), correct(), forget() and acknowledge() are for the recognise node (one thread at a time).
+/// ask(), teach(), correct(), forget() and acknowledge() are for the recognise node (one thread at
+/// a time).
 class LearningService {
  public:
   /// @brief Opens the memory (or makes an in-memory learner). Errors name the store and the reason.
-  [[nodiscard]] static Result<std::unique_ptr<LearningService>, std::string> open(const LearningSettings& settings);
+  [[nodiscard]] static Result<std::unique_ptr<LearningService>, std::string> open(
+      const LearningSettings& settings);
   ~LearningService();
   LearningService(const LearningService&) = delete;
   LearningService& operator=(const LearningService&) = delete;
@@ -92,11 +99,11 @@ class LearningService {
   /// @brief Delivers @p ack to its sender (dropped if the sender has gone).
   void acknowledge(const LearningAck& ack) noexcept;
 
-  /// @brief Stores @p views (row-major, descriptor_length() each, at most MAX_TEACH_VIEWS) under @p label.
-  /// In memory: learned now, @p ack completed (LEARNED or the error) and returned. Durable: queued,
-  /// acknowledged (STORED or WRITE_FAILED) by the writer after the synced write; returns the ack as
-  /// queued (outcome STORED means "on its way") or BUSY / BAD_LABEL / REJECTED when refused at once.
-  /// With @p ack.sequence == 0 (the scripted instructor) nothing is acknowledged.
+  /// @brief Stores @p views (row-major, descriptor_length() each, at most MAX_TEACH_VIEWS) under @p
+  /// label. In memory: learned now, @p ack completed (LEARNED or the error) and returned. Durable:
+  /// queued, acknowledged (STORED or WRITE_FAILED) by the writer after the synced write; returns
+  /// the ack as queued (outcome STORED means "on its way") or BUSY / BAD_LABEL / REJECTED when
+  /// refused at once. With @p ack.sequence == 0 (the scripted instructor) nothing is acknowledged.
   LearningAck teach(std::string_view label, std::span<const float> views, std::uint32_t track_id,
                     std::int64_t stamp_ns, LearningAck ack) noexcept;
   /// @brief Forgets @p label; same acknowledgement rules as teach().
@@ -127,10 +134,10 @@ class LearningService {
   std::unique_ptr<learning::Learner> learner_;          // in memory
   std::unique_ptr<learning::PerceptualMemory> memory_;  // durable
   kernels::DescriptorSpec spec_{};
-  std::mutex senders_;                           // serialises the command producers
+  std::mutex senders_;  // serialises the command producers
   core::SpscRing<LearningCommand> commands_{64};
   std::array<ClientSlot, MAX_LEARNING_CLIENTS> clients_{};
-  core::SpscRing<Job> jobs_;                     // recognise node -> durable writer
+  core::SpscRing<Job> jobs_;  // recognise node -> durable writer
   std::atomic<bool> stop_{false};
   std::atomic<std::uint64_t> teaches_{0}, refused_{0}, commands_dropped_{0}, acks_dropped_{0};
   std::thread worker_;

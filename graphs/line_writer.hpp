@@ -19,12 +19,13 @@ namespace orthoflow::graphs {
 class LineWriter {
  public:
   /// @brief Opens (truncates) @p path; "-" writes to stdout. @p ring_bytes bounds the backlog.
-  [[nodiscard]] static Result<std::unique_ptr<LineWriter>, std::string> open(const std::string& path,
-                                                                             std::size_t ring_bytes = 4 << 20);
+  [[nodiscard]] static Result<std::unique_ptr<LineWriter>, std::string> open(
+      const std::string& path, std::size_t ring_bytes = 4 << 20);
   ~LineWriter();  ///< writes what is queued, then closes
   LineWriter(const LineWriter&) = delete;
   LineWriter& operator=(const LineWriter&) = delete;
-  /// @brief Queues @p line plus '\n'. Single producer. @return false if dropped (ring full). Lock-free.
+  /// @brief Queues @p line plus '\n'. Single producer. @return false if dropped (ring full).
+  /// Lock-free.
   bool write(std::string_view line) noexcept;
   /// @brief Waits until everything queued is written and flushed (off the frame path).
   void flush() noexcept;

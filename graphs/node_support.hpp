@@ -6,17 +6,18 @@
 #include <span>
 #include <string>
 
+#include "core/result.hpp"
 #include "engine/node.hpp"
 #include "engine/params.hpp"
 #include "graphs/frame_block.hpp"
-#include "core/result.hpp"
 
 namespace orthoflow::graphs {
 
 /// @brief Factory result of every node kind.
 using NodeResult = Result<std::unique_ptr<engine::Node>, std::string>;
 
-/// @brief Port lists used by the tabletop kinds ("frame": a FrameBlock; "object": one object of it).
+/// @brief Port lists used by the tabletop kinds ("frame": a FrameBlock; "object": one object of
+/// it).
 inline const engine::PortSpec FRAME_IN{"in", "frame", true};
 inline const engine::PortSpec FRAME_OUT{"out", "frame", false};
 inline const engine::PortSpec OBJECT_IN{"in", "object", true};
@@ -26,8 +27,10 @@ inline const engine::PortSpec OBJECT_OUT{"out", "object", false};
 /// small for even a tiny frame (start-up only).
 [[nodiscard]] Result<std::size_t, std::string> frame_capacity(const engine::NodeContext& context);
 
-/// @brief The frame block a message carries. @pre message.payload holds a block of the graph's pool.
-[[nodiscard]] inline FrameBlock block_of(const engine::Message& message, std::size_t capacity) noexcept {
+/// @brief The frame block a message carries. @pre message.payload holds a block of the graph's
+/// pool.
+[[nodiscard]] inline FrameBlock block_of(const engine::Message& message,
+                                         std::size_t capacity) noexcept {
   return FrameBlock(message.payload.bytes(), capacity);
 }
 

@@ -1,8 +1,9 @@
-// The `objects` kind: kernels::ObjectStage (prism over the table polygon, Euclidean clusters, footprint
-// merge, per-cluster statistics) and the candidate constraints of thesis Table 3.1 that need no tracking
-// (kernels::select_candidates: C_size, C_edge), then the gather of each kept object's points into the
-// block's object-point region (one contiguous span per object, for describe) with the majority
-// ground-truth label of its pixels when the frame carries labels. The same code as the chain.
+// The `objects` kind: kernels::ObjectStage (prism over the table polygon, Euclidean clusters,
+// footprint merge, per-cluster statistics) and the candidate constraints of thesis Table 3.1 that
+// need no tracking (kernels::select_candidates: C_size, C_edge), then the gather of each kept
+// object's points into the block's object-point region (one contiguous span per object, for
+// describe) with the majority ground-truth label of its pixels when the frame carries labels. The
+// same code as the chain.
 #include <algorithm>
 #include <array>
 #include <vector>
@@ -20,12 +21,16 @@ using engine::Emitter;
 using engine::Message;
 
 const engine::PortSpec PORTS[] = {FRAME_IN, FRAME_OUT};
-constexpr std::size_t TRUTH_BINS = 256;  // ground-truth label values counted per object (synthetic: 100 + id)
+constexpr std::size_t TRUTH_BINS =
+    256;  // ground-truth label values counted per object (synthetic: 100 + id)
 
 class Objects final : public engine::Node {
  public:
   Objects(std::size_t capacity, std::string name, const TabletopSegmentation& p)
-      : capacity_(capacity), name_(std::move(name)), p_(p), stage_(capacity, p.stages.cluster.min_size),
+      : capacity_(capacity),
+        name_(std::move(name)),
+        p_(p),
+        stage_(capacity, p.stages.cluster.min_size),
         slot_of_(capacity / std::max<std::size_t>(1, p.stages.cluster.min_size) + 1),
         truth_counts_(MAX_OBJECTS * TRUTH_BINS) {}
   std::span<const engine::PortSpec> inputs() const noexcept override { return {PORTS, 1}; }
@@ -73,17 +78,20 @@ class Objects final : public engine::Node {
     gather(block, *found, s.organized_path ? frame.label : std::span<const std::uint32_t>{});
   }
 
-  void gather(const FrameBlock& block, const kernels::ObjectClusters& found, std::span<const std::uint32_t> truth) {
+  void gather(const FrameBlock& block, const kernels::ObjectClusters& found,
+              std::span<const std::uint32_t> truth) {
     FrameState& s = block.state();
     const auto sizes = std::span<const std::size_t>(sizes_).first(s.object_count);
-    kernels::gather_candidates(found.target, found.labels, found.members, slot_of_, sizes, block.object_points(),
-                               spans_, truth, truth.empty() ? 0 : TRUTH_BINS, truth_counts_);
+    kernels::gather_candidates(found.target, found.labels, found.members, slot_of_, sizes,
+                               block.object_points(), spans_, truth, truth.empty() ? 0 : TRUTH_BINS,
+                               truth_counts_);
     for (std::uint32_t k = 0; k < s.object_count; ++k) {
       ObjectRecord& o = s.objects[k];
       o.first = spans_[k].first;
       o.count = spans_[k].count;
       if (truth.empty()) continue;
-      o.truth_label = kernels::majority_tag(std::span(truth_counts_).subspan(k * TRUTH_BINS, TRUTH_BINS), o.count);
+      o.truth_label = kernels::majority_tag(
+          std::span(truth_counts_).subspan(k * TRUTH_BINS, TRUTH_BINS), o.count);
       for (std::uint32_t t = 0; t < s.truth_count && o.truth_label != 0; ++t) {
         if (s.truth[t].label == o.truth_label) o.truth_category = s.truth[t].category;
       }

@@ -17,7 +17,8 @@ const engine::PortSpec PORTS[] = {FRAME_IN, FRAME_OUT, {"objects", "objects", fa
 /// Copies the header and the first count entries (the rest of the 11 KB list is not read).
 void copy_list(const engine::ObjectListPayload& from, engine::ObjectListPayload& to) noexcept {
   std::memcpy(static_cast<void*>(&to), &from, offsetof(engine::ObjectListPayload, objects));
-  std::memcpy(static_cast<void*>(to.objects), from.objects, from.count * sizeof(engine::ObjectEntry));
+  std::memcpy(static_cast<void*>(to.objects), from.objects,
+              from.count * sizeof(engine::ObjectEntry));
 }
 
 class ObjectsOutput final : public engine::Node {
@@ -32,9 +33,12 @@ class ObjectsOutput final : public engine::Node {
     out.emit(0, in);
     if (in.skipped) return;
     auto block = pool_->acquire("objects_output", sizeof(engine::ObjectListPayload));
-    if (!block) return;  // every list still in flight downstream: this frame's is not sent on the port
-    auto* list = new (block->bytes().data()) engine::ObjectListPayload();  // header and count set below
-    fill_object_list(block_of(in, capacity_), in.frame_id, Clock::now().time_since_epoch().count(), *list);
+    if (!block)
+      return;  // every list still in flight downstream: this frame's is not sent on the port
+    auto* list =
+        new (block->bytes().data()) engine::ObjectListPayload();  // header and count set below
+    fill_object_list(block_of(in, capacity_), in.frame_id, Clock::now().time_since_epoch().count(),
+                     *list);
     if (hub_ != nullptr) hub_->publish(*list);
     engine::Message objects = in;
     objects.payload = std::move(*block);
@@ -74,9 +78,10 @@ void fill_object_list(const FrameBlock& block, std::uint64_t frame_id, std::int6
     std::copy(o.stats.bbox_min.begin(), o.stats.bbox_min.end(), e.bbox_min);
     std::copy(o.stats.bbox_max.begin(), o.stats.bbox_max.end(), e.bbox_max);
     e.point_count = o.count;
-    e.flags = (o.described ? engine::OBJECT_DESCRIBED : 0U) | (o.moving ? engine::OBJECT_MOVING : 0U) |
-              (o.key_view ? engine::OBJECT_KEY_VIEW : 0U) | (o.fragment ? engine::OBJECT_FRAGMENT : 0U) |
-              (o.taught ? engine::OBJECT_TAUGHT : 0U);
+    e.flags = (o.described ? engine::OBJECT_DESCRIBED : 0U) |
+              (o.moving ? engine::OBJECT_MOVING : 0U) |
+              (o.key_view ? engine::OBJECT_KEY_VIEW : 0U) |
+              (o.fragment ? engine::OBJECT_FRAGMENT : 0U) | (o.taught ? engine::OBJECT_TAUGHT : 0U);
   }
 }
 
@@ -121,20 +126,22 @@ void ObjectsHub::publish(const engine::ObjectListPayload& list) noexcept {
 }
 
 void add_objects_output_node(engine::NodeRegistry& registry, ObjectsHub* hub) {
-  registry.add("objects_output",
-               "results out: each frame's objects as one ObjectListPayload to in-process consumers and on port "
-               "'objects' (connect an ipc_publish of type objects for orthoflow/<graph>/objects)",
-               [hub](const engine::ParamMap& params, const engine::NodeContext& context) -> NodeResult {
-                 auto capacity = frame_capacity(context);
-                 if (!capacity) return err(capacity.error());
-                 if (auto ok = params.only({}); !ok) return err(ok.error());
-                 // Lists in flight downstream (an ipc_publish) at most: one per frame in flight, and spare.
-                 const memory_pool::PoolConfig config{sizeof(engine::ObjectListPayload), context.max_in_flight + 4,
-                                                      "objects_output"};
-                 auto pool = memory_pool::BlockPool::create_owned(config);
-                 if (!pool) return err(memory_pool::to_string(pool.error()));
-                 return std::unique_ptr<engine::Node>(new ObjectsOutput(*capacity, hub, std::move(*pool)));
-               });
+  registry.add(
+      "objects_output",
+      "results out: each frame's objects as one ObjectListPayload to in-process consumers and on "
+      "port "
+      "'objects' (connect an ipc_publish of type objects for orthoflow/<graph>/objects)",
+      [hub](const engine::ParamMap& params, const engine::NodeContext& context) -> NodeResult {
+        auto capacity = frame_capacity(context);
+        if (!capacity) return err(capacity.error());
+        if (auto ok = params.only({}); !ok) return err(ok.error());
+        // Lists in flight downstream (an ipc_publish) at most: one per frame in flight, and spare.
+        const memory_pool::PoolConfig config{sizeof(engine::ObjectListPayload),
+                                             context.max_in_flight + 4, "objects_output"};
+        auto pool = memory_pool::BlockPool::create_owned(config);
+        if (!pool) return err(memory_pool::to_string(pool.error()));
+        return std::unique_ptr<engine::Node>(new ObjectsOutput(*capacity, hub, std::move(*pool)));
+      });
 }
 
 }  // namespace orthoflow::graphs

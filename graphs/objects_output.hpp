@@ -1,11 +1,14 @@
 #pragma once
 /// @file
-/// @brief Results out. The `objects_output` kind (ordered, after recognise) turns every frame's objects
-/// into one engine::ObjectListPayload (track id, label or Unknown, score, object frame, boxes, point
-/// count, frame stamps and the frame's age at decision) and hands it
-///   - to in-process consumers: every ObjectsSubscription of the ObjectsHub the registry was made with;
-///   - on its `objects` port (type objects), whose messages an `ipc_publish` node sends to the iceoryx
-///     topic `orthoflow/<graph>/objects` (graphs/perception.yaml; `orthoflow run --publish-objects`).
+/// @brief Results out. The `objects_output` kind (ordered, after recognise) turns every frame's
+/// objects into one engine::ObjectListPayload (track id, label or Unknown, score, object frame,
+/// boxes, point count, frame stamps and the frame's age at decision) and hands it
+///   - to in-process consumers: every ObjectsSubscription of the ObjectsHub the registry was made
+///   with;
+///   - on its `objects` port (type objects), whose messages an `ipc_publish` node sends to the
+///   iceoryx
+///     topic `orthoflow/<graph>/objects` (graphs/perception.yaml; `orthoflow run
+///     --publish-objects`).
 /// Real time: publish() copies the used part of the list into each subscriber's ring (never waits:
 /// a full ring drops the newest list and counts it); nothing allocates after start-up.
 #include <atomic>
@@ -56,8 +59,8 @@ class ObjectsHub {
  private:
   friend class ObjectsSubscription;
   void unsubscribe(ObjectsSubscription* s) noexcept;
-  std::mutex subscribers_lock_;  // taken by publish() only with try_lock: a (un)subscribe in progress
-                                 // makes that frame's list skip the consumers, never wait
+  std::mutex subscribers_lock_;  // taken by publish() only with try_lock: a (un)subscribe in
+                                 // progress makes that frame's list skip the consumers, never wait
   std::vector<ObjectsSubscription*> subscribers_;
   std::atomic<std::uint64_t> published_{0}, skipped_{0};
 };

@@ -1,6 +1,7 @@
 // The `recognise` kind: asks the learner for every described object, smooths the answers per track,
 // keeps each track's key views (graphs/track_memory.hpp), applies the learning channel's commands
-// (graphs/learning_commands.hpp) and, with instructor: 1, the scripted instructor of the synthetic session.
+// (graphs/learning_commands.hpp) and, with instructor: 1, the scripted instructor of the synthetic
+// session.
 #include "graphs/recognise_node.hpp"
 
 #include <algorithm>
@@ -19,8 +20,10 @@ using engine::Message;
 
 const engine::PortSpec PORTS[] = {FRAME_IN, FRAME_OUT};
 constexpr std::size_t MAX_CATEGORIES = 32;  // categories the instructor keeps track of
-constexpr std::size_t MAX_COMMANDS_PER_FRAME = 64;  // commands applied per frame at most (the rest wait)
-constexpr std::array<std::uint32_t, 3> INSTRUCTOR_AGES{5, 15, 25};  // track ages (frames) it teaches at
+constexpr std::size_t MAX_COMMANDS_PER_FRAME =
+    64;  // commands applied per frame at most (the rest wait)
+constexpr std::array<std::uint32_t, 3> INSTRUCTOR_AGES{5, 15,
+                                                       25};  // track ages (frames) it teaches at
 
 struct RecogniseParams {
   std::uint32_t smoothing = 5;
@@ -36,7 +39,10 @@ struct InstructorEntry {
 class Recognise final : public engine::Node {
  public:
   Recognise(std::size_t capacity, const RecogniseParams& p, LearningService& service)
-      : capacity_(capacity), p_(p), service_(service), memories_(service.descriptor_length()),
+      : capacity_(capacity),
+        p_(p),
+        service_(service),
+        memories_(service.descriptor_length()),
         desk_(service, memories_) {}
   std::span<const engine::PortSpec> inputs() const noexcept override { return {PORTS, 1}; }
   std::span<const engine::PortSpec> outputs() const noexcept override { return {PORTS + 1, 1}; }
@@ -83,7 +89,9 @@ class Recognise final : public engine::Node {
     const FrameState& s = block.state();
     for (std::uint32_t k = 0; k < s.object_count; ++k) {
       const ObjectRecord& o = s.objects[k];
-      if (o.track_id == 0 || o.truth_category.empty() || !instructor_teaches(o.truth_category.view())) continue;
+      if (o.track_id == 0 || o.truth_category.empty() ||
+          !instructor_teaches(o.truth_category.view()))
+        continue;
       InstructorEntry* entry = nullptr;
       for (std::size_t c = 0; c < categories_used_ && entry == nullptr; ++c) {
         if (categories_[c].category.view() == o.truth_category.view()) entry = &categories_[c];
@@ -95,8 +103,10 @@ class Recognise final : public engine::Node {
       }
       if (entry == nullptr || entry->track_id != o.track_id) continue;
       const TrackMemory* t = memories_.find(o.track_id);
-      if (t != nullptr && std::find(INSTRUCTOR_AGES.begin(), INSTRUCTOR_AGES.end(), t->age) != INSTRUCTOR_AGES.end()) {
-        (void)desk_.teach_object(block, k, o.truth_category.view(), LearningAck{}, static_cast<std::int64_t>(frame));
+      if (t != nullptr && std::find(INSTRUCTOR_AGES.begin(), INSTRUCTOR_AGES.end(), t->age) !=
+                              INSTRUCTOR_AGES.end()) {
+        (void)desk_.teach_object(block, k, o.truth_category.view(), LearningAck{},
+                                 static_cast<std::int64_t>(frame));
       }
     }
   }
@@ -114,22 +124,24 @@ class Recognise final : public engine::Node {
 }  // namespace
 
 void add_recognise_node(engine::NodeRegistry& registry, LearningService& service) {
-  registry.add("recognise",
-               "asks the learner per object, smooths per track, keeps key views, applies the learning channel's "
-               "commands: smoothing (answers), instructor=0|1 (scripted teacher of the synthetic session)",
-               [&service](const engine::ParamMap& params, const engine::NodeContext& context) -> NodeResult {
-                 auto capacity = frame_capacity(context);
-                 if (!capacity) return err(capacity.error());
-                 if (auto ok = params.only({"smoothing", "instructor"}); !ok) return err(ok.error());
-                 RecogniseParams p;
-                 std::string e;
-                 std::int64_t instructor = 0;
-                 take(params.integer("smoothing", p.smoothing, 1, MAX_VOTES), p.smoothing, e);
-                 take(params.integer("instructor", 0, 0, 1), instructor, e);
-                 if (!e.empty()) return err(e);
-                 p.instructor = instructor == 1;
-                 return std::unique_ptr<engine::Node>(new Recognise(*capacity, p, service));
-               });
+  registry.add(
+      "recognise",
+      "asks the learner per object, smooths per track, keeps key views, applies the learning "
+      "channel's "
+      "commands: smoothing (answers), instructor=0|1 (scripted teacher of the synthetic session)",
+      [&service](const engine::ParamMap& params, const engine::NodeContext& context) -> NodeResult {
+        auto capacity = frame_capacity(context);
+        if (!capacity) return err(capacity.error());
+        if (auto ok = params.only({"smoothing", "instructor"}); !ok) return err(ok.error());
+        RecogniseParams p;
+        std::string e;
+        std::int64_t instructor = 0;
+        take(params.integer("smoothing", p.smoothing, 1, MAX_VOTES), p.smoothing, e);
+        take(params.integer("instructor", 0, 0, 1), instructor, e);
+        if (!e.empty()) return err(e);
+        p.instructor = instructor == 1;
+        return std::unique_ptr<engine::Node>(new Recognise(*capacity, p, service));
+      });
 }
 
 }  // namespace orthoflow::graphs

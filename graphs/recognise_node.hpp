@@ -1,12 +1,12 @@
 #pragma once
 /// @file
 /// @brief The `recognise` kind (stateful, ordered frames): asks the learner for every described
-/// object, smooths the answers over each track (majority of the last `smoothing` answers), keeps each
-/// track's key views, and applies the learning events: outside events from the LearningService queue
-/// (teach a track, or the object at a position) and, with `instructor: 1`, the scripted instructor of
-/// the synthetic session, which teaches the first instance of every category it knows the truth of
-/// (session_script.hpp says which) with 3 views, as the thesis's simulated teacher introduces a
-/// category (Algorithm 7.1).
+/// object, smooths the answers over each track (majority of the last `smoothing` answers), keeps
+/// each track's key views, and applies the learning events: outside events from the LearningService
+/// queue (teach a track, or the object at a position) and, with `instructor: 1`, the scripted
+/// instructor of the synthetic session, which teaches the first instance of every category it knows
+/// the truth of (session_script.hpp says which) with 3 views, as the thesis's simulated teacher
+/// introduces a category (Algorithm 7.1).
 #include "engine/registry.hpp"
 #include "graphs/learning_service.hpp"
 

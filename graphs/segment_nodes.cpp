@@ -1,6 +1,7 @@
 // The preprocess, table and objects kinds: scheduling around the stage objects of
-// kernels/tabletop_stages.hpp, the same ones kernels::SegmentationChain (and so `orthoflow segment`,
-// the benchmarks and the PCL agreement tests) runs. Each node runs one stage on the frame's block:
+// kernels/tabletop_stages.hpp, the same ones kernels::SegmentationChain (and so `orthoflow
+// segment`, the benchmarks and the PCL agreement tests) runs. Each node runs one stage on the
+// frame's block:
 //   preprocess: PlaneInputStage  -> the plane input in voxels() (dense sample, then the sparse one)
 //   table:      TableStage       -> plane and support polygon in the state and hull_u/hull_v
 //   objects:    objects_node.cpp (ObjectStage and the candidate constraints)
@@ -24,9 +25,12 @@ const engine::PortSpec FRAME_PORTS[] = {FRAME_IN, FRAME_OUT};
 /// Base of the frame-in, frame-out kinds: ports, capacity and the node's name for its errors.
 class FrameStage : public engine::Node {
  public:
-  FrameStage(std::size_t capacity, std::string name) : capacity_(capacity), name_(std::move(name)) {}
+  FrameStage(std::size_t capacity, std::string name)
+      : capacity_(capacity), name_(std::move(name)) {}
   std::span<const engine::PortSpec> inputs() const noexcept override { return {FRAME_PORTS, 1}; }
-  std::span<const engine::PortSpec> outputs() const noexcept override { return {FRAME_PORTS + 1, 1}; }
+  std::span<const engine::PortSpec> outputs() const noexcept override {
+    return {FRAME_PORTS + 1, 1};
+  }
   bool stateful() const noexcept override { return true; }
 
  protected:
@@ -48,7 +52,8 @@ class Preprocess final : public FrameStage {
     s.roi = params_.roi;
     auto frame = block.frame();
     if (!frame) {
-      s.error.set(FrameError::Code::INVALID_FRAME, name_, static_cast<std::uint8_t>(frame.error().code));
+      s.error.set(FrameError::Code::INVALID_FRAME, name_,
+                  static_cast<std::uint8_t>(frame.error().code));
       out.emit(0, in);
       return;
     }
@@ -118,7 +123,8 @@ kernels::PlaneInput plane_input(const FrameBlock& block) noexcept {
   const FrameState& s = block.state();
   const kernels::PointsSpan v = block.voxels();
   const auto part = [&](std::size_t offset, std::size_t n) {
-    return kernels::PointsView{v.x.subspan(offset, n), v.y.subspan(offset, n), v.z.subspan(offset, n)};
+    return kernels::PointsView{v.x.subspan(offset, n), v.y.subspan(offset, n),
+                               v.z.subspan(offset, n)};
   };
   return kernels::PlaneInput{part(0, s.voxels), part(s.voxels, s.sparse), s.kept};
 }
@@ -127,13 +133,18 @@ kernels::PlaneInput plane_input(const FrameBlock& block) noexcept {
 NodeResult make_objects_node(const ParamMap& params, const engine::NodeContext& context);
 
 void add_segment_nodes(engine::NodeRegistry& registry) {
-  registry.add("preprocess",
-               "plane input: drops NaN and out-of-ROI points, strided pixel sample (organized) or voxel grid: "
-               "roi_min_x..roi_max_z (m), leaf (m, 0 = off), organized_stride (pixels, 0 = voxel grid)",
-               make_preprocess);
-  registry.add("table", "RANSAC table plane + support polygon: tau (m), iterations, confidence, seed", make_table);
+  registry.add(
+      "preprocess",
+      "plane input: drops NaN and out-of-ROI points, strided pixel sample (organized) or voxel "
+      "grid: "
+      "roi_min_x..roi_max_z (m), leaf (m, 0 = off), organized_stride (pixels, 0 = voxel grid)",
+      make_preprocess);
+  registry.add("table",
+               "RANSAC table plane + support polygon: tau (m), iterations, confidence, seed",
+               make_table);
   registry.add("objects",
-               "prism + Euclidean clusters + footprint merge + C_size/C_edge: h_min, h_max, tolerance, min_points, "
+               "prism + Euclidean clusters + footprint merge + C_size/C_edge: h_min, h_max, "
+               "tolerance, min_points, "
                "max_points, pixel_radius, merge_overlap, min_size, max_size, edge_margin (m)",
                make_objects_node);
 }

@@ -1,10 +1,11 @@
 #pragma once
 /// @file
-/// @brief The three segmentation kinds of the tabletop graph (specs/PIPELINE.md sections 2-4), each one
-/// stage of kernels/tabletop_stages.hpp: `preprocess` (ROI + strided sample or voxel grid: the plane
-/// input), `table` (RANSAC plane + support polygon) and `objects` (prism + Euclidean clusters + footprint
-/// merge + candidate constraints C_size and C_edge + gather). Each is stateful (it owns its stage, sized
-/// once at start-up) and writes its results into the frame block; parameters: graphs/segment_params.hpp.
+/// @brief The three segmentation kinds of the tabletop graph (specs/PIPELINE.md sections 2-4), each
+/// one stage of kernels/tabletop_stages.hpp: `preprocess` (ROI + strided sample or voxel grid: the
+/// plane input), `table` (RANSAC plane + support polygon) and `objects` (prism + Euclidean clusters
+/// + footprint merge + candidate constraints C_size and C_edge + gather). Each is stateful (it owns
+/// its stage, sized once at start-up) and writes its results into the frame block; parameters:
+/// graphs/segment_params.hpp.
 #include "engine/registry.hpp"
 #include "graphs/frame_block.hpp"
 #include "kernels/tabletop_stages.hpp"

@@ -13,14 +13,16 @@ kernels::SegmentationParams TabletopSegmentation::defaults() noexcept {
   return p;
 }
 
-Result<void, std::string> parse_preprocess_params(const engine::ParamMap& params, kernels::SegmentationParams& p) {
-  if (auto ok = params.only({"roi_min_x", "roi_min_y", "roi_min_z", "roi_max_x", "roi_max_y", "roi_max_z", "leaf",
-                             "organized_stride"});
+Result<void, std::string> parse_preprocess_params(const engine::ParamMap& params,
+                                                  kernels::SegmentationParams& p) {
+  if (auto ok = params.only({"roi_min_x", "roi_min_y", "roi_min_z", "roi_max_x", "roi_max_y",
+                             "roi_max_z", "leaf", "organized_stride"});
       !ok) {
     return err(ok.error());
   }
   std::string e;
-  const char* keys[2][3] = {{"roi_min_x", "roi_min_y", "roi_min_z"}, {"roi_max_x", "roi_max_y", "roi_max_z"}};
+  const char* keys[2][3] = {{"roi_min_x", "roi_min_y", "roi_min_z"},
+                            {"roi_max_x", "roi_max_y", "roi_max_z"}};
   for (std::size_t axis = 0; axis < 3; ++axis) {
     take(params.number(keys[0][axis], p.roi.min[axis], -100.0, 100.0), p.roi.min[axis], e);
     take(params.number(keys[1][axis], p.roi.max[axis], -100.0, 100.0), p.roi.max[axis], e);
@@ -31,8 +33,10 @@ Result<void, std::string> parse_preprocess_params(const engine::ParamMap& params
   return {};
 }
 
-Result<void, std::string> parse_table_params(const engine::ParamMap& params, kernels::SegmentationParams& p) {
-  if (auto ok = params.only({"tau", "iterations", "confidence", "seed"}); !ok) return err(ok.error());
+Result<void, std::string> parse_table_params(const engine::ParamMap& params,
+                                             kernels::SegmentationParams& p) {
+  if (auto ok = params.only({"tau", "iterations", "confidence", "seed"}); !ok)
+    return err(ok.error());
   kernels::RansacParams& r = p.ransac;
   std::string e;
   take(params.number("tau", r.tau, 1e-4, 1.0), r.tau, e);
@@ -43,9 +47,11 @@ Result<void, std::string> parse_table_params(const engine::ParamMap& params, ker
   return {};
 }
 
-Result<void, std::string> parse_objects_params(const engine::ParamMap& params, TabletopSegmentation& out) {
-  if (auto ok = params.only({"h_min", "h_max", "tolerance", "min_points", "max_points", "pixel_radius", "min_size",
-                             "max_size", "edge_margin", "merge_overlap"});
+Result<void, std::string> parse_objects_params(const engine::ParamMap& params,
+                                               TabletopSegmentation& out) {
+  if (auto ok =
+          params.only({"h_min", "h_max", "tolerance", "min_points", "max_points", "pixel_radius",
+                       "min_size", "max_size", "edge_margin", "merge_overlap"});
       !ok) {
     return err(ok.error());
   }
@@ -64,7 +70,8 @@ Result<void, std::string> parse_objects_params(const engine::ParamMap& params, T
   take(params.number("edge_margin", c.edge_margin, -1.0, 1.0), c.edge_margin, e);
   if (!e.empty()) return err(e);
   if (p.h_min >= p.h_max) return err(std::string("objects: h_min must be below h_max"));
-  if (p.cluster.min_size > p.cluster.max_size) return err(std::string("objects: min_points must not exceed max_points"));
+  if (p.cluster.min_size > p.cluster.max_size)
+    return err(std::string("objects: min_points must not exceed max_points"));
   return {};
 }
 
@@ -72,9 +79,14 @@ Result<TabletopSegmentation, std::string> segmentation_of_graph(const engine::Gr
   TabletopSegmentation out;
   bool seen[3] = {false, false, false};
   for (const engine::NodeSpec& node : spec.nodes) {
-    const int kind = node.kind == "preprocess" ? 0 : node.kind == "table" ? 1 : node.kind == "objects" ? 2 : -1;
+    const int kind = node.kind == "preprocess" ? 0
+                     : node.kind == "table"    ? 1
+                     : node.kind == "objects"  ? 2
+                                               : -1;
     if (kind < 0) continue;
-    if (seen[kind]) return err("graph '" + spec.name + "': more than one " + node.kind + " node ('" + node.name + "')");
+    if (seen[kind])
+      return err("graph '" + spec.name + "': more than one " + node.kind + " node ('" + node.name +
+                 "')");
     seen[kind] = true;
     Result<void, std::string> ok = kind == 0   ? parse_preprocess_params(node.params, out.stages)
                                    : kind == 1 ? parse_table_params(node.params, out.stages)

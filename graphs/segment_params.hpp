@@ -5,14 +5,15 @@
 /// `orthoflow segment --graph FILE` mean the same segmentation (start-up only: these allocate).
 #include <string>
 
+#include "core/result.hpp"
 #include "engine/graph.hpp"
 #include "engine/params.hpp"
 #include "kernels/segmentation_chain.hpp"
-#include "core/result.hpp"
 
 namespace orthoflow::graphs {
 
-/// @brief The segmentation of the tabletop graph: the stage parameters and the candidate constraints.
+/// @brief The segmentation of the tabletop graph: the stage parameters and the candidate
+/// constraints.
 struct TabletopSegmentation {
   kernels::SegmentationParams stages = defaults();
   kernels::CandidateParams candidates{};
@@ -21,19 +22,21 @@ struct TabletopSegmentation {
   [[nodiscard]] static kernels::SegmentationParams defaults() noexcept;
 };
 
-/// @brief preprocess: roi_min_x..roi_max_z (m), leaf (m, 0 = off), organized_stride (0 = voxel grid).
+/// @brief preprocess: roi_min_x..roi_max_z (m), leaf (m, 0 = off), organized_stride (0 = voxel
+/// grid).
 [[nodiscard]] Result<void, std::string> parse_preprocess_params(const engine::ParamMap& params,
                                                                 kernels::SegmentationParams& out);
 /// @brief table: tau (m), iterations, confidence, seed.
 [[nodiscard]] Result<void, std::string> parse_table_params(const engine::ParamMap& params,
                                                            kernels::SegmentationParams& out);
-/// @brief objects: h_min, h_max, tolerance, min_points, max_points, pixel_radius, merge_overlap and the
-/// candidate constraints min_size, max_size, edge_margin.
+/// @brief objects: h_min, h_max, tolerance, min_points, max_points, pixel_radius, merge_overlap and
+/// the candidate constraints min_size, max_size, edge_margin.
 [[nodiscard]] Result<void, std::string> parse_objects_params(const engine::ParamMap& params,
                                                              TabletopSegmentation& out);
 
 /// @brief The segmentation a graph file runs: the parameters of its preprocess, table and objects
 /// nodes (each kind at most once; a kind that is absent keeps its defaults). Errors name the node.
-[[nodiscard]] Result<TabletopSegmentation, std::string> segmentation_of_graph(const engine::GraphSpec& spec);
+[[nodiscard]] Result<TabletopSegmentation, std::string> segmentation_of_graph(
+    const engine::GraphSpec& spec);
 
 }  // namespace orthoflow::graphs

@@ -15,7 +15,8 @@ constexpr std::size_t MAX_TAUGHT = 1024;
 const engine::PortSpec SINK_IN[] = {FRAME_IN};
 }  // namespace
 
-SessionLog::SessionLog(std::unique_ptr<LineWriter> json) : json_(std::move(json)), line_(LINE_BYTES) {
+SessionLog::SessionLog(std::unique_ptr<LineWriter> json)
+    : json_(std::move(json)), line_(LINE_BYTES) {
   summary_.taught.reserve(MAX_TAUGHT);
   taught_instances_.reserve(MAX_TAUGHT);
   snapshot_.hull_u.reserve(MAX_HULL);
@@ -27,7 +28,8 @@ SessionLog::SessionLog(std::unique_ptr<LineWriter> json) : json_(std::move(json)
 }
 
 bool SessionLog::was_taught(std::string_view category) const noexcept {
-  return std::find(summary_.taught.begin(), summary_.taught.end(), category) != summary_.taught.end();
+  return std::find(summary_.taught.begin(), summary_.taught.end(), category) !=
+         summary_.taught.end();
 }
 
 void SessionLog::score(const ObjectRecord& o) noexcept {
@@ -43,7 +45,8 @@ void SessionLog::score(const ObjectRecord& o) noexcept {
   const bool right = !o.unknown && o.label.view() == truth;
   summary_.after_teaching.right += right ? 1U : 0U;
   ++summary_.after_teaching.asked;
-  if (std::find(taught_instances_.begin(), taught_instances_.end(), o.truth_label) == taught_instances_.end()) {
+  if (std::find(taught_instances_.begin(), taught_instances_.end(), o.truth_label) ==
+      taught_instances_.end()) {
     summary_.new_instances.right += right ? 1U : 0U;
     ++summary_.new_instances.asked;
   }
@@ -66,7 +69,8 @@ void SessionLog::record(const FrameBlock& block, std::uint64_t frame_id) noexcep
     if (!o.taught) continue;
     ++summary_.teaches;
     // Bounded by the reserved capacity: past it, lessons are still counted but not listed.
-    if (!was_taught(o.taught_as.view()) && summary_.taught.size() < MAX_TAUGHT) summary_.taught.emplace_back(o.taught_as.view());
+    if (!was_taught(o.taught_as.view()) && summary_.taught.size() < MAX_TAUGHT)
+      summary_.taught.emplace_back(o.taught_as.view());
     if (taught_instances_.size() < MAX_TAUGHT) taught_instances_.push_back(o.truth_label);
   }
   if (json_) write_json(block, frame_id);
@@ -79,43 +83,49 @@ void SessionLog::write_json(const FrameBlock& block, std::uint64_t frame_id) noe
   const std::int64_t stamp = frame ? frame->header->sensor_stamp_ns : 0;
   char* out = line_.data();
   const std::size_t cap = line_.size();
-  std::size_t n = static_cast<std::size_t>(std::snprintf(out, cap, R"({"frame":%llu,"stamp_ns":%lld,"table":%s,"objects":[)",
-                                                         static_cast<unsigned long long>(frame_id),
-                                                         static_cast<long long>(stamp), s.table_found ? "true" : "false"));
+  std::size_t n = static_cast<std::size_t>(
+      std::snprintf(out, cap, R"({"frame":%llu,"stamp_ns":%lld,"table":%s,"objects":[)",
+                    static_cast<unsigned long long>(frame_id), static_cast<long long>(stamp),
+                    s.table_found ? "true" : "false"));
   for (std::uint32_t k = 0; k < s.object_count && n + 2048 < cap; ++k) {
     const ObjectRecord& o = s.objects[k];
-    // Labels are category names given by people: escape nothing but refuse quotes/backslashes in them.
+    // Labels are category names given by people: escape nothing but refuse quotes/backslashes in
+    // them.
     const std::string_view label = o.label.view();
     const bool plain = label.find_first_of("\"\\") == std::string_view::npos;
     char score[32] = "null";  // JSON has no NaN: nothing learned yet gives a NaN score
-    if (std::isfinite(o.score)) std::snprintf(score, sizeof score, "%.6g", static_cast<double>(o.score));
+    if (std::isfinite(o.score))
+      std::snprintf(score, sizeof score, "%.6g", static_cast<double>(o.score));
     n += static_cast<std::size_t>(std::snprintf(
         out + n, cap - n,
         R"(%s{"track":%u,"label":%s%.*s%s,"unknown":%s,"score":%s,"nearest":"%.*s","truth":"%.*s","points":%u,"centroid":[%.5f,%.5f,%.5f],"bbox":[%.5f,%.5f,%.5f],"frame":[)",
-        k == 0 ? "" : ",", o.track_id, o.unknown || !plain ? "null" : "\"", o.unknown || !plain ? 0 : static_cast<int>(label.size()),
-        label.data(), o.unknown || !plain ? "" : "\"", o.unknown ? "true" : "false", score,
+        k == 0 ? "" : ",", o.track_id, o.unknown || !plain ? "null" : "\"",
+        o.unknown || !plain ? 0 : static_cast<int>(label.size()), label.data(),
+        o.unknown || !plain ? "" : "\"", o.unknown ? "true" : "false", score,
         plain ? static_cast<int>(o.nearest.view().size()) : 0, o.nearest.view().data(),
         static_cast<int>(o.truth_category.view().size()), o.truth_category.view().data(), o.count,
         static_cast<double>(o.stats.centroid[0]), static_cast<double>(o.stats.centroid[1]),
-        static_cast<double>(o.stats.centroid[2]), static_cast<double>(o.bbox[0]), static_cast<double>(o.bbox[1]),
-        static_cast<double>(o.bbox[2])));
+        static_cast<double>(o.stats.centroid[2]), static_cast<double>(o.bbox[0]),
+        static_cast<double>(o.bbox[1]), static_cast<double>(o.bbox[2])));
     for (std::size_t i = 0; i < 16; ++i) {
-      n += static_cast<std::size_t>(std::snprintf(out + n, cap - n, "%s%.6g", i == 0 ? "" : ",", static_cast<double>(o.frame[i])));
+      n += static_cast<std::size_t>(std::snprintf(out + n, cap - n, "%s%.6g", i == 0 ? "" : ",",
+                                                  static_cast<double>(o.frame[i])));
     }
     n += static_cast<std::size_t>(std::snprintf(out + n, cap - n, "]}"));
   }
   n += static_cast<std::size_t>(std::snprintf(out + n, cap - n, "]"));
-  if (!s.error.empty() && n + 256 < cap) {  // the frame's first error: node, code and the stage's reason
+  if (!s.error.empty() &&
+      n + 256 < cap) {  // the frame's first error: node, code and the stage's reason
     const std::string_view stage = s.error.stage.view(), code = FrameError::name(s.error.code);
     const std::string_view reason = s.error.code == FrameError::Code::SEGMENTATION
                                         ? kernels::to_string(s.error.segmentation.code)
                                         : std::string_view{};
     const bool plain = stage.find_first_of("\"\\") == std::string_view::npos;
-    n += static_cast<std::size_t>(std::snprintf(out + n, cap - n, R"(,"error":"%.*s%s%.*s%s%.*s")",
-                                                plain ? static_cast<int>(stage.size()) : 0, stage.data(),
-                                                plain ? ": " : "", static_cast<int>(code.size()), code.data(),
-                                                reason.empty() ? "" : ": ", static_cast<int>(reason.size()),
-                                                reason.data()));
+    n += static_cast<std::size_t>(
+        std::snprintf(out + n, cap - n, R"(,"error":"%.*s%s%.*s%s%.*s")",
+                      plain ? static_cast<int>(stage.size()) : 0, stage.data(), plain ? ": " : "",
+                      static_cast<int>(code.size()), code.data(), reason.empty() ? "" : ": ",
+                      static_cast<int>(reason.size()), reason.data()));
   }
   n += static_cast<std::size_t>(std::snprintf(out + n, cap - n, "}"));
   json_->write({out, std::min(n, cap - 1)});
@@ -164,13 +174,14 @@ class SessionLogNode final : public engine::Node {
 }  // namespace
 
 void add_session_log_node(engine::NodeRegistry& registry, SessionLog& log) {
-  registry.add("session_log", "sink: summary, accuracy against ground truth, JSON lines, snapshot",
-               [&log](const engine::ParamMap& params, const engine::NodeContext& context) -> NodeResult {
-                 auto capacity = frame_capacity(context);
-                 if (!capacity) return err(capacity.error());
-                 if (auto ok = params.only({}); !ok) return err(ok.error());
-                 return std::unique_ptr<engine::Node>(new SessionLogNode(*capacity, log));
-               });
+  registry.add(
+      "session_log", "sink: summary, accuracy against ground truth, JSON lines, snapshot",
+      [&log](const engine::ParamMap& params, const engine::NodeContext& context) -> NodeResult {
+        auto capacity = frame_capacity(context);
+        if (!capacity) return err(capacity.error());
+        if (auto ok = params.only({}); !ok) return err(ok.error());
+        return std::unique_ptr<engine::Node>(new SessionLogNode(*capacity, log));
+      });
 }
 
 }  // namespace orthoflow::graphs

@@ -2,9 +2,10 @@
 /// @file
 /// @brief The `session_log` sink (stateful, ordered frames): counts what the graph did (the summary
 /// `orthoflow run` prints), scores the answers against the ground truth when the source knows it,
-/// writes one JSON line per frame through a LineWriter, and keeps the last frame with objects for the
-/// snapshot picture. Scoring: an object whose true category has been taught is right when labelled
-/// with it; an object whose category has not been taught yet is right when answered Unknown.
+/// writes one JSON line per frame through a LineWriter, and keeps the last frame with objects for
+/// the snapshot picture. Scoring: an object whose true category has been taught is right when
+/// labelled with it; an object whose category has not been taught yet is right when answered
+/// Unknown.
 #include <array>
 #include <cstdint>
 #include <memory>
@@ -20,7 +21,9 @@ namespace orthoflow::graphs {
 /// @brief Right / asked counter.
 struct Score {
   std::uint64_t right = 0, asked = 0;
-  [[nodiscard]] double rate() const noexcept { return asked == 0 ? 0.0 : static_cast<double>(right) / static_cast<double>(asked); }
+  [[nodiscard]] double rate() const noexcept {
+    return asked == 0 ? 0.0 : static_cast<double>(right) / static_cast<double>(asked);
+  }
 };
 
 /// @brief What a run did, for the summary.
@@ -28,9 +31,9 @@ struct SessionSummary {
   std::uint64_t frames = 0, frames_with_table = 0, frames_with_error = 0;
   std::uint64_t object_views = 0, key_views = 0, recognitions = 0, teaches = 0;
   std::uint32_t tracks_started = 0;
-  Score before_teaching;   ///< category not taught yet: Unknown is right
-  Score after_teaching;    ///< category taught: its label is right
-  Score new_instances;     ///< subset of after_teaching: instances that were never taught themselves
+  Score before_teaching;  ///< category not taught yet: Unknown is right
+  Score after_teaching;   ///< category taught: its label is right
+  Score new_instances;    ///< subset of after_teaching: instances that were never taught themselves
   std::vector<std::string> taught;  ///< labels taught, in teaching order
 };
 
@@ -39,8 +42,8 @@ struct SceneSnapshot {
   std::uint64_t frame_id = 0;
   bool valid = false;
   kernels::Plane plane{};
-  std::vector<double> hull_u, hull_v;       ///< table polygon
-  std::vector<float> x, y, z;               ///< object points (subsampled), sensor frame
+  std::vector<double> hull_u, hull_v;  ///< table polygon
+  std::vector<float> x, y, z;          ///< object points (subsampled), sensor frame
   std::vector<ObjectRecord> objects;
 };
 

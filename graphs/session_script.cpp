@@ -4,8 +4,8 @@ namespace orthoflow::graphs {
 
 namespace {
 
-simulation::ScriptedObject place(simulation::Category category, std::uint32_t instance, std::uint64_t seed, double x,
-                              double y, double yaw) {
+simulation::ScriptedObject place(simulation::Category category, std::uint32_t instance,
+                                 std::uint64_t seed, double x, double y, double yaw) {
   simulation::ScriptedObject o;
   o.start.model = simulation::make_object_model(category, instance, seed);
   o.start.table_x = x;

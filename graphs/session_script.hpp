@@ -1,9 +1,10 @@
 #pragma once
 /// @file
-/// @brief The embedded synthetic session `orthoflow run` plays by default: a scripted tabletop where
-/// objects of several categories appear, move and leave, and an instructor teaches the first instance
-/// of every category but one. It exercises tracking (a long-lived object and a sliding one), teaching
-/// (a taught category must be recognised on a new instance) and Unknown (the never-taught category).
+/// @brief The embedded synthetic session `orthoflow run` plays by default: a scripted tabletop
+/// where objects of several categories appear, move and leave, and an instructor teaches the first
+/// instance of every category but one. It exercises tracking (a long-lived object and a sliding
+/// one), teaching (a taught category must be recognised on a new instance) and Unknown (the
+/// never-taught category).
 #include <cstdint>
 #include <string_view>
 
@@ -19,9 +20,11 @@ inline constexpr std::uint64_t SESSION_FRAMES = 300;
 /// Phase 1 (first 40%): first instances of mug, bottle and bowl; the mug slides.
 /// Phase 2 (from 45%): second instances of mug and bottle and a plate (never taught) appear;
 /// the bowl stays for the whole session.
-[[nodiscard]] simulation::SequenceScript make_session_script(std::uint64_t frames, std::uint64_t seed);
+[[nodiscard]] simulation::SequenceScript make_session_script(std::uint64_t frames,
+                                                             std::uint64_t seed);
 
-/// @brief True if the scripted instructor teaches this category (all session categories but "plate").
+/// @brief True if the scripted instructor teaches this category (all session categories but
+/// "plate").
 [[nodiscard]] bool instructor_teaches(std::string_view category) noexcept;
 
 }  // namespace orthoflow::graphs

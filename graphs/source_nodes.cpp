@@ -6,10 +6,10 @@
 #include <new>
 #include <vector>
 
-#include "simulation/object_catalog.hpp"
 #include "formats/pcd_io.hpp"
 #include "graphs/node_support.hpp"
 #include "graphs/session_script.hpp"
+#include "simulation/object_catalog.hpp"
 
 namespace orthoflow::graphs {
 
@@ -49,7 +49,8 @@ class FrameSource : public engine::Node {
     const FrameBlock block = block_of(out, capacity_);
     new (&block.state()) FrameState{};  // value-initialised in place: no temporary on the stack
     if (cloud.size() > capacity_ || !engine::write_frame(block.raw(), cloud)) {
-      block.state().error.set(FrameError::Code::FRAME_TOO_LARGE, name_, 0, static_cast<double>(cloud.size()));
+      block.state().error.set(FrameError::Code::FRAME_TOO_LARGE, name_, 0,
+                              static_cast<double>(cloud.size()));
       return false;
     }
     return true;
@@ -61,8 +62,8 @@ class FrameSource : public engine::Node {
 
 class SyntheticSource final : public FrameSource {
  public:
-  SyntheticSource(std::size_t capacity, const engine::NodeContext& context, simulation::SequenceScript script,
-                  std::uint64_t seed)
+  SyntheticSource(std::size_t capacity, const engine::NodeContext& context,
+                  simulation::SequenceScript script, std::uint64_t seed)
       : FrameSource(capacity, context), sequence_(std::move(script), seed) {
     cloud_.reserve(640 * 480);
   }
@@ -88,8 +89,8 @@ class SyntheticSource final : public FrameSource {
 
 class PcdSource final : public FrameSource {
  public:
-  PcdSource(std::size_t capacity, const engine::NodeContext& context, std::vector<std::filesystem::path> files,
-            bool loop)
+  PcdSource(std::size_t capacity, const engine::NodeContext& context,
+            std::vector<std::filesystem::path> files, bool loop)
       : FrameSource(capacity, context), files_(std::move(files)), loop_(loop) {}
   engine::SourceStatus produce(Message& out) noexcept override {
     if (next_ == files_.size()) {
@@ -104,12 +105,14 @@ class PcdSource final : public FrameSource {
       (void)engine::write_frame(block.raw(), kernels::PointCloud{});
       new (&block.state()) FrameState{};
       FrameError& e = block.state().error;
-      e.set(FrameError::Code::FILE_UNREADABLE, name_, static_cast<std::uint8_t>(cloud.error().code));
+      e.set(FrameError::Code::FILE_UNREADABLE, name_,
+            static_cast<std::uint8_t>(cloud.error().code));
       e.detail.assign(cloud.error().message);
       return engine::SourceStatus::FRAME;
     }
     cloud->info.frame_id = index;
-    if (cloud->info.sensor_stamp_ns == 0) cloud->info.sensor_stamp_ns = static_cast<std::int64_t>(index) * 33'333'333;
+    if (cloud->info.sensor_stamp_ns == 0)
+      cloud->info.sensor_stamp_ns = static_cast<std::int64_t>(index) * 33'333'333;
     cloud->info.host_stamp_ns = Clock::now().time_since_epoch().count();
     emit_cloud(out, *cloud);
     return engine::SourceStatus::FRAME;
@@ -129,14 +132,18 @@ NodeResult make_synthetic(const ParamMap& params, const engine::NodeContext& con
   std::uint64_t seed = 7, frames = SESSION_FRAMES, objects = 0;
   std::string e;
   take(params.integer("seed", 7, 0, INT64_MAX), seed, e);
-  take(params.integer("frames", static_cast<std::int64_t>(SESSION_FRAMES), 1, 100'000'000), frames, e);
+  take(params.integer("frames", static_cast<std::int64_t>(SESSION_FRAMES), 1, 100'000'000), frames,
+       e);
   take(params.integer("objects", 0, 0, simulation::MAX_SCENE_OBJECTS), objects, e);
   if (!e.empty()) return err(e);
-  if (*capacity < 640 * 480) return err("synthetic_source: pool blocks hold " + std::to_string(*capacity) +
-                                        " points, a 640x480 frame needs 307200 (raise pool block_bytes)");
+  if (*capacity < 640 * 480)
+    return err("synthetic_source: pool blocks hold " + std::to_string(*capacity) +
+               " points, a 640x480 frame needs 307200 (raise pool block_bytes)");
   auto script = objects == 0 ? make_session_script(frames, seed)
-                             : simulation::make_sequence_script(static_cast<std::uint32_t>(objects), frames, seed);
-  return std::unique_ptr<engine::Node>(new SyntheticSource(*capacity, context, std::move(script), seed));
+                             : simulation::make_sequence_script(static_cast<std::uint32_t>(objects),
+                                                                frames, seed);
+  return std::unique_ptr<engine::Node>(
+      new SyntheticSource(*capacity, context, std::move(script), seed));
 }
 
 NodeResult make_pcd(const ParamMap& params, const engine::NodeContext& context) {
@@ -156,13 +163,15 @@ NodeResult make_pcd(const ParamMap& params, const engine::NodeContext& context) 
   if (ec) return err("pcd_source: cannot list '" + dir + "': " + ec.message());
   if (files.empty()) return err("pcd_source: no .pcd files in '" + dir + "'");
   std::sort(files.begin(), files.end());
-  return std::unique_ptr<engine::Node>(new PcdSource(*capacity, context, std::move(files), loop == 1));
+  return std::unique_ptr<engine::Node>(
+      new PcdSource(*capacity, context, std::move(files), loop == 1));
 }
 
 }  // namespace
 
 void add_source_nodes(engine::NodeRegistry& registry) {
-  registry.add("synthetic_source", "synthetic Kinect v1 frames: seed, frames, objects (0 = embedded session)",
+  registry.add("synthetic_source",
+               "synthetic Kinect v1 frames: seed, frames, objects (0 = embedded session)",
                make_synthetic);
   registry.add("pcd_source", "the .pcd files of a folder in name order: dir, loop=0|1", make_pcd);
 }

@@ -9,7 +9,8 @@
 
 namespace orthoflow::graphs {
 
-engine::NodeRegistry make_tabletop_registry(LearningService& learning, SessionLog& log, ObjectsHub* objects) {
+engine::NodeRegistry make_tabletop_registry(LearningService& learning, SessionLog& log,
+                                            ObjectsHub* objects) {
   engine::NodeRegistry registry;
   engine::add_generic_nodes(registry);
   engine::add_ipc_nodes(registry);  // ipc_subscribe / ipc_publish: graphs split across processes

@@ -2,9 +2,9 @@
 
 #include <vector>
 
+#include "graphs/descriptor_params.hpp"
 #include "graphs/node_support.hpp"
 #include "graphs/tracker.hpp"
-#include "graphs/descriptor_params.hpp"
 #include "kernels/descriptor_spec.hpp"
 
 namespace orthoflow::graphs {
@@ -23,7 +23,9 @@ class Track final : public engine::Node {
   Track(std::size_t capacity, const TrackerParams& params)
       : capacity_(capacity), tracker_(params), inputs_(MAX_OBJECTS), outputs_(MAX_OBJECTS) {}
   std::span<const engine::PortSpec> inputs() const noexcept override { return {TRACK_PORTS, 1}; }
-  std::span<const engine::PortSpec> outputs() const noexcept override { return {TRACK_PORTS + 1, 1}; }
+  std::span<const engine::PortSpec> outputs() const noexcept override {
+    return {TRACK_PORTS + 1, 1};
+  }
   bool stateful() const noexcept override { return true; }
 
   void process(const Message& in, Emitter& out) noexcept override {
@@ -45,7 +47,8 @@ class Track final : public engine::Node {
       o.key_view = outputs_[k].key_view;
       o.fragment = outputs_[k].fragment;
     }
-    // One message per object (one empty message when there is none, so the join still sees the frame).
+    // One message per object (one empty message when there is none, so the join still sees the
+    // frame).
     Message object = in;
     object.object_count = static_cast<std::uint32_t>(n);
     for (std::uint32_t k = 0; k < (n == 0 ? 1U : n); ++k) {
@@ -66,7 +69,9 @@ class Describe final : public engine::Node {
   Describe(std::size_t capacity, const kernels::DescriptorSpec& spec, std::size_t slots)
       : capacity_(capacity), describers_(slots * MAX_OBJECTS, kernels::Describer(spec)) {}
   std::span<const engine::PortSpec> inputs() const noexcept override { return {DESCRIBE_PORTS, 1}; }
-  std::span<const engine::PortSpec> outputs() const noexcept override { return {DESCRIBE_PORTS + 1, 1}; }
+  std::span<const engine::PortSpec> outputs() const noexcept override {
+    return {DESCRIBE_PORTS + 1, 1};
+  }
   bool stateful() const noexcept override { return false; }
 
   // Runs concurrently for different objects: each (slot, object) has its own describer and its own
@@ -76,7 +81,8 @@ class Describe final : public engine::Node {
       const FrameBlock block = block_of(in, capacity_);
       ObjectRecord& o = block.state().objects[in.object_index];
       kernels::Describer& describer = describers_[in.slot * MAX_OBJECTS + in.object_index];
-      auto described = describer.describe(block.object_view(in.object_index), block.descriptor(in.object_index));
+      auto described =
+          describer.describe(block.object_view(in.object_index), block.descriptor(in.object_index));
       o.described = described.has_value();
       if (described) {
         o.descriptor_length = static_cast<std::uint32_t>(described->length);
@@ -96,7 +102,9 @@ class Describe final : public engine::Node {
 NodeResult make_track(const ParamMap& params, const engine::NodeContext& context) {
   auto capacity = frame_capacity(context);
   if (!capacity) return err(capacity.error());
-  if (auto ok = params.only({"min_share", "box_margin", "lost_timeout_s", "moving_speed", "static_frames"}); !ok) {
+  if (auto ok = params.only(
+          {"min_share", "box_margin", "lost_timeout_s", "moving_speed", "static_frames"});
+      !ok) {
     return err(ok.error());
   }
   TrackerParams p;
@@ -122,10 +130,14 @@ NodeResult make_describe(const ParamMap& params, const engine::NodeContext& cont
 }  // namespace
 
 void add_track_describe_nodes(engine::NodeRegistry& registry) {
-  registry.add("track", "tracks objects by box overlap, splits the frame into objects: min_share, box_margin (m), "
-               "lost_timeout_s, moving_speed (m/s), static_frames", make_track);
+  registry.add(
+      "track",
+      "tracks objects by box overlap, splits the frame into objects: min_share, box_margin (m), "
+      "lost_timeout_s, moving_speed (m/s), static_frames",
+      make_track);
   registry.add("describe",
-               "per object, in parallel: descriptor and object frame: descriptor (good), bins, mode, threshold",
+               "per object, in parallel: descriptor and object frame: descriptor (good), bins, "
+               "mode, threshold",
                make_describe);
 }
 

@@ -16,7 +16,8 @@ struct CloudStats {
   std::array<float, 3> max{};
 };
 
-/// @brief Counts the points whose x, y and z are all finite and bounds them (NaN and +-Inf skipped).
+/// @brief Counts the points whose x, y and z are all finite and bounds them (NaN and +-Inf
+/// skipped).
 /// @pre x, y and z have equal lengths. @note Deterministic; the SIMD and scalar results are equal
 /// bit for bit (min/max and counting are exact operations).
 CloudStats cloud_stats(PointsView points) noexcept;

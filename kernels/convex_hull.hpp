@@ -25,16 +25,20 @@ PlaneBasis make_plane_basis(const Plane& plane) noexcept;
 
 /// @brief (u, v) coordinates of the points @p indices of @p points projected on the plane.
 /// @pre u.size() and v.size() >= indices.size(). @return indices.size().
-std::size_t project_to_plane(PointsView points, std::span<const std::uint32_t> indices, const PlaneBasis& basis,
-                             std::span<double> u, std::span<double> v) noexcept;
+std::size_t project_to_plane(PointsView points, std::span<const std::uint32_t> indices,
+                             const PlaneBasis& basis, std::span<double> u,
+                             std::span<double> v) noexcept;
 
-/// @brief Convex hull of the 2-D points (u[i], v[i]) by Andrew's monotone chain after an Akl-Toussaint
-/// octagon prefilter. Writes the hull vertex indices counter-clockwise, starting at the lowest (u, v),
-/// without repeated, duplicate or collinear vertices. 1 or 2 vertices for degenerate input.
-/// @pre u.size() == v.size() <= UINT32_MAX; scratch.size() >= u.size(); hull_out.size() >= u.size() + 1
-/// (the chain needs one slot more than it returns). NaN coordinates are skipped.
-/// @return the number of hull vertices. @note Allocation-free, deterministic (ties broken by index).
-std::size_t convex_hull_2d(std::span<const double> u, std::span<const double> v, std::span<std::uint32_t> scratch,
+/// @brief Convex hull of the 2-D points (u[i], v[i]) by Andrew's monotone chain after an
+/// Akl-Toussaint octagon prefilter. Writes the hull vertex indices counter-clockwise, starting at
+/// the lowest (u, v), without repeated, duplicate or collinear vertices. 1 or 2 vertices for
+/// degenerate input.
+/// @pre u.size() == v.size() <= UINT32_MAX; scratch.size() >= u.size(); hull_out.size() >= u.size()
+/// + 1 (the chain needs one slot more than it returns). NaN coordinates are skipped.
+/// @return the number of hull vertices. @note Allocation-free, deterministic (ties broken by
+/// index).
+std::size_t convex_hull_2d(std::span<const double> u, std::span<const double> v,
+                           std::span<std::uint32_t> scratch,
                            std::span<std::uint32_t> hull_out) noexcept;
 
 }  // namespace orthoflow::kernels

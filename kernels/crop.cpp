@@ -2,28 +2,32 @@
 
 #include <limits>
 
-#include "kernels/detail/crop_kernel.hpp"
 #include "core/assert.hpp"
+#include "kernels/detail/crop_kernel.hpp"
 
 namespace orthoflow::kernels {
 
-std::size_t crop_box_mask_scalar(PointsView in, const AxisBox& box, std::span<std::uint8_t> mask) noexcept {
+std::size_t crop_box_mask_scalar(PointsView in, const AxisBox& box,
+                                 std::span<std::uint8_t> mask) noexcept {
   OF_ASSERT(mask.size() >= in.size(), "crop_box_mask: mask shorter than the input");
   return detail::crop_box_range(in, box, mask.data(), 0, in.size());
 }
 
-std::size_t crop_box_mask(PointsView in, const AxisBox& box, std::span<std::uint8_t> mask) noexcept {
+std::size_t crop_box_mask(PointsView in, const AxisBox& box,
+                          std::span<std::uint8_t> mask) noexcept {
   OF_ASSERT(mask.size() >= in.size(), "crop_box_mask: mask shorter than the input");
   static auto dispatched = xsimd::dispatch<SimdArchs>(detail::CropBoxKernel{});
   return dispatched(in, box, mask);
 }
 
-std::size_t crop_oriented_mask_scalar(PointsView in, const OrientedBox& box, std::span<std::uint8_t> mask) noexcept {
+std::size_t crop_oriented_mask_scalar(PointsView in, const OrientedBox& box,
+                                      std::span<std::uint8_t> mask) noexcept {
   OF_ASSERT(mask.size() >= in.size(), "crop_oriented_mask: mask shorter than the input");
   return detail::crop_oriented_range(in, box, mask.data(), 0, in.size());
 }
 
-std::size_t crop_oriented_mask(PointsView in, const OrientedBox& box, std::span<std::uint8_t> mask) noexcept {
+std::size_t crop_oriented_mask(PointsView in, const OrientedBox& box,
+                               std::span<std::uint8_t> mask) noexcept {
   OF_ASSERT(mask.size() >= in.size(), "crop_oriented_mask: mask shorter than the input");
   static auto dispatched = xsimd::dispatch<SimdArchs>(detail::CropOrientedKernel{});
   return dispatched(in, box, mask);
@@ -45,7 +49,8 @@ std::size_t compact_masked(PointsView in, std::span<const std::uint8_t> mask, Po
   return w;
 }
 
-std::size_t mask_organized(PointsView in, std::span<const std::uint8_t> mask, PointsSpan out) noexcept {
+std::size_t mask_organized(PointsView in, std::span<const std::uint8_t> mask,
+                           PointsSpan out) noexcept {
   const float nan = std::numeric_limits<float>::quiet_NaN();
   std::size_t kept = 0;
   for (std::size_t i = 0; i < in.size(); ++i) {

@@ -1,7 +1,7 @@
 #include "kernels/depth_projection.hpp"
 
-#include "kernels/detail/depth_projection_kernel.hpp"
 #include "core/assert.hpp"
+#include "kernels/detail/depth_projection_kernel.hpp"
 
 namespace orthoflow::kernels {
 
@@ -13,10 +13,12 @@ void fill_disparity_table_reciprocal(std::span<float, DISPARITY_TABLE_SIZE> tabl
   }
 }
 
-std::size_t depth_to_points_scalar(std::span<const std::uint16_t> raw, std::uint32_t width, std::uint32_t height,
-                                   std::span<const float, DISPARITY_TABLE_SIZE> table_m, const DepthCamera& camera,
-                                   PointsSpan out) noexcept {
-  OF_ASSERT(raw.size() == std::size_t{width} * height && out.size() == raw.size(), "depth_to_points: size mismatch");
+std::size_t depth_to_points_scalar(std::span<const std::uint16_t> raw, std::uint32_t width,
+                                   std::uint32_t height,
+                                   std::span<const float, DISPARITY_TABLE_SIZE> table_m,
+                                   const DepthCamera& camera, PointsSpan out) noexcept {
+  OF_ASSERT(raw.size() == std::size_t{width} * height && out.size() == raw.size(),
+            "depth_to_points: size mismatch");
   const float inv_fy = 1.0F / camera.fy;
   std::size_t valid = 0;
   for (std::size_t v = 0; v < height; ++v) {
@@ -28,10 +30,12 @@ std::size_t depth_to_points_scalar(std::span<const std::uint16_t> raw, std::uint
   return valid;
 }
 
-std::size_t depth_to_points(std::span<const std::uint16_t> raw, std::uint32_t width, std::uint32_t height,
-                            std::span<const float, DISPARITY_TABLE_SIZE> table_m, const DepthCamera& camera,
-                            PointsSpan out) noexcept {
-  OF_ASSERT(raw.size() == std::size_t{width} * height && out.size() == raw.size(), "depth_to_points: size mismatch");
+std::size_t depth_to_points(std::span<const std::uint16_t> raw, std::uint32_t width,
+                            std::uint32_t height,
+                            std::span<const float, DISPARITY_TABLE_SIZE> table_m,
+                            const DepthCamera& camera, PointsSpan out) noexcept {
+  OF_ASSERT(raw.size() == std::size_t{width} * height && out.size() == raw.size(),
+            "depth_to_points: size mismatch");
   static auto dispatched = xsimd::dispatch<SimdArchs>(detail::DepthProjectionKernel{});
   return dispatched(raw, width, height, table_m, camera, out);
 }

@@ -7,7 +7,8 @@ namespace orthoflow::kernels {
 
 std::string_view to_string(DescriptorKind kind) noexcept {
   switch (kind) {
-    case DescriptorKind::GOOD: return "good";
+    case DescriptorKind::GOOD:
+      return "good";
   }
   return "unknown";
 }
@@ -28,7 +29,8 @@ Result<void, std::string> DescriptorSpec::validate() const {
     return err("descriptor " + describe() + ": bins must be 1.." + std::to_string(GOOD_MAX_BINS));
   }
   const float t = good.effective_threshold();
-  if (!std::isfinite(t) || t < 0.0F) return err("descriptor " + describe() + ": the threshold must be finite and >= 0");
+  if (!std::isfinite(t) || t < 0.0F)
+    return err("descriptor " + describe() + ": the threshold must be finite and >= 0");
   return {};
 }
 
@@ -36,7 +38,8 @@ std::string DescriptorSpec::describe() const {
   char threshold[32];
   std::snprintf(threshold, sizeof threshold, "%g", static_cast<double>(good.effective_threshold()));
   return std::string(to_string(kind)) + " bins=" + std::to_string(good.bins) +
-         " mode=" + (good.mode == GoodMode::INVARIANT ? "invariant" : "reference") + " threshold=" + threshold;
+         " mode=" + (good.mode == GoodMode::INVARIANT ? "invariant" : "reference") +
+         " threshold=" + threshold;
 }
 
 bool DescriptorSpec::operator==(const DescriptorSpec& other) const noexcept {
@@ -46,7 +49,8 @@ bool DescriptorSpec::operator==(const DescriptorSpec& other) const noexcept {
 
 Describer::Describer(const DescriptorSpec& spec) : spec_(spec), good_scratch_(spec.good.bins) {}
 
-Result<DescriptorInfo, GoodError> Describer::describe(PointsView points, std::span<float> out) noexcept {
+Result<DescriptorInfo, GoodError> Describer::describe(PointsView points,
+                                                      std::span<float> out) noexcept {
   auto good = compute_good(points, spec_.good, good_scratch_, out);
   if (!good) return err(good.error());
   return DescriptorInfo{good->length, good->frame, good->bbox, good->flags};

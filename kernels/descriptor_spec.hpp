@@ -1,10 +1,11 @@
 #pragma once
 /// @file
-/// @brief One descriptor specification: the representation's kind, its parameters and its length travel
-/// together as one value (STYLE rule 18). The describe node, the learners, the perceptual memory, the
-/// evaluation and the CLI ask the specification for the length instead of computing one of their own, and
-/// a store records the specification it was written with. GOOD is the one kind today; the local-feature
-/// representations (spin-image sets, bag of words, topic models) are added as kinds here.
+/// @brief One descriptor specification: the representation's kind, its parameters and its length
+/// travel together as one value (STYLE rule 18). The describe node, the learners, the perceptual
+/// memory, the evaluation and the CLI ask the specification for the length instead of computing one
+/// of their own, and a store records the specification it was written with. GOOD is the one kind
+/// today; the local-feature representations (spin-image sets, bag of words, topic models) are added
+/// as kinds here.
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -29,7 +30,8 @@ struct DescriptorSpec {
   GoodConfig good{};  ///< kind GOOD: bins, frame rule and sign threshold (thesis: 15 bins)
 
   /// @brief A GOOD specification.
-  [[nodiscard]] static DescriptorSpec make_good(std::size_t bins, GoodMode mode = GoodMode::INVARIANT) noexcept;
+  [[nodiscard]] static DescriptorSpec make_good(std::size_t bins,
+                                                GoodMode mode = GoodMode::INVARIANT) noexcept;
   /// @brief Values per descriptor (GOOD: 3 n^2).
   [[nodiscard]] std::size_t length() const noexcept;
   /// @brief Every value is a non-negative histogram share (what a naive Bayes learner needs).
@@ -38,7 +40,8 @@ struct DescriptorSpec {
   [[nodiscard]] Result<void, std::string> validate() const;
   /// @brief "good bins=15 mode=invariant threshold=0.015": what a mismatch error names.
   [[nodiscard]] std::string describe() const;
-  /// @brief Same kind and parameters (GOOD: the effective threshold, so unset equals the mode's default).
+  /// @brief Same kind and parameters (GOOD: the effective threshold, so unset equals the mode's
+  /// default).
   [[nodiscard]] bool operator==(const DescriptorSpec& other) const noexcept;
 };
 
@@ -57,9 +60,10 @@ class Describer {
   /// @pre spec.validate() succeeded.
   explicit Describer(const DescriptorSpec& spec);
   [[nodiscard]] const DescriptorSpec& spec() const noexcept { return spec_; }
-  /// @brief Writes the descriptor of @p points to the front of @p out. @pre out.size() >= spec().length().
-  /// Allocation-free. Deterministic (SIMD tolerance as compute_good()).
-  [[nodiscard]] Result<DescriptorInfo, GoodError> describe(PointsView points, std::span<float> out) noexcept;
+  /// @brief Writes the descriptor of @p points to the front of @p out. @pre out.size() >=
+  /// spec().length(). Allocation-free. Deterministic (SIMD tolerance as compute_good()).
+  [[nodiscard]] Result<DescriptorInfo, GoodError> describe(PointsView points,
+                                                           std::span<float> out) noexcept;
 
  private:
   DescriptorSpec spec_;

@@ -2,15 +2,17 @@
 
 #include <cmath>
 
-#include "kernels/detail/distance_kernel.hpp"
 #include "core/assert.hpp"
+#include "kernels/detail/distance_kernel.hpp"
 
 namespace orthoflow::kernels {
 
 namespace {
 
-void check_shapes(std::span<const float> query, const DescriptorMatrixView& s, std::size_t out_size) noexcept {
-  OF_ENFORCE(query.size() == s.dims, "distances: query length differs from the stored descriptors' dims");
+void check_shapes(std::span<const float> query, const DescriptorMatrixView& s,
+                  std::size_t out_size) noexcept {
+  OF_ENFORCE(query.size() == s.dims,
+             "distances: query length differs from the stored descriptors' dims");
   OF_ENFORCE(s.stride >= s.count, "distances: stored.stride is smaller than stored.count");
   OF_ENFORCE(s.count == 0 || s.dims == 0 || s.data.size() >= (s.dims - 1) * s.stride + s.count,
              "distances: stored.data is shorter than (dims - 1) * stride + count");
@@ -27,7 +29,8 @@ bool before(float da, std::size_t ia, float db, std::size_t ib) noexcept {
 }
 
 // Bounded insertion into the sorted out[0..filled): O(count) when k is small, as in recognition.
-std::size_t select_k(std::span<const float> dist, std::size_t count, std::span<Neighbor> out) noexcept {
+std::size_t select_k(std::span<const float> dist, std::size_t count,
+                     std::span<Neighbor> out) noexcept {
   const std::size_t k = out.size();
   std::size_t filled = 0;
   for (std::size_t j = 0; j < count && k > 0; ++j) {
@@ -46,18 +49,24 @@ std::size_t select_k(std::span<const float> dist, std::size_t count, std::span<N
 
 const char* to_string(Metric metric) noexcept {
   switch (metric) {
-    case Metric::L1: return "l1";
-    case Metric::L2: return "l2";
-    case Metric::L2_SQUARED: return "l2_squared";
-    case Metric::CHI_SQUARED: return "chi_squared";
-    case Metric::SYMMETRIC_KL: return "symmetric_kl";
-    case Metric::JENSEN_SHANNON: return "jensen_shannon";
+    case Metric::L1:
+      return "l1";
+    case Metric::L2:
+      return "l2";
+    case Metric::L2_SQUARED:
+      return "l2_squared";
+    case Metric::CHI_SQUARED:
+      return "chi_squared";
+    case Metric::SYMMETRIC_KL:
+      return "symmetric_kl";
+    case Metric::JENSEN_SHANNON:
+      return "jensen_shannon";
   }
   return "unknown";
 }
 
-std::size_t distances_scalar(std::span<const float> query, DescriptorMatrixView stored, Metric metric,
-                             std::span<float> out) noexcept {
+std::size_t distances_scalar(std::span<const float> query, DescriptorMatrixView stored,
+                             Metric metric, std::span<float> out) noexcept {
   check_shapes(query, stored, out.size());
   detail::distance_columns_scalar(query, stored, metric, 0, stored.count, out);
   return stored.count;
@@ -77,8 +86,9 @@ std::size_t nearest_k(std::span<const float> query, DescriptorMatrixView stored,
   return select_k(scratch, n, out);
 }
 
-std::size_t nearest_k_scalar(std::span<const float> query, DescriptorMatrixView stored, Metric metric,
-                             std::span<float> scratch, std::span<Neighbor> out) noexcept {
+std::size_t nearest_k_scalar(std::span<const float> query, DescriptorMatrixView stored,
+                             Metric metric, std::span<float> scratch,
+                             std::span<Neighbor> out) noexcept {
   const std::size_t n = distances_scalar(query, stored, metric, scratch);
   return select_k(scratch, n, out);
 }

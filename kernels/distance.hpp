@@ -1,13 +1,15 @@
 #pragma once
 /// @file
-/// @brief Distances between one query descriptor and N stored descriptors, and the k nearest of them.
-/// Stored descriptors form a structure-of-arrays matrix: value d of descriptor j is data[d * stride + j],
-/// so one SIMD register holds dimension d of several descriptors and a query is compared with many at once.
-/// Metrics for histograms (non-negative values, e.g. GOOD blocks):
+/// @brief Distances between one query descriptor and N stored descriptors, and the k nearest of
+/// them. Stored descriptors form a structure-of-arrays matrix: value d of descriptor j is data[d *
+/// stride + j], so one SIMD register holds dimension d of several descriptors and a query is
+/// compared with many at once. Metrics for histograms (non-negative values, e.g. GOOD blocks):
 /// - L1 = sum |a - b|;  L2_SQUARED = sum (a - b)^2;  L2 = sqrt(L2_SQUARED)
 /// - CHI_SQUARED = sum (a - b)^2 / (a + b), terms with a + b == 0 count 0 (no factor 1/2)
-/// - SYMMETRIC_KL = KL(a||b) + KL(b||a) = sum (a - b) (ln(a + e) - ln(b + e)), e = DISTANCE_KL_EPSILON
-/// - JENSEN_SHANNON = 1/2 sum [a ln(2a / (a + b)) + b ln(2b / (a + b))], 0 ln 0 = 0 (nats, in [0, ln 2] per
+/// - SYMMETRIC_KL = KL(a||b) + KL(b||a) = sum (a - b) (ln(a + e) - ln(b + e)), e =
+/// DISTANCE_KL_EPSILON
+/// - JENSEN_SHANNON = 1/2 sum [a ln(2a / (a + b)) + b ln(2b / (a + b))], 0 ln 0 = 0 (nats, in [0,
+/// ln 2] per
 ///   unit-sum histogram pair)
 #include <cstddef>
 #include <cstdint>
@@ -28,7 +30,8 @@ struct DescriptorMatrixView {
   std::span<const float> data;  ///< data[d * stride + j] = value d of descriptor j
   std::size_t dims = 0;
   std::size_t count = 0;
-  std::size_t stride = 0;  ///< >= count; lets a store keep spare columns for descriptors still to come
+  std::size_t stride =
+      0;  ///< >= count; lets a store keep spare columns for descriptors still to come
 };
 
 /// @brief One neighbour: the stored descriptor's column and its distance to the query.
@@ -47,8 +50,8 @@ struct Neighbor {
 std::size_t distances(std::span<const float> query, DescriptorMatrixView stored, Metric metric,
                       std::span<float> out) noexcept;
 /// @brief Scalar reference twin of distances().
-std::size_t distances_scalar(std::span<const float> query, DescriptorMatrixView stored, Metric metric,
-                             std::span<float> out) noexcept;
+std::size_t distances_scalar(std::span<const float> query, DescriptorMatrixView stored,
+                             Metric metric, std::span<float> out) noexcept;
 
 /// @brief The min(k, count) stored descriptors nearest to @p query, nearest first, k = out.size();
 /// equal distances keep the lower index first; NaN distances rank last.
@@ -57,7 +60,8 @@ std::size_t distances_scalar(std::span<const float> query, DescriptorMatrixView 
 std::size_t nearest_k(std::span<const float> query, DescriptorMatrixView stored, Metric metric,
                       std::span<float> scratch, std::span<Neighbor> out) noexcept;
 /// @brief nearest_k() computed with distances_scalar().
-std::size_t nearest_k_scalar(std::span<const float> query, DescriptorMatrixView stored, Metric metric,
-                             std::span<float> scratch, std::span<Neighbor> out) noexcept;
+std::size_t nearest_k_scalar(std::span<const float> query, DescriptorMatrixView stored,
+                             Metric metric, std::span<float> scratch,
+                             std::span<Neighbor> out) noexcept;
 
 }  // namespace orthoflow::kernels

@@ -1,6 +1,6 @@
-// ObjectStage's footprint merge (kernels/tabletop_stages.hpp): clusters whose footprints on the table
-// overlap are one object seen in pieces (a bowl's near and far walls, a mug's rim and body when a depth
-// edge cuts them apart): objects on a table do not overlap from above.
+// ObjectStage's footprint merge (kernels/tabletop_stages.hpp): clusters whose footprints on the
+// table overlap are one object seen in pieces (a bowl's near and far walls, a mug's rim and body
+// when a depth edge cuts them apart): objects on a table do not overlap from above.
 #include <algorithm>
 
 #include "kernels/tabletop_stages.hpp"
@@ -31,13 +31,15 @@ std::int32_t find_root(std::span<std::int32_t> root, std::size_t c) noexcept {
 
 // Union-find over the overlapping pairs; merged ids renumbered by lowest member (deterministic).
 std::size_t ObjectStage::merge_footprints(PointsView target, std::span<const std::uint32_t> members,
-                                          const PlaneBasis& b, std::size_t clusters, float overlap) noexcept {
+                                          const PlaneBasis& b, std::size_t clusters,
+                                          float overlap) noexcept {
   if (clusters < 2 || clusters > footprints_.size()) return clusters;
   const auto labels = std::span(labels_).first(target.size());
   for (std::size_t c = 0; c < clusters; ++c) footprints_[c] = {1e30, -1e30, 1e30, -1e30};
   for_each_member(members, target.size(), [&](std::size_t i) {
     if (labels[i] < 0) return;
-    const double x = target.x[i] - b.origin[0], y = target.y[i] - b.origin[1], z = target.z[i] - b.origin[2];
+    const double x = target.x[i] - b.origin[0], y = target.y[i] - b.origin[1],
+                 z = target.z[i] - b.origin[2];
     const double u = x * b.u[0] + y * b.u[1] + z * b.u[2], v = x * b.v[0] + y * b.v[1] + z * b.v[2];
     auto& f = footprints_[static_cast<std::size_t>(labels[i])];
     f = {std::min(f[0], u), std::max(f[1], u), std::min(f[2], v), std::max(f[3], v)};
@@ -47,18 +49,21 @@ std::size_t ObjectStage::merge_footprints(PointsView target, std::span<const std
   for (std::size_t i = 0; i < clusters; ++i) {
     for (std::size_t j = i + 1; j < clusters; ++j) {
       const auto &a = footprints_[i], &c = footprints_[j];
-      const double w = std::min(a[1], c[1]) - std::max(a[0], c[0]), h = std::min(a[3], c[3]) - std::max(a[2], c[2]);
+      const double w = std::min(a[1], c[1]) - std::max(a[0], c[0]),
+                   h = std::min(a[3], c[3]) - std::max(a[2], c[2]);
       const double smaller = std::min((a[1] - a[0]) * (a[3] - a[2]), (c[1] - c[0]) * (c[3] - c[2]));
       if (w > 0.0 && h > 0.0 && w * h >= overlap * smaller) {
         const std::int32_t ra = find_root(root, i), rb = find_root(root, j);
-        root[static_cast<std::size_t>(std::max(ra, rb))] = std::min(ra, rb);  // the lowest id stays the root
+        root[static_cast<std::size_t>(std::max(ra, rb))] =
+            std::min(ra, rb);  // the lowest id stays the root
       }
     }
   }
   std::size_t merged = 0;
   for (std::size_t c = 0; c < clusters; ++c) {
     const auto r = static_cast<std::size_t>(find_root(root, c));
-    new_id_[c] = r == c ? static_cast<std::int32_t>(merged++) : new_id_[r];  // a root is its lowest member
+    new_id_[c] =
+        r == c ? static_cast<std::int32_t>(merged++) : new_id_[r];  // a root is its lowest member
   }
   if (merged == clusters) return clusters;
   for_each_member(members, target.size(), [&](std::size_t i) {

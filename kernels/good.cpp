@@ -24,10 +24,12 @@ GoodTransform make_transform(const PcaFrame& f, const std::array<int, 3>& signs)
 }
 
 // Third central moment sum q^3 and second sum q^2 along one provisional axis, in double.
-std::array<double, 2> moments_along(PointsView points, const PcaFrame& f, std::size_t axis) noexcept {
+std::array<double, 2> moments_along(PointsView points, const PcaFrame& f,
+                                    std::size_t axis) noexcept {
   std::array<double, 2> m{0.0, 0.0};
   for (std::size_t i = 0; i < points.size(); ++i) {
-    const double d[3] = {points.x[i] - f.centroid[0], points.y[i] - f.centroid[1], points.z[i] - f.centroid[2]};
+    const double d[3] = {points.x[i] - f.centroid[0], points.y[i] - f.centroid[1],
+                         points.z[i] - f.centroid[2]};
     const double q = f.axes[axis][0] * d[0] + f.axes[axis][1] * d[1] + f.axes[axis][2] * d[2];
     if (!std::isfinite(q)) { continue; }
     m[0] += q * q;
@@ -36,11 +38,13 @@ std::array<double, 2> moments_along(PointsView points, const PcaFrame& f, std::s
   return m;
 }
 
-// Invariant sign of a provisional axis (docs/GOOD.md, "tie rule"). Every rule reads only the shape in
-// the provisional frame, and flipping the axis flips each statistic, so the chosen direction is pose-free:
+// Invariant sign of a provisional axis (docs/GOOD.md, "tie rule"). Every rule reads only the shape
+// in the provisional frame, and flipping the axis flips each statistic, so the chosen direction is
+// pose-free:
 // 1. counts beyond +-t: the side with more points wins if it leads by more than 1 % of the points;
 // 2. else the sign of the third moment (skewness), if |skew| > 1e-3;
-// 3. else the side that reaches farther from the centroid, if it is farther by > 1e-4 of the extent;
+// 3. else the side that reaches farther from the centroid, if it is farther by > 1e-4 of the
+// extent;
 // 4. else +1 and SIGN_AMBIGUOUS (the shape is symmetric along the axis: both signs look alike).
 int invariant_sign(PointsView points, const PcaFrame& f, const GoodStats& s, std::size_t axis,
                    std::uint32_t& flags) noexcept {
@@ -58,8 +62,8 @@ int invariant_sign(PointsView points, const PcaFrame& f, const GoodStats& s, std
   return 1;
 }
 
-// Reference rule (GOOD_REFERENCE.md section 4): flip only if neg > pos and neg - pos >= floor(m/10),
-// m counting every input point, NaN included.
+// Reference rule (GOOD_REFERENCE.md section 4): flip only if neg > pos and neg - pos >=
+// floor(m/10), m counting every input point, NaN included.
 int reference_sign(const GoodStats& s, std::size_t axis, std::size_t all_points) noexcept {
   const std::size_t margin = all_points / 10;
   return (s.neg[axis] > s.pos[axis] && s.neg[axis] - s.pos[axis] >= margin) ? -1 : 1;
@@ -79,8 +83,8 @@ std::array<float, 16> frame_matrix(const GoodTransform& t) noexcept {
   return m;
 }
 
-std::optional<GoodError> validate(PointsView points, const GoodConfig& cfg, const GoodScratch& scratch,
-                                  std::span<float> out) noexcept {
+std::optional<GoodError> validate(PointsView points, const GoodConfig& cfg,
+                                  const GoodScratch& scratch, std::span<float> out) noexcept {
   const float t = cfg.effective_threshold();
   if (cfg.bins == 0 || cfg.bins > GOOD_MAX_BINS) { return GoodError::BAD_BINS; }
   if (!std::isfinite(t) || t < 0.0F) { return GoodError::BAD_THRESHOLD; }
@@ -90,8 +94,8 @@ std::optional<GoodError> validate(PointsView points, const GoodConfig& cfg, cons
   return std::nullopt;
 }
 
-std::array<int, 3> choose_signs(PointsView points, const GoodConfig& cfg, const PcaFrame& f, const GoodStats& s,
-                                std::uint32_t& flags) noexcept {
+std::array<int, 3> choose_signs(PointsView points, const GoodConfig& cfg, const PcaFrame& f,
+                                const GoodStats& s, std::uint32_t& flags) noexcept {
   if (cfg.mode == GoodMode::INVARIANT) {
     const int sx = invariant_sign(points, f, s, 0, flags);
     const int sy = invariant_sign(points, f, s, 1, flags);
@@ -102,8 +106,9 @@ std::array<int, 3> choose_signs(PointsView points, const GoodConfig& cfg, const 
 }
 
 template <class FrameFn, class StatsFn, class BinFn>
-Result<GoodResult, GoodError> run_good(PointsView points, const GoodConfig& cfg, GoodScratch& scratch,
-                                       std::span<float> out, FrameFn&& frame_fn, StatsFn&& stats_fn,
+Result<GoodResult, GoodError> run_good(PointsView points, const GoodConfig& cfg,
+                                       GoodScratch& scratch, std::span<float> out,
+                                       FrameFn&& frame_fn, StatsFn&& stats_fn,
                                        BinFn&& bin_fn) noexcept {
   if (const auto bad = validate(points, cfg, scratch, out)) { return err(*bad); }
   const auto frame_result = frame_fn(points);
@@ -118,7 +123,8 @@ Result<GoodResult, GoodError> run_good(PointsView points, const GoodConfig& cfg,
   p.bins = cfg.bins;
   for (std::size_t a = 0; a < 3; ++a) { r.bbox[a] = s.max[a] - s.min[a]; }
   // L = largest edge + 0.02 m in double, square centred on the centroid (section 5).
-  const double side = static_cast<double>(std::max({r.bbox[0], r.bbox[1], r.bbox[2]})) + GOOD_SQUARE_MARGIN;
+  const double side =
+      static_cast<double>(std::max({r.bbox[0], r.bbox[1], r.bbox[2]})) + GOOD_SQUARE_MARGIN;
   p.half = static_cast<float>(side / 2.0);
   p.width = static_cast<float>(side / static_cast<double>(cfg.bins));
   const std::size_t len = 3 * cfg.bins * cfg.bins;
@@ -126,7 +132,8 @@ Result<GoodResult, GoodError> run_good(PointsView points, const GoodConfig& cfg,
   std::fill(counts.begin(), counts.end(), 0U);
   bin_fn(points, p, counts);
   for (std::size_t v = 0; v < 3; ++v) { r.kept[v] = points.size() - counts[len + v]; }
-  const detail::GoodOrderOut o = detail::good_normalise_and_order(counts, r.kept, cfg.bins, out.subspan(0, len));
+  const detail::GoodOrderOut o =
+      detail::good_normalise_and_order(counts, r.kept, cfg.bins, out.subspan(0, len));
   r.length = len;
   r.frame = frame_matrix(p.t);
   r.order = o.order;
@@ -143,26 +150,36 @@ Result<GoodResult, GoodError> run_good(PointsView points, const GoodConfig& cfg,
 
 const char* to_string(GoodView view) noexcept {
   switch (view) {
-    case GoodView::YOZ: return "YoZ";
-    case GoodView::XOZ: return "XoZ";
-    case GoodView::XOY: return "XoY";
+    case GoodView::YOZ:
+      return "YoZ";
+    case GoodView::XOZ:
+      return "XoZ";
+    case GoodView::XOY:
+      return "XoY";
   }
   return "?";
 }
 
 const char* to_string(GoodError error) noexcept {
   switch (error) {
-    case GoodError::EMPTY_CLOUD: return "compute_good: the cloud has no points";
-    case GoodError::NO_FINITE_POINTS: return "compute_good: every point has a NaN or infinite coordinate";
-    case GoodError::BAD_BINS: return "compute_good: config.bins must be between 1 and 256";
-    case GoodError::BAD_THRESHOLD: return "compute_good: config.threshold must be finite and >= 0";
-    case GoodError::OUTPUT_TOO_SMALL: return "compute_good: descriptor_out holds fewer than 3*bins*bins values";
-    case GoodError::SCRATCH_TOO_SMALL: return "compute_good: the GoodScratch was made for fewer bins than requested";
+    case GoodError::EMPTY_CLOUD:
+      return "compute_good: the cloud has no points";
+    case GoodError::NO_FINITE_POINTS:
+      return "compute_good: every point has a NaN or infinite coordinate";
+    case GoodError::BAD_BINS:
+      return "compute_good: config.bins must be between 1 and 256";
+    case GoodError::BAD_THRESHOLD:
+      return "compute_good: config.threshold must be finite and >= 0";
+    case GoodError::OUTPUT_TOO_SMALL:
+      return "compute_good: descriptor_out holds fewer than 3*bins*bins values";
+    case GoodError::SCRATCH_TOO_SMALL:
+      return "compute_good: the GoodScratch was made for fewer bins than requested";
   }
   return "compute_good: unknown error";
 }
 
-Result<GoodResult, GoodError> compute_good_scalar(PointsView points, const GoodConfig& cfg, GoodScratch& scratch,
+Result<GoodResult, GoodError> compute_good_scalar(PointsView points, const GoodConfig& cfg,
+                                                  GoodScratch& scratch,
                                                   std::span<float> descriptor_out) noexcept {
   const auto stats = [](PointsView pts, const GoodTransform& t, float thr) {
     const float inf = std::numeric_limits<float>::infinity();
@@ -176,7 +193,8 @@ Result<GoodResult, GoodError> compute_good_scalar(PointsView points, const GoodC
   return run_good(points, cfg, scratch, descriptor_out, compute_pca_frame_scalar, stats, bins);
 }
 
-Result<GoodResult, GoodError> compute_good(PointsView points, const GoodConfig& cfg, GoodScratch& scratch,
+Result<GoodResult, GoodError> compute_good(PointsView points, const GoodConfig& cfg,
+                                           GoodScratch& scratch,
                                            std::span<float> descriptor_out) noexcept {
   static auto stats = xsimd::dispatch<SimdArchs>(detail::GoodStatsKernel{});
   static auto bins = xsimd::dispatch<SimdArchs>(detail::GoodBinKernel{});

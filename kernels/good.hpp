@@ -1,15 +1,18 @@
 #pragma once
 /// @file
-/// @brief GOOD, the Global Orthographic Object Descriptor (PIPELINE.md section 6, GOOD_REFERENCE.md):
-/// the object frame, three orthographic n x n projections, per-projection normalisation, entropy and
-/// variance ordering. Two modes, one code path (docs/GOOD.md):
-/// - INVARIANT (default): X = Sx v1, Y = Sy v2, Z = X x Y, each sign chosen on its own by the rule in
-///   docs/GOOD.md, so every rigid pose of one object gives the same descriptor. Default threshold 0.015 m
-///   (the thesis value).
-/// - REFERENCE: the public reference implementation's frame rule: s = Sx * Sy with the floor(m/10) count
+/// @brief GOOD, the Global Orthographic Object Descriptor (PIPELINE.md section 6,
+/// GOOD_REFERENCE.md): the object frame, three orthographic n x n projections, per-projection
+/// normalisation, entropy and variance ordering. Two modes, one code path (docs/GOOD.md):
+/// - INVARIANT (default): X = Sx v1, Y = Sy v2, Z = X x Y, each sign chosen on its own by the rule
+/// in
+///   docs/GOOD.md, so every rigid pose of one object gives the same descriptor. Default threshold
+///   0.015 m (the thesis value).
+/// - REFERENCE: the public reference implementation's frame rule: s = Sx * Sy with the floor(m/10)
+/// count
 ///   margin, applied to x and y only. Default threshold 0.0015 m (the reference code's default).
-/// Both modes keep the reference's binning: side L = largest AABB edge + 0.02 m, square centred on the
-/// centroid, truncating bin index, points outside the square dropped, one view normalised by its kept count.
+/// Both modes keep the reference's binning: side L = largest AABB edge + 0.02 m, square centred on
+/// the centroid, truncating bin index, points outside the square dropped, one view normalised by
+/// its kept count.
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -17,9 +20,9 @@
 #include <span>
 #include <vector>
 
+#include "core/result.hpp"
 #include "kernels/pca_frame.hpp"
 #include "kernels/point_cloud.hpp"
-#include "core/result.hpp"
 
 namespace orthoflow::kernels {
 
@@ -33,7 +36,8 @@ enum class GoodView : std::uint8_t { YOZ = 0, XOZ = 1, XOY = 2 };
 
 /// @brief Default sign threshold of the invariant mode (thesis, PIPELINE.md section 6).
 inline constexpr float GOOD_INVARIANT_THRESHOLD = 0.015F;
-/// @brief Default sign threshold of the reference mode (the reference code's default, GOOD_REFERENCE.md 0).
+/// @brief Default sign threshold of the reference mode (the reference code's default,
+/// GOOD_REFERENCE.md 0).
 inline constexpr float GOOD_REFERENCE_THRESHOLD = 0.0015F;
 /// @brief Fixed margin added to the largest bounding-box edge (GOOD_REFERENCE.md section 5).
 inline constexpr float GOOD_SQUARE_MARGIN = 0.02F;
@@ -42,29 +46,33 @@ inline constexpr std::size_t GOOD_MAX_BINS = 256;
 
 /// @brief Plain configuration, validated by compute_good().
 struct GoodConfig {
-  std::size_t bins = 15;                ///< n: bins per side, 1..GOOD_MAX_BINS (15 thesis, 5 compact)
+  std::size_t bins = 15;  ///< n: bins per side, 1..GOOD_MAX_BINS (15 thesis, 5 compact)
   GoodMode mode = GoodMode::INVARIANT;  ///< frame rule
   std::optional<float> threshold;       ///< sign threshold t in metres; unset = the mode's default
   /// @brief The threshold in use: the set value, or the mode's default.
   [[nodiscard]] float effective_threshold() const noexcept {
-    return threshold ? *threshold : (mode == GoodMode::INVARIANT ? GOOD_INVARIANT_THRESHOLD : GOOD_REFERENCE_THRESHOLD);
+    return threshold ? *threshold
+                     : (mode == GoodMode::INVARIANT ? GOOD_INVARIANT_THRESHOLD
+                                                    : GOOD_REFERENCE_THRESHOLD);
   }
 };
 
 /// @brief Everything compute_good() reports besides the descriptor.
 struct GoodResult {
-  std::size_t length = 0;       ///< values written to the descriptor: 3 n^2
-  std::array<float, 16> frame{};  ///< world -> object transform, row-major; rows 0-2 are X, Y, Z; t = -R c
-  std::array<float, 3> bbox{};    ///< AABB edge lengths along X, Y, Z of the object frame
+  std::size_t length = 0;  ///< values written to the descriptor: 3 n^2
+  std::array<float, 16>
+      frame{};  ///< world -> object transform, row-major; rows 0-2 are X, Y, Z; t = -R c
+  std::array<float, 3> bbox{};      ///< AABB edge lengths along X, Y, Z of the object frame
   std::array<GoodView, 3> order{};  ///< the projection of each descriptor block, first block first
   std::array<std::size_t, 3> kept{};  ///< points binned per view, canonical order (YoZ, XoZ, XoY)
   std::array<float, 3> entropy{};     ///< base-2 entropy per view, canonical order
-  std::array<float, 3> variance{};    ///< variance of the 1-based flattened bin index per view, canonical order
+  std::array<float, 3>
+      variance{};  ///< variance of the 1-based flattened bin index per view, canonical order
   std::array<float, 3> eigenvalues{};  ///< lambda1 >= lambda2 >= lambda3
   std::array<int, 3> signs{};          ///< signs applied to (v1, v2, v3) to get (X, Y, Z)
   float side = 0.0F;                   ///< square side L = largest edge + 0.02 m
   std::size_t points_used = 0;         ///< finite points
-  std::uint32_t flags = 0;             ///< FrameFlag bits (FRAME_UNRELIABLE: do not trust invariance)
+  std::uint32_t flags = 0;  ///< FrameFlag bits (FRAME_UNRELIABLE: do not trust invariance)
 };
 
 /// @brief Why no descriptor was computed.
@@ -79,18 +87,23 @@ enum class GoodError : std::uint8_t {
 /// @brief What the error means, as a sentence naming compute_good and the offending value's role.
 [[nodiscard]] const char* to_string(GoodError error) noexcept;
 
-/// @brief Histogram memory for compute_good(), allocated once by the caller (not on the frame path).
+/// @brief Histogram memory for compute_good(), allocated once by the caller (not on the frame
+/// path).
 /// @note Not thread-safe: one scratch per thread.
 class GoodScratch {
  public:
   /// @brief Room for up to @p max_bins bins per side.
-  explicit GoodScratch(std::size_t max_bins = 15) : max_bins_(max_bins), counts_(3 * max_bins * max_bins + 3) {}
+  explicit GoodScratch(std::size_t max_bins = 15)
+      : max_bins_(max_bins), counts_(3 * max_bins * max_bins + 3) {}
   [[nodiscard]] std::size_t max_bins() const noexcept { return max_bins_; }
   /// @brief Raw counts of @p view (row-major n x n) from the last compute_good() call with n bins.
-  [[nodiscard]] std::span<const std::uint32_t> counts(GoodView view, std::size_t bins) const noexcept {
-    return std::span<const std::uint32_t>(counts_).subspan(static_cast<std::size_t>(view) * bins * bins, bins * bins);
+  [[nodiscard]] std::span<const std::uint32_t> counts(GoodView view,
+                                                      std::size_t bins) const noexcept {
+    return std::span<const std::uint32_t>(counts_).subspan(
+        static_cast<std::size_t>(view) * bins * bins, bins * bins);
   }
-  /// @brief The whole buffer (3 n^2 counts in canonical order, then 3 drop counters); for compute_good() only.
+  /// @brief The whole buffer (3 n^2 counts in canonical order, then 3 drop counters); for
+  /// compute_good() only.
   [[nodiscard]] std::span<std::uint32_t> buffer() noexcept { return counts_; }
 
  private:
@@ -99,19 +112,22 @@ class GoodScratch {
 };
 
 /// @brief Computes the GOOD descriptor of the finite points of @p points.
-/// The three n x n projection matrices are the three blocks of @p descriptor_out, in GoodResult::order;
-/// each block is row-major (row = first named axis, column = second) and sums to 1.
+/// The three n x n projection matrices are the three blocks of @p descriptor_out, in
+/// GoodResult::order; each block is row-major (row = first named axis, column = second) and sums
+/// to 1.
 /// @pre x, y and z have equal lengths.
 /// @note No allocation; thread-safe with one scratch per thread; deterministic on one machine.
-/// Tolerance against compute_good_scalar(): the frame is identical (computed by the same scalar code);
-/// the AVX2/AVX-512 units let the compiler fuse a*b+c into FMA, so a transformed coordinate may differ by
-/// one rounding and a point lying within that of a bin edge or of +-t may change side: the descriptor
-/// L1 difference is at most a few points / kept (tested <= 1e-3 on the shared clouds). SSE2 is exact.
-[[nodiscard]] Result<GoodResult, GoodError> compute_good(PointsView points, const GoodConfig& cfg, GoodScratch& scratch,
+/// Tolerance against compute_good_scalar(): the frame is identical (computed by the same scalar
+/// code); the AVX2/AVX-512 units let the compiler fuse a*b+c into FMA, so a transformed coordinate
+/// may differ by one rounding and a point lying within that of a bin edge or of +-t may change
+/// side: the descriptor L1 difference is at most a few points / kept (tested <= 1e-3 on the shared
+/// clouds). SSE2 is exact.
+[[nodiscard]] Result<GoodResult, GoodError> compute_good(PointsView points, const GoodConfig& cfg,
+                                                         GoodScratch& scratch,
                                                          std::span<float> descriptor_out) noexcept;
 /// @brief Scalar reference twin of compute_good().
-[[nodiscard]] Result<GoodResult, GoodError> compute_good_scalar(PointsView points, const GoodConfig& cfg,
-                                                                GoodScratch& scratch,
-                                                                std::span<float> descriptor_out) noexcept;
+[[nodiscard]] Result<GoodResult, GoodError> compute_good_scalar(
+    PointsView points, const GoodConfig& cfg, GoodScratch& scratch,
+    std::span<float> descriptor_out) noexcept;
 
 }  // namespace orthoflow::kernels

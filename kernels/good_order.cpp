@@ -17,8 +17,8 @@ float entropy_of(std::span<const float> p) noexcept {
   return -h;
 }
 
-// Variance of the 1-based flattened index: mu = sum (i+1) p_i in float, sigma^2 = sum ((i+1) - mu)^2 p_i
-// with the square in double accumulated into float, as the reference does (section 8).
+// Variance of the 1-based flattened index: mu = sum (i+1) p_i in float, sigma^2 = sum ((i+1) -
+// mu)^2 p_i with the square in double accumulated into float, as the reference does (section 8).
 float variance_of(std::span<const float> p) noexcept {
   float mu = 0.0F;
   for (std::size_t i = 0; i < p.size(); ++i) { mu += static_cast<float>(i + 1) * p[i]; }
@@ -31,8 +31,10 @@ float variance_of(std::span<const float> p) noexcept {
 }
 
 // Highest entropy first (first maximum wins: YoZ < XoZ < XoY); of the other two, in canonical order
-// A < B, A comes second when var_A <= var_B (the smaller variance second, ties keep canonical order).
-std::array<GoodView, 3> order_of(const std::array<float, 3>& h, const std::array<float, 3>& var) noexcept {
+// A < B, A comes second when var_A <= var_B (the smaller variance second, ties keep canonical
+// order).
+std::array<GoodView, 3> order_of(const std::array<float, 3>& h,
+                                 const std::array<float, 3>& var) noexcept {
   std::size_t first = 0;
   for (std::size_t v = 1; v < 3; ++v) {
     if (h[v] > h[first]) { first = v; }
@@ -46,8 +48,9 @@ std::array<GoodView, 3> order_of(const std::array<float, 3>& h, const std::array
 
 }  // namespace
 
-GoodOrderOut good_normalise_and_order(std::span<const std::uint32_t> counts, const std::array<std::size_t, 3>& kept,
-                                      std::size_t bins, std::span<float> out) noexcept {
+GoodOrderOut good_normalise_and_order(std::span<const std::uint32_t> counts,
+                                      const std::array<std::size_t, 3>& kept, std::size_t bins,
+                                      std::span<float> out) noexcept {
   const std::size_t nn = bins * bins;
   GoodOrderOut r;
   for (std::size_t v = 0; v < 3; ++v) {

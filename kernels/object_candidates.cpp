@@ -6,7 +6,8 @@
 
 namespace orthoflow::kernels {
 
-double inside_distance(double u, double v, std::span<const double> hu, std::span<const double> hv) noexcept {
+double inside_distance(double u, double v, std::span<const double> hu,
+                       std::span<const double> hv) noexcept {
   double best = 1e300;
   const std::size_t n = std::min(hu.size(), hv.size());
   for (std::size_t k = 0; k < n; ++k) {
@@ -14,7 +15,8 @@ double inside_distance(double u, double v, std::span<const double> hu, std::span
     const double ex = hu[j] - hu[k], ey = hv[j] - hv[k];
     const double len = std::hypot(ex, ey);
     if (len == 0.0) continue;
-    best = std::min(best, (ex * (v - hv[k]) - ey * (u - hu[k])) / len);  // counter-clockwise: left is inside
+    best = std::min(
+        best, (ex * (v - hv[k]) - ey * (u - hu[k])) / len);  // counter-clockwise: left is inside
   }
   return best;
 }
@@ -52,10 +54,11 @@ CandidateCounts select_candidates(std::span<const ClusterStats> clusters, const 
 }
 
 std::size_t gather_candidates(PointsView target, std::span<const std::int32_t> labels,
-                              std::span<const std::uint32_t> members, std::span<const std::int32_t> slot_of,
-                              std::span<const std::size_t> sizes, PointsSpan dst, std::span<CandidateSpan> spans,
-                              std::span<const std::uint32_t> tags, std::size_t bins,
-                              std::span<std::uint32_t> tag_histogram) noexcept {
+                              std::span<const std::uint32_t> members,
+                              std::span<const std::int32_t> slot_of,
+                              std::span<const std::size_t> sizes, PointsSpan dst,
+                              std::span<CandidateSpan> spans, std::span<const std::uint32_t> tags,
+                              std::size_t bins, std::span<std::uint32_t> tag_histogram) noexcept {
   std::uint32_t next = 0;
   for (std::size_t k = 0; k < sizes.size(); ++k) {
     spans[k] = CandidateSpan{next, 0};
@@ -89,8 +92,8 @@ std::size_t gather_candidates(PointsView target, std::span<const std::int32_t> l
 
 std::uint32_t majority_tag(std::span<const std::uint32_t> histogram, std::size_t points) noexcept {
   if (histogram.size() < 2) return 0;
-  const auto best =
-      static_cast<std::uint32_t>(std::max_element(histogram.begin() + 1, histogram.end()) - histogram.begin());
+  const auto best = static_cast<std::uint32_t>(
+      std::max_element(histogram.begin() + 1, histogram.end()) - histogram.begin());
   return histogram[best] > 0 && std::size_t{histogram[best]} * 2 >= points ? best : 0U;
 }
 

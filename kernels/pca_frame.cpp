@@ -18,7 +18,8 @@ std::uint32_t shape_flags(const PcaFrame& f) noexcept {
     return flags | COLLINEAR | COPLANAR | AXES_AMBIGUOUS;
   }
   if (f.eigenvalues[2] <= FLAT_RATIO * l1) { flags |= COPLANAR; }
-  if ((l1 - f.eigenvalues[1]) < AXES_GAP_MIN * l1 || (f.eigenvalues[1] - f.eigenvalues[2]) < AXES_GAP_MIN * l1) {
+  if ((l1 - f.eigenvalues[1]) < AXES_GAP_MIN * l1 ||
+      (f.eigenvalues[1] - f.eigenvalues[2]) < AXES_GAP_MIN * l1) {
     flags |= AXES_AMBIGUOUS;
   }
   return flags;
@@ -28,8 +29,10 @@ std::uint32_t shape_flags(const PcaFrame& f) noexcept {
 
 const char* to_string(PcaError error) noexcept {
   switch (error) {
-    case PcaError::EMPTY_CLOUD: return "the cloud has no points";
-    case PcaError::NO_FINITE_POINTS: return "every point of the cloud has a NaN or infinite coordinate";
+    case PcaError::EMPTY_CLOUD:
+      return "the cloud has no points";
+    case PcaError::NO_FINITE_POINTS:
+      return "every point of the cloud has a NaN or infinite coordinate";
   }
   return "unknown PcaError";
 }
@@ -64,7 +67,8 @@ Result<PcaFrame, PcaError> compute_pca_frame_scalar(PointsView points) noexcept 
   return pca_frame_from_moments(pca_moments_scalar(points), points.size());
 }
 
-Result<PcaFrame, PcaError> pca_frame_from_moments(const PcaMoments& m, std::size_t total_points) noexcept {
+Result<PcaFrame, PcaError> pca_frame_from_moments(const PcaMoments& m,
+                                                  std::size_t total_points) noexcept {
   if (total_points == 0) { return err(PcaError::EMPTY_CLOUD); }
   if (m.count == 0) { return err(PcaError::NO_FINITE_POINTS); }
   const double inv = 1.0 / static_cast<double>(m.count);
@@ -77,7 +81,9 @@ Result<PcaFrame, PcaError> pca_frame_from_moments(const PcaMoments& m, std::size
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(cov, Eigen::ComputeEigenvectors);
   PcaFrame f;
   f.finite = m.count;
-  for (std::size_t a = 0; a < 3; ++a) { f.centroid[a] = m.origin[a] + mean[static_cast<Eigen::Index>(a)]; }
+  for (std::size_t a = 0; a < 3; ++a) {
+    f.centroid[a] = m.origin[a] + mean[static_cast<Eigen::Index>(a)];
+  }
   // Eigen sorts ascending: column 2 is the largest.
   const Eigen::Vector3d v1 = solver.eigenvectors().col(2);
   const Eigen::Vector3d v2 = solver.eigenvectors().col(1);

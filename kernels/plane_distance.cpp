@@ -1,7 +1,7 @@
 #include "kernels/plane_distance.hpp"
 
-#include "kernels/detail/plane_distance_kernel.hpp"
 #include "core/assert.hpp"
+#include "kernels/detail/plane_distance_kernel.hpp"
 
 namespace orthoflow::kernels {
 
@@ -14,7 +14,8 @@ std::size_t count_plane_inliers(PointsView points, const Plane& plane, float tau
   return dispatched(points, plane, tau);
 }
 
-std::size_t plane_signed_distance_scalar(PointsView points, const Plane& plane, std::span<float> out) noexcept {
+std::size_t plane_signed_distance_scalar(PointsView points, const Plane& plane,
+                                         std::span<float> out) noexcept {
   OF_ASSERT(out.size() >= points.size(), "plane_signed_distance: output too small");
   for (std::size_t i = 0; i < points.size(); ++i) {
     out[i] = detail::plane_distance(plane, points.x[i], points.y[i], points.z[i]);
@@ -22,7 +23,8 @@ std::size_t plane_signed_distance_scalar(PointsView points, const Plane& plane, 
   return points.size();
 }
 
-std::size_t plane_signed_distance(PointsView points, const Plane& plane, std::span<float> out) noexcept {
+std::size_t plane_signed_distance(PointsView points, const Plane& plane,
+                                  std::span<float> out) noexcept {
   OF_ASSERT(out.size() >= points.size(), "plane_signed_distance: output too small");
   static auto dispatched = xsimd::dispatch<SimdArchs>(detail::PlaneDistanceKernel{});
   return dispatched(points, plane, out);

@@ -1,6 +1,7 @@
 #pragma once
 /// @file
-/// @brief Point-to-plane distances: inlier counting (the RANSAC score) and signed heights (the prism).
+/// @brief Point-to-plane distances: inlier counting (the RANSAC score) and signed heights (the
+/// prism).
 #include <array>
 #include <cstddef>
 #include <span>
@@ -17,15 +18,18 @@ struct Plane {
 
 /// @brief Counts the points with |normal . p + d| <= tau (NaN points never count).
 /// @pre tau >= 0. @note Stateless, thread-safe. Tolerance: the SIMD variant may fuse multiply-adds,
-/// so a point whose distance is within 1e-6 x (|p| + |d|) of tau may count differently; all others agree.
+/// so a point whose distance is within 1e-6 x (|p| + |d|) of tau may count differently; all others
+/// agree.
 std::size_t count_plane_inliers(PointsView points, const Plane& plane, float tau) noexcept;
 /// @brief Scalar reference twin of count_plane_inliers().
 std::size_t count_plane_inliers_scalar(PointsView points, const Plane& plane, float tau) noexcept;
 
 /// @brief out[i] = normal . p_i + d (NaN for NaN points). @pre out.size() >= points.size().
 /// @return points.size(). @note Tolerance against the scalar twin: 1e-6 x (|p| + |d|) absolute.
-std::size_t plane_signed_distance(PointsView points, const Plane& plane, std::span<float> out) noexcept;
+std::size_t plane_signed_distance(PointsView points, const Plane& plane,
+                                  std::span<float> out) noexcept;
 /// @brief Scalar reference twin of plane_signed_distance().
-std::size_t plane_signed_distance_scalar(PointsView points, const Plane& plane, std::span<float> out) noexcept;
+std::size_t plane_signed_distance_scalar(PointsView points, const Plane& plane,
+                                         std::span<float> out) noexcept;
 
 }  // namespace orthoflow::kernels

@@ -7,8 +7,14 @@
 namespace orthoflow::kernels {
 
 PointCloud::PointCloud(std::pmr::memory_resource* resource)
-    : x_(resource), y_(resource), z_(resource), rgb_(resource), label_(resource),
-      nx_(resource), ny_(resource), nz_(resource) {}
+    : x_(resource),
+      y_(resource),
+      z_(resource),
+      rgb_(resource),
+      label_(resource),
+      nx_(resource),
+      ny_(resource),
+      nz_(resource) {}
 
 void PointCloud::resize(std::uint32_t width, std::uint32_t height) {
   // An empty cloud is always 0 x 1 (unorganized), as PCL writes it.
@@ -39,8 +45,14 @@ void PointCloud::resize_buffers(std::size_t n) {
 void PointCloud::add_field(Field field) {
   const std::size_t n = size();
   switch (field) {
-    case Field::RGB: has_rgb_ = true; rgb_.resize(n); break;
-    case Field::LABEL: has_label_ = true; label_.resize(n); break;
+    case Field::RGB:
+      has_rgb_ = true;
+      rgb_.resize(n);
+      break;
+    case Field::LABEL:
+      has_label_ = true;
+      label_.resize(n);
+      break;
     case Field::NORMALS:
       has_normals_ = true;
       nx_.resize(n);
@@ -52,8 +64,14 @@ void PointCloud::add_field(Field field) {
 
 void PointCloud::remove_field(Field field) {
   switch (field) {
-    case Field::RGB: has_rgb_ = false; rgb_.clear(); break;
-    case Field::LABEL: has_label_ = false; label_.clear(); break;
+    case Field::RGB:
+      has_rgb_ = false;
+      rgb_.clear();
+      break;
+    case Field::LABEL:
+      has_label_ = false;
+      label_.clear();
+      break;
     case Field::NORMALS:
       has_normals_ = false;
       nx_.clear();
@@ -65,9 +83,12 @@ void PointCloud::remove_field(Field field) {
 
 bool PointCloud::has(Field field) const noexcept {
   switch (field) {
-    case Field::RGB: return has_rgb_;
-    case Field::LABEL: return has_label_;
-    case Field::NORMALS: return has_normals_;
+    case Field::RGB:
+      return has_rgb_;
+    case Field::LABEL:
+      return has_label_;
+    case Field::NORMALS:
+      return has_normals_;
   }
   return false;
 }

@@ -41,7 +41,8 @@ struct CloudView {
   [[nodiscard]] bool organized() const noexcept { return height > 1; }
 };
 
-/// @brief Acquisition pose of the sensor (PCD VIEWPOINT): translation and unit quaternion (w, x, y, z).
+/// @brief Acquisition pose of the sensor (PCD VIEWPOINT): translation and unit quaternion (w, x, y,
+/// z).
 struct Viewpoint {
   std::array<float, 3> origin{0.0F, 0.0F, 0.0F};
   std::array<float, 4> orientation{1.0F, 0.0F, 0.0F, 0.0F};
@@ -62,7 +63,8 @@ enum class Field : std::uint8_t { RGB, LABEL, NORMALS };
 
 /// @brief Owning structure-of-arrays point cloud.
 /// @note Every buffer has size() elements; optional fields are either absent (empty) or full size.
-/// NaN coordinates mark invalid pixels of an organized cloud. Not thread-safe for concurrent writes.
+/// NaN coordinates mark invalid pixels of an organized cloud. Not thread-safe for concurrent
+/// writes.
 class PointCloud {
  public:
   template <class T>

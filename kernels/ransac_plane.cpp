@@ -9,10 +9,14 @@ namespace orthoflow::kernels {
 
 std::string RansacError::to_string() const {
   switch (code) {
-    case Code::BAD_PARAMS: return "ransac_plane: invalid parameter value " + std::to_string(value);
-    case Code::TOO_FEW_POINTS: return "ransac_plane: " + std::to_string(value) + " finite points, need at least 3";
-    case Code::NO_HYPOTHESIS: return "ransac_plane: all " + std::to_string(value) + " draws were degenerate";
-    case Code::OUTPUT_TOO_SMALL: return "ransac_plane: inlier output too small for " + std::to_string(value);
+    case Code::BAD_PARAMS:
+      return "ransac_plane: invalid parameter value " + std::to_string(value);
+    case Code::TOO_FEW_POINTS:
+      return "ransac_plane: " + std::to_string(value) + " finite points, need at least 3";
+    case Code::NO_HYPOTHESIS:
+      return "ransac_plane: all " + std::to_string(value) + " draws were degenerate";
+    case Code::OUTPUT_TOO_SMALL:
+      return "ransac_plane: inlier output too small for " + std::to_string(value);
   }
   return "ransac_plane: unknown error";
 }
@@ -31,7 +35,8 @@ bool finite_at(PointsView p, std::size_t i) {
 bool draw_hypothesis(PointsView pts, core::Rng& rng, Plane& out) {
   const auto n = pts.size();
   const auto i0 = rng.below(n), i1 = rng.below(n), i2 = rng.below(n);
-  if (i0 == i1 || i0 == i2 || i1 == i2 || !finite_at(pts, i0) || !finite_at(pts, i1) || !finite_at(pts, i2)) {
+  if (i0 == i1 || i0 == i2 || i1 == i2 || !finite_at(pts, i0) || !finite_at(pts, i1) ||
+      !finite_at(pts, i2)) {
     return false;
   }
   const Vec p0 = point(pts, i0);
@@ -41,12 +46,14 @@ bool draw_hypothesis(PointsView pts, core::Rng& rng, Plane& out) {
   const double norm = normal.norm();
   if (!(norm > 1e-6 * e1.norm() * e2.norm())) { return false; }
   const Vec unit = normal / norm;
-  out.normal = {static_cast<float>(unit.x()), static_cast<float>(unit.y()), static_cast<float>(unit.z())};
+  out.normal = {static_cast<float>(unit.x()), static_cast<float>(unit.y()),
+                static_cast<float>(unit.z())};
   out.d = static_cast<float>(-unit.dot(p0));
   return true;
 }
 
-/// Hypotheses needed for @p confidence of one outlier-free sample at inlier ratio w (Fischler-Bolles).
+/// Hypotheses needed for @p confidence of one outlier-free sample at inlier ratio w
+/// (Fischler-Bolles).
 double needed_iterations(double confidence, double w) {
   const double w3 = w * w * w;
   if (w3 >= 1.0) { return 1.0; }
@@ -54,11 +61,14 @@ double needed_iterations(double confidence, double w) {
   return std::log(1.0 - confidence) / std::log(1.0 - w3);
 }
 
-/// Writes the indices within tau of @p plane; returns how many there are (stops writing at capacity).
-std::size_t collect_inliers(PointsView pts, const Plane& plane, float tau, std::span<std::uint32_t> out) {
+/// Writes the indices within tau of @p plane; returns how many there are (stops writing at
+/// capacity).
+std::size_t collect_inliers(PointsView pts, const Plane& plane, float tau,
+                            std::span<std::uint32_t> out) {
   std::size_t n = 0;
   for (std::size_t i = 0; i < pts.size(); ++i) {
-    const float dist = plane.normal[0] * pts.x[i] + plane.normal[1] * pts.y[i] + plane.normal[2] * pts.z[i] + plane.d;
+    const float dist = plane.normal[0] * pts.x[i] + plane.normal[1] * pts.y[i] +
+                       plane.normal[2] * pts.z[i] + plane.d;
     if (!(std::fabs(dist) <= tau)) { continue; }
     if (n < out.size()) { out[n] = static_cast<std::uint32_t>(i); }
     ++n;
@@ -67,25 +77,35 @@ std::size_t collect_inliers(PointsView pts, const Plane& plane, float tau, std::
 }
 
 /// Least-squares refit on the hypothesis's inliers, then the inliers of the refit plane.
-Result<RansacPlane, RansacError> refine(PointsView pts, const Plane& hypothesis, float tau, std::uint32_t iterations,
-                                        std::span<std::uint32_t> out) {
+Result<RansacPlane, RansacError> refine(PointsView pts, const Plane& hypothesis, float tau,
+                                        std::uint32_t iterations, std::span<std::uint32_t> out) {
   const std::size_t first = collect_inliers(pts, hypothesis, tau, out);
-  if (first > out.size()) { return err(RansacError{RansacError::Code::OUTPUT_TOO_SMALL, double(first)}); }
+  if (first > out.size()) {
+    return err(RansacError{RansacError::Code::OUTPUT_TOO_SMALL, double(first)});
+  }
   const Plane refit = fit_plane(pts, out.first(first));
   const std::size_t second = collect_inliers(pts, refit, tau, out);
-  if (second > out.size()) { return err(RansacError{RansacError::Code::OUTPUT_TOO_SMALL, double(second)}); }
+  if (second > out.size()) {
+    return err(RansacError{RansacError::Code::OUTPUT_TOO_SMALL, double(second)});
+  }
   return RansacPlane{refit, second, iterations};
 }
 
 template <class Counter>
-Result<RansacPlane, RansacError> ransac_impl(PointsView pts, const RansacParams& prm, std::span<std::uint32_t> out,
-                                             Counter count) noexcept {
+Result<RansacPlane, RansacError> ransac_impl(PointsView pts, const RansacParams& prm,
+                                             std::span<std::uint32_t> out, Counter count) noexcept {
   using Code = RansacError::Code;
-  if (!std::isfinite(prm.tau) || prm.tau < 0.0F) { return err(RansacError{Code::BAD_PARAMS, prm.tau}); }
+  if (!std::isfinite(prm.tau) || prm.tau < 0.0F) {
+    return err(RansacError{Code::BAD_PARAMS, prm.tau});
+  }
   if (prm.max_iterations == 0) { return err(RansacError{Code::BAD_PARAMS, 0.0}); }
-  if (!(prm.confidence >= 0.0 && prm.confidence < 1.0)) { return err(RansacError{Code::BAD_PARAMS, prm.confidence}); }
+  if (!(prm.confidence >= 0.0 && prm.confidence < 1.0)) {
+    return err(RansacError{Code::BAD_PARAMS, prm.confidence});
+  }
   std::size_t finite = 0;
-  for (std::size_t i = 0; i < pts.size() && finite < 3; ++i) { finite += finite_at(pts, i) ? 1U : 0U; }
+  for (std::size_t i = 0; i < pts.size() && finite < 3; ++i) {
+    finite += finite_at(pts, i) ? 1U : 0U;
+  }
   if (finite < 3) { return err(RansacError{Code::TOO_FEW_POINTS, double(finite)}); }
   core::Rng rng(prm.seed);
   Plane best;
@@ -95,12 +115,21 @@ Result<RansacPlane, RansacError> ransac_impl(PointsView pts, const RansacParams&
   for (; it < prm.max_iterations; ++it) {
     Plane hypothesis;
     bool ok = false;
-    for (int attempt = 0; attempt < 100 && !ok; ++attempt) { ok = draw_hypothesis(pts, rng, hypothesis); }
+    for (int attempt = 0; attempt < 100 && !ok; ++attempt) {
+      ok = draw_hypothesis(pts, rng, hypothesis);
+    }
     if (!ok) { continue; }
     const std::size_t c = count(pts, hypothesis, prm.tau);
-    if (c > best_count) { best_count = c; best = hypothesis; }
+    if (c > best_count) {
+      best_count = c;
+      best = hypothesis;
+    }
     const double w = static_cast<double>(best_count) / static_cast<double>(pts.size());
-    if (prm.confidence > 0.0 && static_cast<double>(it + 1) >= needed_iterations(prm.confidence, w)) { ++it; break; }
+    if (prm.confidence > 0.0 &&
+        static_cast<double>(it + 1) >= needed_iterations(prm.confidence, w)) {
+      ++it;
+      break;
+    }
   }
   if (best_count < 3) { return err(RansacError{Code::NO_HYPOTHESIS, double(it)}); }
   return refine(pts, best, prm.tau, it, out);
@@ -125,7 +154,8 @@ Plane fit_plane(PointsView pts, std::span<const std::uint32_t> indices) noexcept
     normal = -normal;
     d = -d;
   }
-  return Plane{{static_cast<float>(normal.x()), static_cast<float>(normal.y()), static_cast<float>(normal.z())},
+  return Plane{{static_cast<float>(normal.x()), static_cast<float>(normal.y()),
+                static_cast<float>(normal.z())},
                static_cast<float>(d)};
 }
 
@@ -136,8 +166,8 @@ Result<RansacPlane, RansacError> ransac_plane(PointsView points, const RansacPar
   });
 }
 
-Result<RansacPlane, RansacError> ransac_plane_scalar(PointsView points, const RansacParams& params,
-                                                     std::span<std::uint32_t> inliers_out) noexcept {
+Result<RansacPlane, RansacError> ransac_plane_scalar(
+    PointsView points, const RansacParams& params, std::span<std::uint32_t> inliers_out) noexcept {
   return ransac_impl(points, params, inliers_out, [](PointsView p, const Plane& pl, float tau) {
     return count_plane_inliers_scalar(p, pl, tau);
   });

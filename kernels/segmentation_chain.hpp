@@ -1,15 +1,18 @@
 #pragma once
 /// @file
-/// @brief The tabletop chain of specs/PIPELINE.md sections 2-4: the stages of kernels/tabletop_stages.hpp
-/// and the candidate constraints of kernels/object_candidates.hpp run back to back, with all memory sized
-/// once at construction (nothing allocates in run()). The tabletop graph's preprocess, table and objects
-/// nodes run the same stage objects (docs/SEGMENTATION.md):
+/// @brief The tabletop chain of specs/PIPELINE.md sections 2-4: the stages of
+/// kernels/tabletop_stages.hpp and the candidate constraints of kernels/object_candidates.hpp run
+/// back to back, with all memory sized once at construction (nothing allocates in run()). The
+/// tabletop graph's preprocess, table and objects nodes run the same stage objects
+/// (docs/SEGMENTATION.md):
 /// - organized frame: strided pixel sample inside the ROI -> RANSAC plane (hypotheses scored on the
-///   sample at twice the stride, refit on the sample) -> hull of the sample inliers -> prism (and ROI)
-///   over the full-resolution pixels -> image-space clustering of those pixels -> footprint merge.
-///   With organized_stride == 0 the sample is replaced by the voxel grid of every kept pixel.
-/// - unorganized cloud: ROI -> voxel grid -> RANSAC -> hull -> prism -> grid clustering, all on voxels.
-/// leaf == 0 skips the voxel grid where it runs (RANSAC and hull then run on every kept point).
+///   sample at twice the stride, refit on the sample) -> hull of the sample inliers -> prism (and
+///   ROI) over the full-resolution pixels -> image-space clustering of those pixels -> footprint
+///   merge. With organized_stride == 0 the sample is replaced by the voxel grid of every kept
+///   pixel.
+/// - unorganized cloud: ROI -> voxel grid -> RANSAC -> hull -> prism -> grid clustering, all on
+/// voxels. leaf == 0 skips the voxel grid where it runs (RANSAC and hull then run on every kept
+/// point).
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -44,12 +47,15 @@ struct SegmentationResult {
 class SegmentationChain {
  public:
   /// @brief Allocates every buffer for clouds of up to @p max_points points.
-  SegmentationChain(std::size_t max_points, const SegmentationParams& params, const CandidateParams& candidates = {});
-  /// @brief Segments @p cloud. @pre cloud.points.size() <= max_points. Allocation-free. An organized
-  /// cloud whose point count is not width x height is an error.
+  SegmentationChain(std::size_t max_points, const SegmentationParams& params,
+                    const CandidateParams& candidates = {});
+  /// @brief Segments @p cloud. @pre cloud.points.size() <= max_points. Allocation-free. An
+  /// organized cloud whose point count is not width x height is an error.
   [[nodiscard]] Result<SegmentationResult, SegmentationError> run(CloudView cloud);
   [[nodiscard]] const SegmentationParams& params() const noexcept { return params_; }
-  [[nodiscard]] const CandidateParams& candidate_params() const noexcept { return candidate_params_; }
+  [[nodiscard]] const CandidateParams& candidate_params() const noexcept {
+    return candidate_params_;
+  }
 
  private:
   SegmentationParams params_;

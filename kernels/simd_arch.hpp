@@ -3,7 +3,8 @@
 /// @brief The instruction sets a kernel is compiled for, and which one run-time dispatch picks.
 ///
 /// How a SIMD kernel is built (STYLE rule 3):
-/// - `kernels/detail/<name>.inl` defines `template <class Arch> R <Name>Kernel::operator()(Arch, ...) const`
+/// - `kernels/detail/<name>.inl` defines `template <class Arch> R <Name>Kernel::operator()(Arch,
+/// ...) const`
 ///   and ends with `#ifdef OF_SIMD_ARCH` + an explicit instantiation for `OF_SIMD_ARCH`.
 /// - CMake (`orthoflow_simd_sources`) generates one translation unit per architecture that defines
 ///   `OF_SIMD_ARCH` and includes the .inl, compiled with that architecture's flags only.
@@ -27,8 +28,8 @@ using SimdArchs = xsimd::arch_list<xsimd::neon64>;
 /// "fma3+avx2", "sse2" or "arm64+neon"). @note Thread-safe; constant for the process lifetime.
 const char* simd_arch_name() noexcept;
 
-/// @brief Calls @p f(Arch{}) for every architecture in SimdArchs that this CPU supports, best first.
-/// For tests and benchmarks that compare each compiled variant with the scalar twin.
+/// @brief Calls @p f(Arch{}) for every architecture in SimdArchs that this CPU supports, best
+/// first. For tests and benchmarks that compare each compiled variant with the scalar twin.
 template <class F>
 void for_each_available_arch(F&& f) {
   auto visit = [&f]<class... Archs>(xsimd::arch_list<Archs...>) {

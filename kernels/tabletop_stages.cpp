@@ -20,13 +20,17 @@ double ms_since(Clock::time_point& start) noexcept {
   return ms;
 }
 
-constexpr std::size_t MAX_MERGE = 256;  // clusters beyond this are not merged (a cluttered frame; O(n^2) pairs)
+constexpr std::size_t MAX_MERGE =
+    256;  // clusters beyond this are not merged (a cluttered frame; O(n^2) pairs)
 
-/// Indices of the points within tau of the plane (ransac_plane's rule), ascending. @pre out holds them all.
-std::size_t collect_inliers(PointsView p, const Plane& plane, float tau, std::span<std::uint32_t> out) noexcept {
+/// Indices of the points within tau of the plane (ransac_plane's rule), ascending. @pre out holds
+/// them all.
+std::size_t collect_inliers(PointsView p, const Plane& plane, float tau,
+                            std::span<std::uint32_t> out) noexcept {
   std::size_t n = 0;
   for (std::size_t i = 0; i < p.size(); ++i) {
-    const float dist = plane.normal[0] * p.x[i] + plane.normal[1] * p.y[i] + plane.normal[2] * p.z[i] + plane.d;
+    const float dist =
+        plane.normal[0] * p.x[i] + plane.normal[1] * p.y[i] + plane.normal[2] * p.z[i] + plane.d;
     out[n] = static_cast<std::uint32_t>(i);
     n += std::fabs(dist) <= tau ? 1U : 0U;  // false for NaN
   }
@@ -37,9 +41,12 @@ PointsView first(PointsSpan s, std::size_t offset, std::size_t n) noexcept {
   return PointsView{s.x.subspan(offset, n), s.y.subspan(offset, n), s.z.subspan(offset, n)};
 }
 
-std::size_t cells(std::uint32_t extent, std::uint32_t stride) noexcept { return (extent + stride - 1) / stride; }
+std::size_t cells(std::uint32_t extent, std::uint32_t stride) noexcept {
+  return (extent + stride - 1) / stride;
+}
 
-SegmentationError fail(SegmentationError::Code code, std::uint8_t cause = 0, double value = 0.0) noexcept {
+SegmentationError fail(SegmentationError::Code code, std::uint8_t cause = 0,
+                       double value = 0.0) noexcept {
   return SegmentationError{code, cause, value, 0, 0};
 }
 
@@ -48,15 +55,24 @@ SegmentationError fail(SegmentationError::Code code, std::uint8_t cause = 0, dou
 std::string_view to_string(SegmentationError::Code code) noexcept {
   using C = SegmentationError::Code;
   switch (code) {
-    case C::CLOUD_TOO_LARGE: return "CLOUD_TOO_LARGE";
-    case C::NOT_WIDTH_X_HEIGHT: return "NOT_WIDTH_X_HEIGHT";
-    case C::OUTPUT_TOO_SMALL: return "OUTPUT_TOO_SMALL";
-    case C::VOXEL_GRID_FAILED: return "VOXEL_GRID_FAILED";
-    case C::NO_PLANE: return "NO_PLANE";
-    case C::FEW_SAMPLE_INLIERS: return "FEW_SAMPLE_INLIERS";
-    case C::DEGENERATE_HULL: return "DEGENERATE_HULL";
-    case C::HULL_TOO_LARGE: return "HULL_TOO_LARGE";
-    case C::CLUSTERING_FAILED: return "CLUSTERING_FAILED";
+    case C::CLOUD_TOO_LARGE:
+      return "CLOUD_TOO_LARGE";
+    case C::NOT_WIDTH_X_HEIGHT:
+      return "NOT_WIDTH_X_HEIGHT";
+    case C::OUTPUT_TOO_SMALL:
+      return "OUTPUT_TOO_SMALL";
+    case C::VOXEL_GRID_FAILED:
+      return "VOXEL_GRID_FAILED";
+    case C::NO_PLANE:
+      return "NO_PLANE";
+    case C::FEW_SAMPLE_INLIERS:
+      return "FEW_SAMPLE_INLIERS";
+    case C::DEGENERATE_HULL:
+      return "DEGENERATE_HULL";
+    case C::HULL_TOO_LARGE:
+      return "HULL_TOO_LARGE";
+    case C::CLUSTERING_FAILED:
+      return "CLUSTERING_FAILED";
   }
   return "UNKNOWN";
 }
@@ -66,19 +82,28 @@ std::string SegmentationError::to_string() const {
   const std::string name(kernels::to_string(code));
   const std::string count = std::to_string(static_cast<std::uint64_t>(value));
   switch (code) {
-    case C::CLOUD_TOO_LARGE: return "segmentation: " + name + ": " + count + " points, more than it was sized for";
+    case C::CLOUD_TOO_LARGE:
+      return "segmentation: " + name + ": " + count + " points, more than it was sized for";
     case C::NOT_WIDTH_X_HEIGHT:
-      return "segmentation: " + name + ": organized cloud of " + count + " points is not " + std::to_string(width) +
-             " x " + std::to_string(height);
-    case C::OUTPUT_TOO_SMALL: return "segmentation: " + name + ": the plane input needs room for " + count + " points";
+      return "segmentation: " + name + ": organized cloud of " + count + " points is not " +
+             std::to_string(width) + " x " + std::to_string(height);
+    case C::OUTPUT_TOO_SMALL:
+      return "segmentation: " + name + ": the plane input needs room for " + count + " points";
     case C::VOXEL_GRID_FAILED:
-      return "segmentation: " + name + ": " + VoxelGridError{VoxelGridError::Code{cause}, value}.to_string();
-    case C::NO_PLANE: return "segmentation: " + name + ": " + RansacError{RansacError::Code{cause}, value}.to_string();
-    case C::FEW_SAMPLE_INLIERS: return "segmentation: " + name + ": the plane has fewer than 3 inliers on the sample";
-    case C::DEGENERATE_HULL: return "segmentation: " + name + ": the plane inliers have a degenerate hull";
-    case C::HULL_TOO_LARGE: return "segmentation: " + name + ": " + count + " hull vertices";
+      return "segmentation: " + name + ": " +
+             VoxelGridError{VoxelGridError::Code{cause}, value}.to_string();
+    case C::NO_PLANE:
+      return "segmentation: " + name + ": " +
+             RansacError{RansacError::Code{cause}, value}.to_string();
+    case C::FEW_SAMPLE_INLIERS:
+      return "segmentation: " + name + ": the plane has fewer than 3 inliers on the sample";
+    case C::DEGENERATE_HULL:
+      return "segmentation: " + name + ": the plane inliers have a degenerate hull";
+    case C::HULL_TOO_LARGE:
+      return "segmentation: " + name + ": " + count + " hull vertices";
     case C::CLUSTERING_FAILED:
-      return "segmentation: " + name + ": " + ClusterError{ClusterError::Code{cause}, value}.to_string();
+      return "segmentation: " + name + ": " +
+             ClusterError{ClusterError::Code{cause}, value}.to_string();
   }
   return "segmentation: " + name;
 }
@@ -88,10 +113,15 @@ bool takes_organized_path(CloudView cloud, const SegmentationParams& params) noe
 }
 
 PlaneInputStage::PlaneInputStage(std::size_t max_points)
-    : max_points_(max_points), mask_(max_points), kx_(max_points), ky_(max_points), kz_(max_points),
+    : max_points_(max_points),
+      mask_(max_points),
+      kx_(max_points),
+      ky_(max_points),
+      kz_(max_points),
       voxel_scratch_(max_points) {}
 
-Result<PlaneInput, SegmentationError> PlaneInputStage::run(CloudView cloud, const SegmentationParams& p,
+Result<PlaneInput, SegmentationError> PlaneInputStage::run(CloudView cloud,
+                                                           const SegmentationParams& p,
                                                            PointsSpan out) noexcept {
   using C = SegmentationError::Code;
   auto start = Clock::now();
@@ -105,9 +135,10 @@ Result<PlaneInput, SegmentationError> PlaneInputStage::run(CloudView cloud, cons
     return err(e);
   }
   if (organized && p.organized_stride > 0) {
-    // The plane and hull need a sample about as dense as 5 mm voxels, not a voxel grid over every kept
-    // pixel: a strided pixel sample costs 1/stride^2 of the frame and needs no sort. RANSAC scores its
-    // hypotheses on the sample at twice the stride (a quarter of the points), written after the dense one.
+    // The plane and hull need a sample about as dense as 5 mm voxels, not a voxel grid over every
+    // kept pixel: a strided pixel sample costs 1/stride^2 of the frame and needs no sort. RANSAC
+    // scores its hypotheses on the sample at twice the stride (a quarter of the points), written
+    // after the dense one.
     const std::uint32_t s = p.organized_stride;
     const std::size_t dense_max = cells(cloud.width, s) * cells(cloud.height, s);
     const std::size_t sparse_max = cells(cloud.width, 2 * s) * cells(cloud.height, 2 * s);
@@ -122,10 +153,12 @@ Result<PlaneInput, SegmentationError> PlaneInputStage::run(CloudView cloud, cons
   if (out.size() < n) return err(fail(C::OUTPUT_TOO_SMALL, 0, static_cast<double>(n)));
   const std::size_t kept = crop_box_mask(cloud.points, p.roi, mask_);  // NaN points never pass
   if (p.leaf == 0.0F) {
-    compact_masked(cloud.points, mask_, PointsSpan{out.x.first(kept), out.y.first(kept), out.z.first(kept)}, {});
+    compact_masked(cloud.points, mask_,
+                   PointsSpan{out.x.first(kept), out.y.first(kept), out.z.first(kept)}, {});
     return PlaneInput{first(out, 0, kept), {}, kept, ms_since(start), 0.0};
   }
-  const PointsSpan kept_span{std::span(kx_).first(kept), std::span(ky_).first(kept), std::span(kz_).first(kept)};
+  const PointsSpan kept_span{std::span(kx_).first(kept), std::span(ky_).first(kept),
+                             std::span(kz_).first(kept)};
   compact_masked(cloud.points, mask_, kept_span, {});
   const double filter_ms = ms_since(start);
   auto voxel_result = voxel_grid(kept_span, p.leaf, voxel_scratch_, out);
@@ -137,13 +170,20 @@ Result<PlaneInput, SegmentationError> PlaneInputStage::run(CloudView cloud, cons
 }
 
 TableStage::TableStage(std::size_t max_points)
-    : inliers_(max_points), hull_scratch_(max_points), hull_idx_(max_points + 1), pu_(max_points), pv_(max_points) {}
+    : inliers_(max_points),
+      hull_scratch_(max_points),
+      hull_idx_(max_points + 1),
+      pu_(max_points),
+      pv_(max_points) {}
 
-Result<TableModel, SegmentationError> TableStage::run(const PlaneInput& input, const SegmentationParams& p,
-                                                      std::span<double> hull_u, std::span<double> hull_v) noexcept {
+Result<TableModel, SegmentationError> TableStage::run(const PlaneInput& input,
+                                                      const SegmentationParams& p,
+                                                      std::span<double> hull_u,
+                                                      std::span<double> hull_v) noexcept {
   using C = SegmentationError::Code;
   const PointsView dense = input.dense;
-  if (dense.size() > inliers_.size()) return err(fail(C::CLOUD_TOO_LARGE, 0, static_cast<double>(dense.size())));
+  if (dense.size() > inliers_.size())
+    return err(fail(C::CLOUD_TOO_LARGE, 0, static_cast<double>(dense.size())));
   const bool two_level = input.sparse.size() >= MIN_SPARSE_POINTS;
   auto ransac_result = ransac_plane(two_level ? input.sparse : dense, p.ransac, inliers_);
   if (!ransac_result) {
@@ -152,8 +192,8 @@ Result<TableModel, SegmentationError> TableStage::run(const PlaneInput& input, c
   }
   RansacPlane plane = *ransac_result;
   if (two_level) {
-    // The refit of RANSAC (least squares on the inliers, then the inliers of the refit plane) once more
-    // on the dense sample: the plane and the hull get the density of the stride-s sample.
+    // The refit of RANSAC (least squares on the inliers, then the inliers of the refit plane) once
+    // more on the dense sample: the plane and the hull get the density of the stride-s sample.
     const std::size_t found = collect_inliers(dense, plane.plane, p.ransac.tau, inliers_);
     if (found < 3) return err(fail(C::FEW_SAMPLE_INLIERS, 0, static_cast<double>(found)));
     plane.plane = fit_plane(dense, std::span<const std::uint32_t>(inliers_).first(found));
@@ -162,10 +202,12 @@ Result<TableModel, SegmentationError> TableStage::run(const PlaneInput& input, c
   const PlaneBasis basis = make_plane_basis(plane.plane);
   const auto idx = std::span<const std::uint32_t>(inliers_).first(plane.inliers);
   project_to_plane(dense, idx, basis, pu_, pv_);
-  const std::size_t h = convex_hull_2d(std::span<const double>(pu_).first(idx.size()),
-                                       std::span<const double>(pv_).first(idx.size()), hull_scratch_, hull_idx_);
+  const std::size_t h =
+      convex_hull_2d(std::span<const double>(pu_).first(idx.size()),
+                     std::span<const double>(pv_).first(idx.size()), hull_scratch_, hull_idx_);
   if (h < 3) return err(fail(C::DEGENERATE_HULL, 0, static_cast<double>(h)));
-  if (h > hull_u.size() || h > hull_v.size()) return err(fail(C::HULL_TOO_LARGE, 0, static_cast<double>(h)));
+  if (h > hull_u.size() || h > hull_v.size())
+    return err(fail(C::HULL_TOO_LARGE, 0, static_cast<double>(h)));
   for (std::size_t k = 0; k < h; ++k) {
     hull_u[k] = pu_[hull_idx_[k]];
     hull_v[k] = pv_[hull_idx_[k]];
@@ -174,39 +216,50 @@ Result<TableModel, SegmentationError> TableStage::run(const PlaneInput& input, c
 }
 
 ObjectStage::ObjectStage(std::size_t max_points, std::uint32_t min_cluster_size)
-    : heights_(max_points), mask_(max_points), labels_(max_points),
+    : heights_(max_points),
+      mask_(max_points),
+      labels_(max_points),
       // every cluster has at least max(1, min_size) points, which bounds the cluster count
-      moments_(max_points / std::max<std::size_t>(1, min_cluster_size) + 1), stats_(moments_.size()),
-      cluster_scratch_(max_points), footprints_(std::min(MAX_MERGE, moments_.size())), root_(footprints_.size()),
+      moments_(max_points / std::max<std::size_t>(1, min_cluster_size) + 1),
+      stats_(moments_.size()),
+      cluster_scratch_(max_points),
+      footprints_(std::min(MAX_MERGE, moments_.size())),
+      root_(footprints_.size()),
       new_id_(footprints_.size()) {}
 
-Result<ObjectClusters, SegmentationError> ObjectStage::run(CloudView cloud, const PlaneInput& plane_input,
+Result<ObjectClusters, SegmentationError> ObjectStage::run(CloudView cloud,
+                                                           const PlaneInput& plane_input,
                                                            const TableModel& table,
                                                            const SegmentationParams& p) noexcept {
   using C = SegmentationError::Code;
   auto start = Clock::now();
   const bool organized = takes_organized_path(cloud, p);
-  // The prism runs on the full-resolution pixels (organized) or on the plane's input points; the ROI
-  // applies to the pixels too (the plane input lies in it already).
+  // The prism runs on the full-resolution pixels (organized) or on the plane's input points; the
+  // ROI applies to the pixels too (the plane input lies in it already).
   const PointsView target = organized ? cloud.points : plane_input.dense;
-  if (target.size() > labels_.size()) return err(fail(C::CLOUD_TOO_LARGE, 0, static_cast<double>(target.size())));
+  if (target.size() > labels_.size())
+    return err(fail(C::CLOUD_TOO_LARGE, 0, static_cast<double>(target.size())));
   const PlaneBasis basis = make_plane_basis(table.plane.plane);
   const Prism prism{table.plane.plane, basis, table.hull_u, table.hull_v, p.h_min, p.h_max, p.roi};
   const std::size_t inside = polygonal_prism(target, prism, heights_, mask_);
   const double prism_ms = ms_since(start);
   const auto mask = std::span<const std::uint8_t>(mask_).first(target.size());
   const auto labels = std::span(labels_).first(target.size());
-  auto clusters_result = organized ? euclidean_cluster_organized({target, cloud.width, cloud.height}, mask, p.cluster,
-                                                                 cluster_scratch_, labels)
-                                   : euclidean_cluster(target, mask, p.cluster, cluster_scratch_, labels);
+  auto clusters_result =
+      organized ? euclidean_cluster_organized({target, cloud.width, cloud.height}, mask, p.cluster,
+                                              cluster_scratch_, labels)
+                : euclidean_cluster(target, mask, p.cluster, cluster_scratch_, labels);
   if (!clusters_result) {
     const auto& e = clusters_result.error();
     return err(fail(C::CLUSTERING_FAILED, static_cast<std::uint8_t>(e.code), e.value));
   }
-  // Organized: only the pixels the clustering listed (the prism's), not a scan of the whole label frame.
-  const auto members = organized ? cluster_scratch_.listed_members() : std::span<const std::uint32_t>{};
+  // Organized: only the pixels the clustering listed (the prism's), not a scan of the whole label
+  // frame.
+  const auto members =
+      organized ? cluster_scratch_.listed_members() : std::span<const std::uint32_t>{};
   std::size_t clusters = std::min(*clusters_result, stats_.size());
-  if (p.merge_overlap > 0.0F) clusters = merge_footprints(target, members, basis, clusters, p.merge_overlap);
+  if (p.merge_overlap > 0.0F)
+    clusters = merge_footprints(target, members, basis, clusters, p.merge_overlap);
   const auto stats = std::span(stats_).first(clusters);
   if (organized) {
     cluster_stats_listed(target, labels, members, moments_, stats);

@@ -1,16 +1,19 @@
 #pragma once
 /// @file
-/// @brief The stages of the tabletop chain (specs/PIPELINE.md sections 2-4), each a stage object that owns
-/// its scratch (sized once at construction) and writes its results into memory the caller hands it. The
-/// chain (kernels/segmentation_chain.hpp) runs them back to back; the graph's preprocess, table and
-/// objects nodes run the same objects, one per node (STYLE rule 15: one implementation, the product runs
-/// it). Nothing here allocates after construction, starts a thread or does I/O.
+/// @brief The stages of the tabletop chain (specs/PIPELINE.md sections 2-4), each a stage object
+/// that owns its scratch (sized once at construction) and writes its results into memory the caller
+/// hands it. The chain (kernels/segmentation_chain.hpp) runs them back to back; the graph's
+/// preprocess, table and objects nodes run the same objects, one per node (STYLE rule 15: one
+/// implementation, the product runs it). Nothing here allocates after construction, starts a thread
+/// or does I/O.
 ///
-/// - PlaneInputStage: organized frame: strided pixel sample inside the ROI (the plane-fit input) and the
-///   sample at twice the stride (RANSAC scores its hypotheses there); unorganized cloud, or stride 0:
-///   ROI crop then voxel grid (or every kept point when leaf == 0).
+/// - PlaneInputStage: organized frame: strided pixel sample inside the ROI (the plane-fit input)
+/// and the
+///   sample at twice the stride (RANSAC scores its hypotheses there); unorganized cloud, or stride
+///   0: ROI crop then voxel grid (or every kept point when leaf == 0).
 /// - TableStage: RANSAC plane (refit on the dense sample), convex hull of the inliers.
-/// - ObjectStage: prism (hull, height range and ROI) over the full-resolution pixels (organized) or the
+/// - ObjectStage: prism (hull, height range and ROI) over the full-resolution pixels (organized) or
+/// the
 ///   plane input (unorganized), Euclidean clusters, the footprint merge, per-cluster statistics.
 #include <cstddef>
 #include <cstdint>
@@ -37,36 +40,41 @@ struct SegmentationParams {
   float h_max = 0.5F;
   ClusterParams cluster{};
   bool use_organized = true;  ///< organized input: image-space clustering of full-resolution pixels
-  /// Organized input only: the plane refit and the hull run on every organized_stride-th pixel of every
-  /// organized_stride-th row inside the ROI (pixel_subsample), RANSAC scores its hypotheses on the sample
-  /// at twice that stride (when it has >= 500 points), and leaf is not used; 0: the voxel grid of leaf
-  /// over every kept pixel, as for unorganized input.
+  /// Organized input only: the plane refit and the hull run on every organized_stride-th pixel of
+  /// every organized_stride-th row inside the ROI (pixel_subsample), RANSAC scores its hypotheses
+  /// on the sample at twice that stride (when it has >= 500 points), and leaf is not used; 0: the
+  /// voxel grid of leaf over every kept pixel, as for unorganized input.
   std::uint32_t organized_stride = 4;
-  /// Footprint merge: clusters whose footprints on the table (boxes in the plane's u, v) overlap by at
-  /// least this share of the smaller one are one object in pieces (a bowl's near and far walls). 0: off
-  /// (the PCL baseline has no such step); the tabletop graph uses 0.3.
+  /// Footprint merge: clusters whose footprints on the table (boxes in the plane's u, v) overlap by
+  /// at least this share of the smaller one are one object in pieces (a bowl's near and far walls).
+  /// 0: off (the PCL baseline has no such step); the tabletop graph uses 0.3.
   float merge_overlap = 0.0F;
 };
 
 /// @brief Why a stage failed. Plain data: building one on the frame path never allocates. @p cause
-/// keeps the kernel's own reason (RansacError / VoxelGridError / ClusterError code) and @p value its number.
+/// keeps the kernel's own reason (RansacError / VoxelGridError / ClusterError code) and @p value
+/// its number.
 struct SegmentationError {
   enum class Code : std::uint8_t {
-    CLOUD_TOO_LARGE,      ///< more points than the stage was sized for (value: the point count)
-    NOT_WIDTH_X_HEIGHT,   ///< an organized cloud whose point count is not width x height (value: the count)
-    OUTPUT_TOO_SMALL,     ///< the caller's output span cannot hold the plane input (value: points needed)
-    VOXEL_GRID_FAILED,    ///< cause: VoxelGridError::Code
-    NO_PLANE,             ///< RANSAC found none; cause: RansacError::Code
-    FEW_SAMPLE_INLIERS,   ///< the plane has fewer than 3 inliers on the dense sample
-    DEGENERATE_HULL,      ///< the inliers' hull has fewer than 3 vertices
-    HULL_TOO_LARGE,       ///< the hull has more vertices than the caller's hull span holds (value: count)
-    CLUSTERING_FAILED,    ///< cause: ClusterError::Code
+    CLOUD_TOO_LARGE,     ///< more points than the stage was sized for (value: the point count)
+    NOT_WIDTH_X_HEIGHT,  ///< an organized cloud whose point count is not width x height (value: the
+                         ///< count)
+    OUTPUT_TOO_SMALL,    ///< the caller's output span cannot hold the plane input (value: points
+                         ///< needed)
+    VOXEL_GRID_FAILED,   ///< cause: VoxelGridError::Code
+    NO_PLANE,            ///< RANSAC found none; cause: RansacError::Code
+    FEW_SAMPLE_INLIERS,  ///< the plane has fewer than 3 inliers on the dense sample
+    DEGENERATE_HULL,     ///< the inliers' hull has fewer than 3 vertices
+    HULL_TOO_LARGE,      ///< the hull has more vertices than the caller's hull span holds (value:
+                         ///< count)
+    CLUSTERING_FAILED,   ///< cause: ClusterError::Code
   };
   Code code = Code::NO_PLANE;
   std::uint8_t cause = 0;
   double value = 0.0;
   std::uint32_t width = 0, height = 0;  ///< NOT_WIDTH_X_HEIGHT: the image size the cloud claims
-  /// @brief The full message: stage, reason and the kernel's own message. Allocates: off the frame path.
+  /// @brief The full message: stage, reason and the kernel's own message. Allocates: off the frame
+  /// path.
   [[nodiscard]] std::string to_string() const;
 };
 
@@ -75,23 +83,29 @@ struct SegmentationError {
 
 /// @brief Plane-fit input of one frame, in the caller's output span.
 struct PlaneInput {
-  PointsView dense;   ///< the points RANSAC refits on and the hull is built from
-  PointsView sparse;  ///< organized strided path: RANSAC scores its hypotheses on these (may be empty)
-  std::size_t kept = 0;  ///< finite points inside the ROI that fed it (organized strided: the dense sample)
+  PointsView dense;  ///< the points RANSAC refits on and the hull is built from
+  PointsView
+      sparse;  ///< organized strided path: RANSAC scores its hypotheses on these (may be empty)
+  std::size_t kept =
+      0;  ///< finite points inside the ROI that fed it (organized strided: the dense sample)
   double filter_ms = 0.0, voxel_ms = 0.0;  ///< wall time of the ROI / sample and of the voxel grid
 };
 
 /// @brief True when the chain takes its organized path for @p cloud under @p params.
 [[nodiscard]] bool takes_organized_path(CloudView cloud, const SegmentationParams& params) noexcept;
 
-/// @brief Stage 1: ROI, strided sample or voxel grid. @note Not thread-safe; one instance per thread.
+/// @brief Stage 1: ROI, strided sample or voxel grid. @note Not thread-safe; one instance per
+/// thread.
 class PlaneInputStage {
  public:
   /// @brief Allocates its scratch for clouds of up to @p max_points points.
   explicit PlaneInputStage(std::size_t max_points);
-  /// @brief Writes the plane input of @p cloud to the front of @p out (dense sample, then the sparse one).
-  /// @pre out.size() >= max_points, or at least the sample bounds of an organized cloud. Allocation-free.
-  [[nodiscard]] Result<PlaneInput, SegmentationError> run(CloudView cloud, const SegmentationParams& params,
+  /// @brief Writes the plane input of @p cloud to the front of @p out (dense sample, then the
+  /// sparse one).
+  /// @pre out.size() >= max_points, or at least the sample bounds of an organized cloud.
+  /// Allocation-free.
+  [[nodiscard]] Result<PlaneInput, SegmentationError> run(CloudView cloud,
+                                                          const SegmentationParams& params,
                                                           PointsSpan out) noexcept;
 
  private:
@@ -101,7 +115,8 @@ class PlaneInputStage {
   VoxelGridScratch voxel_scratch_;
 };
 
-/// @brief The table a frame stands on: plane, inlier count and support polygon (in the caller's spans).
+/// @brief The table a frame stands on: plane, inlier count and support polygon (in the caller's
+/// spans).
 struct TableModel {
   RansacPlane plane;
   std::span<const double> hull_u, hull_v;  ///< counter-clockwise, in make_plane_basis(plane.plane)
@@ -113,8 +128,10 @@ class TableStage {
   explicit TableStage(std::size_t max_points);
   /// @brief Fits the table to @p input; the hull goes to the front of @p hull_u / @p hull_v.
   /// @pre input.dense.size() <= max_points. Allocation-free. Deterministic (seeded RANSAC).
-  [[nodiscard]] Result<TableModel, SegmentationError> run(const PlaneInput& input, const SegmentationParams& params,
-                                                          std::span<double> hull_u, std::span<double> hull_v) noexcept;
+  [[nodiscard]] Result<TableModel, SegmentationError> run(const PlaneInput& input,
+                                                          const SegmentationParams& params,
+                                                          std::span<double> hull_u,
+                                                          std::span<double> hull_v) noexcept;
 
  private:
   static constexpr std::size_t MIN_SPARSE_POINTS = 500;  // below: RANSAC on the dense sample
@@ -122,30 +139,37 @@ class TableStage {
   std::vector<double> pu_, pv_;
 };
 
-/// @brief What the object stage found. Spans point into the stage and stay valid until its next run().
+/// @brief What the object stage found. Spans point into the stage and stay valid until its next
+/// run().
 struct ObjectClusters {
-  PointsView target;  ///< the points labelled: the full-resolution pixels (organized) or the plane input
-  std::span<const std::int32_t> labels;     ///< per target point: cluster id or -1
-  std::span<const std::uint32_t> members;   ///< ascending superset of the labelled indices (all when empty)
-  std::span<const ClusterStats> clusters;   ///< after the footprint merge
-  std::size_t prism_points = 0;             ///< points inside the prism
-  double prism_ms = 0.0, cluster_ms = 0.0;  ///< wall time of the prism and of clusters + merge + statistics
+  PointsView
+      target;  ///< the points labelled: the full-resolution pixels (organized) or the plane input
+  std::span<const std::int32_t> labels;  ///< per target point: cluster id or -1
+  std::span<const std::uint32_t>
+      members;  ///< ascending superset of the labelled indices (all when empty)
+  std::span<const ClusterStats> clusters;  ///< after the footprint merge
+  std::size_t prism_points = 0;            ///< points inside the prism
+  double prism_ms = 0.0,
+         cluster_ms = 0.0;  ///< wall time of the prism and of clusters + merge + statistics
 };
 
 /// @brief Stage 3: prism, clusters, footprint merge, statistics. @note Not thread-safe.
 class ObjectStage {
  public:
-  /// @brief Sized for clouds of up to @p max_points points and clusters of at least @p min_cluster_size.
+  /// @brief Sized for clouds of up to @p max_points points and clusters of at least @p
+  /// min_cluster_size.
   ObjectStage(std::size_t max_points, std::uint32_t min_cluster_size);
-  /// @brief Objects above @p table. @p plane_input is the stage-1 output (the target of an unorganized cloud).
+  /// @brief Objects above @p table. @p plane_input is the stage-1 output (the target of an
+  /// unorganized cloud).
   /// @pre the cloud passed stage 1 with the same @p params. Allocation-free. Deterministic.
-  [[nodiscard]] Result<ObjectClusters, SegmentationError> run(CloudView cloud, const PlaneInput& plane_input,
-                                                              const TableModel& table,
-                                                              const SegmentationParams& params) noexcept;
+  [[nodiscard]] Result<ObjectClusters, SegmentationError> run(
+      CloudView cloud, const PlaneInput& plane_input, const TableModel& table,
+      const SegmentationParams& params) noexcept;
 
  private:
-  std::size_t merge_footprints(PointsView target, std::span<const std::uint32_t> members, const PlaneBasis& basis,
-                               std::size_t clusters, float overlap) noexcept;
+  std::size_t merge_footprints(PointsView target, std::span<const std::uint32_t> members,
+                               const PlaneBasis& basis, std::size_t clusters,
+                               float overlap) noexcept;
   std::vector<float> heights_;
   std::vector<std::uint8_t> mask_;
   std::vector<std::int32_t> labels_;

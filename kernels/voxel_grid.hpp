@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "kernels/point_cloud.hpp"
 #include "core/result.hpp"
+#include "kernels/point_cloud.hpp"
 
 namespace orthoflow::kernels {
 
@@ -28,7 +28,8 @@ struct VoxelGridError {
   [[nodiscard]] std::string to_string() const;
 };
 
-/// @brief Working memory of voxel_grid(), sized once for the largest input (4 arrays of max_points).
+/// @brief Working memory of voxel_grid(), sized once for the largest input (4 arrays of
+/// max_points).
 /// @note Allocates only in the constructor; reuse it frame after frame (not concurrently).
 struct VoxelGridScratch {
   explicit VoxelGridScratch(std::size_t max_points)
@@ -43,7 +44,8 @@ struct VoxelGridScratch {
 /// Centroids are averaged in double then rounded to float.
 /// @pre in.size() <= scratch.capacity() <= UINT32_MAX. @return the number of voxels written, or an
 /// error (nothing useful written). @note Allocation-free; thread-safe with distinct scratch/output.
-[[nodiscard]] Result<std::size_t, VoxelGridError> voxel_grid(PointsView in, float leaf, VoxelGridScratch& scratch,
+[[nodiscard]] Result<std::size_t, VoxelGridError> voxel_grid(PointsView in, float leaf,
+                                                             VoxelGridScratch& scratch,
                                                              PointsSpan out) noexcept;
 
 }  // namespace orthoflow::kernels

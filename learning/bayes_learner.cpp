@@ -10,7 +10,8 @@
 
 namespace orthoflow::learning {
 
-/// One category model: N_k, the unscaled bin sums s_k (a_k = count_scale * s_k) and log P(x_i | C_k).
+/// One category model: N_k, the unscaled bin sums s_k (a_k = count_scale * s_k) and log P(x_i |
+/// C_k).
 struct BayesCategory {
   CategoryId id = NO_CATEGORY;
   Label label;
@@ -21,7 +22,7 @@ struct BayesCategory {
 
 struct BayesSnapshot {
   std::vector<std::shared_ptr<const BayesCategory>> categories;  // by id
-  std::uint64_t total = 0;                                        // N = sum of N_k
+  std::uint64_t total = 0;                                       // N = sum of N_k
   std::uint64_t generation = 0;
   CategoryId next_id = 0;
 };
@@ -41,10 +42,10 @@ namespace {
 
 using CategoryPtr = std::shared_ptr<const BayesCategory>;
 
-// Laplace-smoothed bin probabilities (thesis eq. update_p): P(x_i | C_k) = (a_ki + 1) / sum_j (a_kj + 1),
-// with a_ki = count_scale * sums_i; stored as logarithms for the log-likelihood sum.
-CategoryPtr make_category(CategoryId id, const Label& label, std::uint64_t seen, std::vector<double> sums,
-                          float count_scale) {
+// Laplace-smoothed bin probabilities (thesis eq. update_p): P(x_i | C_k) = (a_ki + 1) / sum_j (a_kj
+// + 1), with a_ki = count_scale * sums_i; stored as logarithms for the log-likelihood sum.
+CategoryPtr make_category(CategoryId id, const Label& label, std::uint64_t seen,
+                          std::vector<double> sums, float count_scale) {
   auto c = std::make_shared<BayesCategory>();
   c->id = id;
   c->label = label;
@@ -60,7 +61,8 @@ CategoryPtr make_category(CategoryId id, const Label& label, std::uint64_t seen,
   return c;
 }
 
-std::unique_ptr<BayesSnapshot> finish(std::vector<CategoryPtr> categories, std::uint64_t generation, CategoryId next_id) {
+std::unique_ptr<BayesSnapshot> finish(std::vector<CategoryPtr> categories, std::uint64_t generation,
+                                      CategoryId next_id) {
   auto s = std::make_unique<BayesSnapshot>();
   s->categories = std::move(categories);
   s->generation = generation;
@@ -73,7 +75,8 @@ std::unique_ptr<BayesSnapshot> finish(std::vector<CategoryPtr> categories, std::
 
 BayesLearner::BayesLearner(const BayesConfig& cfg) : cfg_(cfg) {
   OF_ENFORCE(cfg.descriptor_length > 0, "BayesConfig::descriptor_length must be positive");
-  OF_ENFORCE(cfg.count_scale > 0.0F && std::isfinite(cfg.count_scale), "BayesConfig::count_scale must be > 0");
+  OF_ENFORCE(cfg.count_scale > 0.0F && std::isfinite(cfg.count_scale),
+             "BayesConfig::count_scale must be > 0");
   cell_ = std::make_unique<Cell>(finish({}, 0, 0));
 }
 
@@ -84,7 +87,8 @@ Result<CategoryId, LearnError> BayesLearner::teach(std::string_view label, Descr
   if (auto r = validate_batch(views, cfg_.descriptor_length, true); !r) { return err(r.error()); }
   // Thesis "Category Initialization and Update": N_k <- N_k + views, a_ki <- a_ki + x'_i.
   auto make = [&](const BayesCategory* existing, CategoryId id) {
-    std::vector<double> sums = existing == nullptr ? std::vector<double>(cfg_.descriptor_length, 0.0) : existing->sums;
+    std::vector<double> sums =
+        existing == nullptr ? std::vector<double>(cfg_.descriptor_length, 0.0) : existing->sums;
     accumulate_views(views, sums);
     const std::uint64_t seen = (existing == nullptr ? 0 : existing->seen) + views.count();
     return make_category(id, Label::from(label), seen, std::move(sums), cfg_.count_scale);
@@ -92,15 +96,19 @@ Result<CategoryId, LearnError> BayesLearner::teach(std::string_view label, Descr
   return upsert_category(writer_, *cell_, label, make, finish);
 }
 
-Prediction BayesLearner::ask(std::span<const float> descriptor, AskScratch& scratch) const noexcept {
+Prediction BayesLearner::ask(std::span<const float> descriptor,
+                             AskScratch& scratch) const noexcept {
   const auto snap = cell_->read(scratch.slot_hint);
   RankedScores ranked(true);
-  if (descriptor.size() != cfg_.descriptor_length) { return RankedScores::wrong_length(snap->generation); }
+  if (descriptor.size() != cfg_.descriptor_length) {
+    return RankedScores::wrong_length(snap->generation);
+  }
   const auto n = static_cast<Eigen::Index>(descriptor.size());
   const Eigen::Map<const Eigen::VectorXf> x(descriptor.data(), n);
   const double log_total = std::log(static_cast<double>(snap->total));
   for (const CategoryPtr& c : snap->categories) {
-    // log P(C_k) + sum_i y_i log P(x_i | C_k) with y_i = count_scale * x_i (thesis, log-likelihood rule).
+    // log P(C_k) + sum_i y_i log P(x_i | C_k) with y_i = count_scale * x_i (thesis, log-likelihood
+    // rule).
     const float dot = x.dot(Eigen::Map<const Eigen::VectorXf>(c->log_p.data(), n));
     const double score = std::log(static_cast<double>(c->seen)) - log_total +
                          static_cast<double>(cfg_.count_scale) * static_cast<double>(dot);
@@ -113,8 +121,11 @@ Result<void, LearnError> BayesLearner::forget(std::string_view label) {
   return erase_category(writer_, *cell_, label, finish);
 }
 
-Result<void, LearnError> BayesLearner::restore(std::span<const RestoredCategory> categories, CategoryId next_id) {
-  if (auto r = validate_restored(categories, cfg_.descriptor_length, true); !r) { return err(r.error()); }
+Result<void, LearnError> BayesLearner::restore(std::span<const RestoredCategory> categories,
+                                               CategoryId next_id) {
+  if (auto r = validate_restored(categories, cfg_.descriptor_length, true); !r) {
+    return err(r.error());
+  }
   std::vector<CategoryPtr> next;
   for (const RestoredCategory& rc : categories) {
     std::vector<double> sums(rc.accumulators.begin(), rc.accumulators.end());
@@ -124,8 +135,8 @@ Result<void, LearnError> BayesLearner::restore(std::span<const RestoredCategory>
       accumulate_views(rc.views, sums);
       seen = rc.views.count();
     }
-    next.push_back(make_category(rc.id, Label::from(rc.label), std::max<std::uint64_t>(seen, 1), std::move(sums),
-                                 cfg_.count_scale));
+    next.push_back(make_category(rc.id, Label::from(rc.label), std::max<std::uint64_t>(seen, 1),
+                                 std::move(sums), cfg_.count_scale));
     next_id = std::max(next_id, rc.id + 1);
   }
   replace_categories(writer_, *cell_, std::move(next), next_id, finish);
@@ -136,7 +147,8 @@ LearnerStats BayesLearner::stats() const noexcept {
   std::size_t hint = 0;
   const auto snap = cell_->read(hint);
   return LearnerStats{snap->categories.size(), static_cast<std::size_t>(snap->total),
-                      snap->categories.size() * cfg_.descriptor_length, snap->generation, cell_->retired_pending()};
+                      snap->categories.size() * cfg_.descriptor_length, snap->generation,
+                      cell_->retired_pending()};
 }
 
 std::vector<CategorySummary> BayesLearner::categories() const {

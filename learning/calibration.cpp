@@ -38,7 +38,8 @@ struct IcdInputs {
   std::vector<double> pair_sum;
 };
 
-// The ICD in use for each category and their mean: the rules of InstanceLearner (instance_learner.hpp).
+// The ICD in use for each category and their mean: the rules of InstanceLearner
+// (instance_learner.hpp).
 std::vector<float> icds(const IcdInputs& in, const InstanceConfig& cfg, float& mean) {
   double defined_sum = 0.0;
   std::size_t defined = 0;
@@ -51,7 +52,9 @@ std::vector<float> icds(const IcdInputs& in, const InstanceConfig& cfg, float& m
       ++defined;
     }
   }
-  const float fallback = defined > 0 ? static_cast<float>(defined_sum / static_cast<double>(defined)) : cfg.default_icd;
+  const float fallback = defined > 0
+                             ? static_cast<float>(defined_sum / static_cast<double>(defined))
+                             : cfg.default_icd;
   double sum = 0.0;
   std::size_t present = 0;
   for (std::size_t k = 0; k < out.size(); ++k) {
@@ -65,9 +68,10 @@ std::vector<float> icds(const IcdInputs& in, const InstanceConfig& cfg, float& m
   return out;
 }
 
-// NOCD of the view in column @p self to category @p k (excluding column self), from its distance row.
-float nocd(std::span<const float> row, const AllViews& all, std::size_t self, std::size_t k, float icd, float mean_icd,
-           const InstanceConfig& cfg) {
+// NOCD of the view in column @p self to category @p k (excluding column self), from its distance
+// row.
+float nocd(std::span<const float> row, const AllViews& all, std::size_t self, std::size_t k,
+           float icd, float mean_icd, const InstanceConfig& cfg) {
   float min_d = std::numeric_limits<float>::infinity();
   double sum = 0.0;
   std::size_t n = 0;
@@ -97,10 +101,13 @@ Calibration best_threshold(std::vector<float> known, std::vector<float> unknown)
   candidates.push_back(all.back() * 1.5F + 1e-6F);
   Calibration best{0.0F, -1.0F, known.size(), unknown.size()};
   for (const float ct : candidates) {
-    const auto accepted = static_cast<double>(std::upper_bound(known.begin(), known.end(), ct) - known.begin());
-    const auto rejected = static_cast<double>(unknown.end() - std::upper_bound(unknown.begin(), unknown.end(), ct));
-    const auto balanced = static_cast<float>(0.5 * (accepted / static_cast<double>(known.size()) +
-                                                    rejected / static_cast<double>(unknown.size())));
+    const auto accepted =
+        static_cast<double>(std::upper_bound(known.begin(), known.end(), ct) - known.begin());
+    const auto rejected =
+        static_cast<double>(unknown.end() - std::upper_bound(unknown.begin(), unknown.end(), ct));
+    const auto balanced =
+        static_cast<float>(0.5 * (accepted / static_cast<double>(known.size()) +
+                                  rejected / static_cast<double>(unknown.size())));
     if (balanced > best.balanced_accuracy) {
       best.threshold = ct;
       best.balanced_accuracy = balanced;
@@ -113,27 +120,35 @@ Calibration best_threshold(std::vector<float> known, std::vector<float> unknown)
 
 const char* to_string(CalibrationError error) noexcept {
   switch (error) {
-    case CalibrationError::TOO_FEW_CATEGORIES: return "calibration needs at least two categories";
-    case CalibrationError::TOO_FEW_VIEWS: return "calibration needs a category with at least two views";
+    case CalibrationError::TOO_FEW_CATEGORIES:
+      return "calibration needs at least two categories";
+    case CalibrationError::TOO_FEW_VIEWS:
+      return "calibration needs a category with at least two views";
   }
   return "unknown calibration error";
 }
 
-Result<Calibration, CalibrationError> calibrate_threshold(std::span<const RestoredCategory> categories,
-                                                          const InstanceConfig& cfg) {
+Result<Calibration, CalibrationError> calibrate_threshold(
+    std::span<const RestoredCategory> categories, const InstanceConfig& cfg) {
   if (categories.size() < 2) { return err(CalibrationError::TOO_FEW_CATEGORIES); }
   const std::size_t dims = cfg.descriptor_length;
   const AllViews all = gather(categories, dims);
   const kernels::DescriptorMatrixView matrix{all.soa, dims, all.count, all.count};
   std::vector<std::vector<float>> rows(all.count, std::vector<float>(all.count));
-  IcdInputs base{std::vector<std::size_t>(categories.size(), 0), std::vector<double>(categories.size(), 0.0)};
+  IcdInputs base{std::vector<std::size_t>(categories.size(), 0),
+                 std::vector<double>(categories.size(), 0.0)};
   std::vector<std::size_t> first(categories.size(), 0);
-  for (std::size_t t = 0, col = 0; t < categories.size(); col += categories[t].views.count(), ++t) { first[t] = col; }
+  for (std::size_t t = 0, col = 0; t < categories.size(); col += categories[t].views.count(), ++t) {
+    first[t] = col;
+  }
   for (std::size_t t = 0; t < all.count; ++t) {
     const std::size_t k = all.category[t];
-    kernels::distances(categories[k].views.view(t - first[k]), matrix, kernels::Metric::L2, rows[t]);
+    kernels::distances(categories[k].views.view(t - first[k]), matrix, kernels::Metric::L2,
+                       rows[t]);
     ++base.count[k];
-    for (std::size_t j = first[k]; j < t; ++j) { base.pair_sum[k] += static_cast<double>(rows[t][j]); }
+    for (std::size_t j = first[k]; j < t; ++j) {
+      base.pair_sum[k] += static_cast<double>(rows[t][j]);
+    }
   }
   std::vector<float> known;
   std::vector<float> unknown;
@@ -153,7 +168,10 @@ Result<Calibration, CalibrationError> calibrate_threshold(std::span<const Restor
     const std::vector<float> icd_unknown = icds(removed, cfg, mean);
     float nearest_other = std::numeric_limits<float>::infinity();
     for (std::size_t k = 0; k < categories.size(); ++k) {
-      if (k != c) { nearest_other = std::min(nearest_other, nocd(rows[t], all, t, k, icd_unknown[k], mean, cfg)); }
+      if (k != c) {
+        nearest_other =
+            std::min(nearest_other, nocd(rows[t], all, t, k, icd_unknown[k], mean, cfg));
+      }
     }
     unknown.push_back(nearest_other);
   }

@@ -1,11 +1,11 @@
 #pragma once
 /// @file
 /// @brief Choosing the classification threshold CT of InstanceLearner from the stored views
-/// (docs/LEARNING.md, "Choosing CT"). Leave-one-out: every stored view T of category C (with |C| >= 2)
-/// is removed from C, its NOCD to the rest of C is a "known" sample (should be <= CT) and its smallest
-/// NOCD to every other category is an "unknown" sample (as if C had never been taught: should be > CT).
-/// CT is the midpoint between two consecutive sorted samples that maximises balanced accuracy
-/// (mean of the known and unknown acceptance rates); ties keep the smallest CT.
+/// (docs/LEARNING.md, "Choosing CT"). Leave-one-out: every stored view T of category C (with |C| >=
+/// 2) is removed from C, its NOCD to the rest of C is a "known" sample (should be <= CT) and its
+/// smallest NOCD to every other category is an "unknown" sample (as if C had never been taught:
+/// should be > CT). CT is the midpoint between two consecutive sorted samples that maximises
+/// balanced accuracy (mean of the known and unknown acceptance rates); ties keep the smallest CT.
 #include <cstddef>
 #include <span>
 
@@ -33,7 +33,7 @@ enum class CalibrationError : std::uint8_t {
 /// @pre every category's views have cfg.descriptor_length values. @note Allocates (start-up/offline
 /// tool, not the frame path): O(V^2) floats for the distance table and O(V^2 L) time for V views of
 /// length L (2 000 views: 16 MB). Deterministic.
-[[nodiscard]] Result<Calibration, CalibrationError> calibrate_threshold(std::span<const RestoredCategory> categories,
-                                                                        const InstanceConfig& cfg);
+[[nodiscard]] Result<Calibration, CalibrationError> calibrate_threshold(
+    std::span<const RestoredCategory> categories, const InstanceConfig& cfg);
 
 }  // namespace orthoflow::learning

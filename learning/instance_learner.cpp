@@ -10,21 +10,23 @@
 
 namespace orthoflow::learning {
 
-/// One category: its views as a dims x stride structure-of-arrays matrix (columns count..stride are zero)
-/// and the sum of its pairwise distances, kept so that ICD is updated in O(new views x count) per teach.
+/// One category: its views as a dims x stride structure-of-arrays matrix (columns count..stride are
+/// zero) and the sum of its pairwise distances, kept so that ICD is updated in O(new views x count)
+/// per teach.
 struct InstanceCategory {
   CategoryId id = NO_CATEGORY;
   Label label;
   std::size_t count = 0;
-  std::size_t stride = 0;  // count rounded up to COLUMN_PAD: zero columns keep the kernel in its SIMD body
+  std::size_t stride =
+      0;  // count rounded up to COLUMN_PAD: zero columns keep the kernel in its SIMD body
   std::vector<float> soa;
   double pair_sum = 0.0;  // sum over unordered pairs {U, V}, U != V, of D(U, V)
 };
 
 struct InstanceSnapshot {
   std::vector<std::shared_ptr<const InstanceCategory>> categories;  // by id
-  std::vector<float> icd;                                           // ICD in use, parallel to categories
-  float mean_icd = 0.0F;                                            // mean of icd (approach II)
+  std::vector<float> icd;  // ICD in use, parallel to categories
+  float mean_icd = 0.0F;   // mean of icd (approach II)
   std::size_t views = 0;
   std::uint64_t generation = 0;
   CategoryId next_id = 0;
@@ -38,13 +40,14 @@ namespace {
 
 using CategoryPtr = std::shared_ptr<const InstanceCategory>;
 
-// kernels::distances runs SIMD across columns (16 lanes with AVX-512) and finishes with a scalar tail, so a
-// 10-view category would be all tail. Padding columns to a multiple of 16 lets ask() compute the zero
-// columns too and ignore them: 1.6x the arithmetic of a 10-view category, at SIMD speed.
+// kernels::distances runs SIMD across columns (16 lanes with AVX-512) and finishes with a scalar
+// tail, so a 10-view category would be all tail. Padding columns to a multiple of 16 lets ask()
+// compute the zero columns too and ignore them: 1.6x the arithmetic of a 10-view category, at SIMD
+// speed.
 constexpr std::size_t COLUMN_PAD = 16;
 
-// A new category holding @p base's views followed by @p views; every new view adds its distances to all
-// earlier views to pair_sum (thesis: ICD_n <- ICD(C_n) after C_n <- C_{n-1} U {O_n}).
+// A new category holding @p base's views followed by @p views; every new view adds its distances to
+// all earlier views to pair_sum (thesis: ICD_n <- ICD(C_n) after C_n <- C_{n-1} U {O_n}).
 CategoryPtr extend(const InstanceCategory& base, DescriptorBatch views, std::size_t dims) {
   auto c = std::make_shared<InstanceCategory>();
   c->id = base.id;
@@ -70,8 +73,9 @@ CategoryPtr extend(const InstanceCategory& base, DescriptorBatch views, std::siz
 }
 
 // ICD of every category (rules in instance_learner.hpp), their mean, and the view total.
-std::unique_ptr<InstanceSnapshot> finish(std::vector<CategoryPtr> categories, std::uint64_t generation,
-                                         CategoryId next_id, const InstanceConfig& cfg) {
+std::unique_ptr<InstanceSnapshot> finish(std::vector<CategoryPtr> categories,
+                                         std::uint64_t generation, CategoryId next_id,
+                                         const InstanceConfig& cfg) {
   auto s = std::make_unique<InstanceSnapshot>();
   s->categories = std::move(categories);
   s->generation = generation;
@@ -82,41 +86,51 @@ std::unique_ptr<InstanceSnapshot> finish(std::vector<CategoryPtr> categories, st
     s->views += c->count;
     if (c->count >= 2) {
       const double n = static_cast<double>(c->count);
-      defined_sum += std::max(2.0 * c->pair_sum / (n * (n - 1.0)), static_cast<double>(cfg.min_icd));
+      defined_sum +=
+          std::max(2.0 * c->pair_sum / (n * (n - 1.0)), static_cast<double>(cfg.min_icd));
       ++defined;
     }
   }
-  const double fallback = defined > 0 ? defined_sum / static_cast<double>(defined) : static_cast<double>(cfg.default_icd);
+  const double fallback = defined > 0 ? defined_sum / static_cast<double>(defined)
+                                      : static_cast<double>(cfg.default_icd);
   double all_sum = 0.0;
   for (const CategoryPtr& c : s->categories) {
     const double n = static_cast<double>(c->count);
-    const double icd = c->count >= 2 ? std::max(2.0 * c->pair_sum / (n * (n - 1.0)), static_cast<double>(cfg.min_icd))
+    const double icd = c->count >= 2 ? std::max(2.0 * c->pair_sum / (n * (n - 1.0)),
+                                                static_cast<double>(cfg.min_icd))
                                      : fallback;
     s->icd.push_back(static_cast<float>(icd));
     all_sum += icd;
   }
-  s->mean_icd = s->categories.empty() ? cfg.default_icd : static_cast<float>(all_sum / static_cast<double>(s->categories.size()));
+  s->mean_icd = s->categories.empty()
+                    ? cfg.default_icd
+                    : static_cast<float>(all_sum / static_cast<double>(s->categories.size()));
   return s;
 }
 
-// finish() with this learner's configuration, in the form the shared writer (category_writer.hpp) calls.
+// finish() with this learner's configuration, in the form the shared writer (category_writer.hpp)
+// calls.
 auto finisher(const InstanceConfig& cfg) {
   return [&cfg](std::vector<CategoryPtr> categories, std::uint64_t generation, CategoryId next_id) {
     return finish(std::move(categories), generation, next_id, cfg);
   };
 }
 
-// Min (approach I) or mean (approach II) of the L2 distances from @p query to the views of @p c, walked
-// in chunks of the scratch size (thesis eq. OCD, approaches I and II). NaN distances propagate.
-float ocd(std::span<const float> query, const InstanceCategory& c, bool mean, std::span<float> buffer) noexcept {
+// Min (approach I) or mean (approach II) of the L2 distances from @p query to the views of @p c,
+// walked in chunks of the scratch size (thesis eq. OCD, approaches I and II). NaN distances
+// propagate.
+float ocd(std::span<const float> query, const InstanceCategory& c, bool mean,
+          std::span<float> buffer) noexcept {
   const std::size_t dims = query.size();
   float min_d = std::numeric_limits<float>::infinity();
   double sum = 0.0;
   bool saw_nan = false;
   for (std::size_t j0 = 0; j0 < c.count; j0 += buffer.size()) {
     const std::size_t n = std::min(buffer.size(), c.count - j0);
-    const std::size_t computed = std::min(buffer.size(), c.stride - j0);  // padding columns when they fit
-    const kernels::DescriptorMatrixView chunk{std::span<const float>(c.soa).subspan(j0), dims, computed, c.stride};
+    const std::size_t computed =
+        std::min(buffer.size(), c.stride - j0);  // padding columns when they fit
+    const kernels::DescriptorMatrixView chunk{std::span<const float>(c.soa).subspan(j0), dims,
+                                              computed, c.stride};
     kernels::distances(query, chunk, kernels::Metric::L2, buffer.first(computed));
     for (std::size_t j = 0; j < n; ++j) {
       saw_nan = saw_nan || std::isnan(buffer[j]);
@@ -132,15 +146,19 @@ float ocd(std::span<const float> query, const InstanceCategory& c, bool mean, st
 
 InstanceLearner::InstanceLearner(const InstanceConfig& cfg) : cfg_(cfg) {
   OF_ENFORCE(cfg.descriptor_length > 0, "InstanceConfig::descriptor_length must be positive");
-  OF_ENFORCE(cfg.default_icd > 0.0F && std::isfinite(cfg.default_icd), "InstanceConfig::default_icd must be > 0");
-  OF_ENFORCE(cfg.min_icd > 0.0F && std::isfinite(cfg.min_icd), "InstanceConfig::min_icd must be > 0");
-  OF_ENFORCE(!std::isnan(cfg.classification_threshold), "InstanceConfig::classification_threshold is NaN");
+  OF_ENFORCE(cfg.default_icd > 0.0F && std::isfinite(cfg.default_icd),
+             "InstanceConfig::default_icd must be > 0");
+  OF_ENFORCE(cfg.min_icd > 0.0F && std::isfinite(cfg.min_icd),
+             "InstanceConfig::min_icd must be > 0");
+  OF_ENFORCE(!std::isnan(cfg.classification_threshold),
+             "InstanceConfig::classification_threshold is NaN");
   cell_ = std::make_unique<Cell>(finish({}, 0, 0, cfg_));
 }
 
 InstanceLearner::~InstanceLearner() = default;
 
-Result<CategoryId, LearnError> InstanceLearner::teach(std::string_view label, DescriptorBatch views) {
+Result<CategoryId, LearnError> InstanceLearner::teach(std::string_view label,
+                                                      DescriptorBatch views) {
   if (auto r = validate_label(label); !r) { return err(r.error()); }
   if (auto r = validate_batch(views, cfg_.descriptor_length, false); !r) { return err(r.error()); }
   auto make = [&](const InstanceCategory* existing, CategoryId id) {
@@ -152,7 +170,8 @@ Result<CategoryId, LearnError> InstanceLearner::teach(std::string_view label, De
   return upsert_category(writer_, *cell_, label, make, finisher(cfg_));
 }
 
-Prediction InstanceLearner::ask(std::span<const float> descriptor, AskScratch& scratch) const noexcept {
+Prediction InstanceLearner::ask(std::span<const float> descriptor,
+                                AskScratch& scratch) const noexcept {
   const auto snap = cell_->read(scratch.slot_hint);
   RankedScores ranked(false);
   if (descriptor.size() != cfg_.descriptor_length) { return ranked.wrong_length(snap->generation); }
@@ -162,7 +181,9 @@ Prediction InstanceLearner::ask(std::span<const float> descriptor, AskScratch& s
     const float o = ocd(descriptor, c, mean, scratch.distances());
     float score = o;
     if (cfg_.normalise) {
-      score = cfg_.approach == NocdApproach::MIN_DISTANCE ? o / snap->icd[k] : 2.0F * o / (snap->icd[k] + snap->mean_icd);
+      score = cfg_.approach == NocdApproach::MIN_DISTANCE
+                  ? o / snap->icd[k]
+                  : 2.0F * o / (snap->icd[k] + snap->mean_icd);
     }
     ranked.offer(score, c.id, c.label);
   }
@@ -176,10 +197,15 @@ Result<void, LearnError> InstanceLearner::forget(std::string_view label) {
   return erase_category(writer_, *cell_, label, finisher(cfg_));
 }
 
-Result<void, LearnError> InstanceLearner::restore(std::span<const RestoredCategory> categories, CategoryId next_id) {
-  if (auto r = validate_restored(categories, cfg_.descriptor_length, false); !r) { return err(r.error()); }
+Result<void, LearnError> InstanceLearner::restore(std::span<const RestoredCategory> categories,
+                                                  CategoryId next_id) {
+  if (auto r = validate_restored(categories, cfg_.descriptor_length, false); !r) {
+    return err(r.error());
+  }
   for (const RestoredCategory& rc : categories) {
-    if (rc.views.count() == 0) { return err(LearnError::NO_VIEWS); }  // a model alone is not enough here
+    if (rc.views.count() == 0) {
+      return err(LearnError::NO_VIEWS);
+    }  // a model alone is not enough here
   }
   std::vector<CategoryPtr> next;
   for (const RestoredCategory& rc : categories) {
@@ -196,8 +222,8 @@ Result<void, LearnError> InstanceLearner::restore(std::span<const RestoredCatego
 LearnerStats InstanceLearner::stats() const noexcept {
   std::size_t hint = 0;
   const auto snap = cell_->read(hint);
-  return LearnerStats{snap->categories.size(), snap->views, snap->views * cfg_.descriptor_length, snap->generation,
-                      cell_->retired_pending()};
+  return LearnerStats{snap->categories.size(), snap->views, snap->views * cfg_.descriptor_length,
+                      snap->generation, cell_->retired_pending()};
 }
 
 std::vector<CategorySummary> InstanceLearner::categories() const {

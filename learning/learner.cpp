@@ -8,17 +8,24 @@
 
 namespace orthoflow::learning {
 
-
 const char* to_string(LearnError error) noexcept {
   switch (error) {
-    case LearnError::EMPTY_LABEL: return "empty label: a category needs a name";
-    case LearnError::LABEL_TOO_LONG: return "label longer than 63 bytes";
-    case LearnError::NO_VIEWS: return "no view to learn from (empty descriptor batch)";
-    case LearnError::WRONG_LENGTH: return "descriptor length differs from the learner's descriptor_length";
-    case LearnError::NOT_FINITE: return "descriptor holds a NaN or infinite value";
-    case LearnError::NEGATIVE_VALUE: return "histogram descriptor holds a negative value";
-    case LearnError::UNKNOWN_LABEL: return "no category has this label";
-    case LearnError::DUPLICATE_ID: return "two restored categories share an id or a label";
+    case LearnError::EMPTY_LABEL:
+      return "empty label: a category needs a name";
+    case LearnError::LABEL_TOO_LONG:
+      return "label longer than 63 bytes";
+    case LearnError::NO_VIEWS:
+      return "no view to learn from (empty descriptor batch)";
+    case LearnError::WRONG_LENGTH:
+      return "descriptor length differs from the learner's descriptor_length";
+    case LearnError::NOT_FINITE:
+      return "descriptor holds a NaN or infinite value";
+    case LearnError::NEGATIVE_VALUE:
+      return "histogram descriptor holds a negative value";
+    case LearnError::UNKNOWN_LABEL:
+      return "no category has this label";
+    case LearnError::DUPLICATE_ID:
+      return "two restored categories share an id or a label";
   }
   return "unknown learn error";
 }
@@ -31,9 +38,12 @@ Result<void, LearnError> validate_label(std::string_view label) noexcept {
   return {};
 }
 
-Result<void, LearnError> validate_batch(DescriptorBatch views, std::size_t length, bool histograms) noexcept {
+Result<void, LearnError> validate_batch(DescriptorBatch views, std::size_t length,
+                                        bool histograms) noexcept {
   if (views.values.empty()) { return err(LearnError::NO_VIEWS); }
-  if (views.length != length || views.values.size() % length != 0) { return err(LearnError::WRONG_LENGTH); }
+  if (views.length != length || views.values.size() % length != 0) {
+    return err(LearnError::WRONG_LENGTH);
+  }
   for (const float v : views.values) {
     if (!std::isfinite(v)) { return err(LearnError::NOT_FINITE); }
     if (histograms && v < 0.0F) { return err(LearnError::NEGATIVE_VALUE); }
@@ -41,8 +51,8 @@ Result<void, LearnError> validate_batch(DescriptorBatch views, std::size_t lengt
   return {};
 }
 
-Result<void, LearnError> validate_restored(std::span<const RestoredCategory> categories, std::size_t length,
-                                           bool histograms) noexcept {
+Result<void, LearnError> validate_restored(std::span<const RestoredCategory> categories,
+                                           std::size_t length, bool histograms) noexcept {
   for (std::size_t k = 0; k < categories.size(); ++k) {
     const RestoredCategory& c = categories[k];
     if (auto r = validate_label(c.label); !r) { return r; }
@@ -52,7 +62,9 @@ Result<void, LearnError> validate_restored(std::span<const RestoredCategory> cat
     }
     if (has_model && c.accumulators.size() != length) { return err(LearnError::WRONG_LENGTH); }
     for (std::size_t j = 0; j < k; ++j) {
-      if (categories[j].id == c.id || categories[j].label == c.label) { return err(LearnError::DUPLICATE_ID); }
+      if (categories[j].id == c.id || categories[j].label == c.label) {
+        return err(LearnError::DUPLICATE_ID);
+      }
     }
   }
   return {};

@@ -13,7 +13,8 @@ namespace {
 static_assert(std::endian::native == std::endian::little, "the memory format is little-endian");
 
 constexpr std::uint32_t VIEW_MAGIC = 0x3156464FU;  // "OFV1"
-// Largest descriptor a record may declare (GOOD_MAX_BINS): a corrupt length never triggers a huge allocation.
+// Largest descriptor a record may declare (GOOD_MAX_BINS): a corrupt length never triggers a huge
+// allocation.
 constexpr std::size_t MAX_VALUES = 3 * kernels::GOOD_MAX_BINS * kernels::GOOD_MAX_BINS;
 
 class Writer {
@@ -85,15 +86,17 @@ std::optional<CategoryId> key_category(std::string_view key) noexcept {
 }
 
 std::string encode_schema(const kernels::DescriptorSpec& spec) {
-  const nlohmann::json j{{"schema", MEMORY_SCHEMA_VERSION},
-                         {"descriptor", std::string(kernels::to_string(spec.kind))},
-                         {"bins", spec.good.bins},
-                         {"mode", spec.good.mode == kernels::GoodMode::INVARIANT ? "invariant" : "reference"},
-                         {"threshold", spec.good.effective_threshold()}};
+  const nlohmann::json j{
+      {"schema", MEMORY_SCHEMA_VERSION},
+      {"descriptor", std::string(kernels::to_string(spec.kind))},
+      {"bins", spec.good.bins},
+      {"mode", spec.good.mode == kernels::GoodMode::INVARIANT ? "invariant" : "reference"},
+      {"threshold", spec.good.effective_threshold()}};
   return j.dump();
 }
 
-std::optional<kernels::DescriptorSpec> decode_schema(std::string_view json, std::uint32_t& version, std::string& why) {
+std::optional<kernels::DescriptorSpec> decode_schema(std::string_view json, std::uint32_t& version,
+                                                     std::string& why) {
   const nlohmann::json j = nlohmann::json::parse(json, nullptr, false);
   if (j.is_discarded() || !j.is_object()) {
     why = "not a JSON object";
@@ -104,13 +107,16 @@ std::optional<kernels::DescriptorSpec> decode_schema(std::string_view json, std:
   const auto bins = j.find("bins");
   const auto mode = j.find("mode");
   const auto threshold = j.find("threshold");
-  if (schema == j.end() || !schema->is_number_unsigned() || bins == j.end() || !bins->is_number_unsigned() ||
-      mode == j.end() || !mode->is_string() || threshold == j.end() || !threshold->is_number() ||
-      (kind != j.end() && !kind->is_string())) {
-    why = "needs unsigned \"schema\" and \"bins\", string \"mode\", number \"threshold\" (and a string \"descriptor\")";
+  if (schema == j.end() || !schema->is_number_unsigned() || bins == j.end() ||
+      !bins->is_number_unsigned() || mode == j.end() || !mode->is_string() ||
+      threshold == j.end() || !threshold->is_number() || (kind != j.end() && !kind->is_string())) {
+    why =
+        "needs unsigned \"schema\" and \"bins\", string \"mode\", number \"threshold\" (and a "
+        "string \"descriptor\")";
     return std::nullopt;
   }
-  if (kind != j.end() && kind->get<std::string>() != kernels::to_string(kernels::DescriptorKind::GOOD)) {
+  if (kind != j.end() &&
+      kind->get<std::string>() != kernels::to_string(kernels::DescriptorKind::GOOD)) {
     why = "descriptor \"" + kind->get<std::string>() + "\" is not one this build knows (good)";
     return std::nullopt;
   }
@@ -121,7 +127,8 @@ std::optional<kernels::DescriptorSpec> decode_schema(std::string_view json, std:
   }
   version = schema->get<std::uint32_t>();
   auto spec = kernels::DescriptorSpec::make_good(
-      bins->get<std::size_t>(), m == "invariant" ? kernels::GoodMode::INVARIANT : kernels::GoodMode::REFERENCE);
+      bins->get<std::size_t>(),
+      m == "invariant" ? kernels::GoodMode::INVARIANT : kernels::GoodMode::REFERENCE);
   spec.good.threshold = threshold->get<float>();
   return spec;
 }
@@ -136,14 +143,18 @@ std::string encode_category(const CategoryRecord& c) {
 std::optional<CategoryRecord> decode_category(std::string_view bytes) {
   Reader r(bytes);
   CategoryRecord c;
-  if (!r.get(c.next_seq) || !r.get(c.views) || r.left() == 0 || r.left() > LABEL_MAX_BYTES) { return std::nullopt; }
+  if (!r.get(c.next_seq) || !r.get(c.views) || r.left() == 0 || r.left() > LABEL_MAX_BYTES) {
+    return std::nullopt;
+  }
   c.label = std::string(r.rest());
   return c;
 }
 
 std::string encode_model(const ModelRecord& m) {
   Writer w;
-  w.put(m.seen).put(static_cast<std::uint32_t>(m.sums.size())).put_all(std::span<const double>(m.sums));
+  w.put(m.seen)
+      .put(static_cast<std::uint32_t>(m.sums.size()))
+      .put_all(std::span<const double>(m.sums));
   return w.take();
 }
 
@@ -151,7 +162,9 @@ std::optional<ModelRecord> decode_model(std::string_view bytes) {
   Reader r(bytes);
   ModelRecord m;
   std::uint32_t n = 0;
-  if (!r.get(m.seen) || !r.get(n) || n > MAX_VALUES || r.left() != n * sizeof(double)) { return std::nullopt; }
+  if (!r.get(m.seen) || !r.get(n) || n > MAX_VALUES || r.left() != n * sizeof(double)) {
+    return std::nullopt;
+  }
   m.sums.resize(n);
   if (!r.get_all(std::span<double>(m.sums))) { return std::nullopt; }
   return m;
@@ -159,7 +172,9 @@ std::optional<ModelRecord> decode_model(std::string_view bytes) {
 
 std::string encode_view(const ViewRecord& v, const kernels::DescriptorSpec& spec) {
   Writer w;
-  w.put(VIEW_MAGIC).put(static_cast<std::uint32_t>(spec.good.bins)).put(static_cast<std::uint8_t>(spec.good.mode));
+  w.put(VIEW_MAGIC)
+      .put(static_cast<std::uint32_t>(spec.good.bins))
+      .put(static_cast<std::uint8_t>(spec.good.mode));
   w.put(spec.good.effective_threshold());
   w.put_all(std::span<const float>(v.frame)).put_all(std::span<const float>(v.bbox));
   w.put(v.track_id).put(v.stamp_ns).put(static_cast<std::uint32_t>(v.descriptor.size()));
@@ -167,8 +182,8 @@ std::string encode_view(const ViewRecord& v, const kernels::DescriptorSpec& spec
   return w.take();
 }
 
-std::optional<ViewRecord> decode_view(std::string_view bytes, const kernels::DescriptorSpec& expected,
-                                      std::string& why) {
+std::optional<ViewRecord> decode_view(std::string_view bytes,
+                                      const kernels::DescriptorSpec& expected, std::string& why) {
   Reader r(bytes);
   std::uint32_t magic = 0, bins = 0, n = 0;
   std::uint8_t mode = 0;
@@ -179,15 +194,17 @@ std::optional<ViewRecord> decode_view(std::string_view bytes, const kernels::Des
     return std::nullopt;
   }
   if (!r.get(bins) || !r.get(mode) || !r.get(threshold) || !r.get_all(std::span<float>(v.frame)) ||
-      !r.get_all(std::span<float>(v.bbox)) || !r.get(v.track_id) || !r.get(v.stamp_ns) || !r.get(n)) {
+      !r.get_all(std::span<float>(v.bbox)) || !r.get(v.track_id) || !r.get(v.stamp_ns) ||
+      !r.get(n)) {
     why = "view record truncated in its header";
     return std::nullopt;
   }
-  auto got = kernels::DescriptorSpec::make_good(bins, mode == 0 ? kernels::GoodMode::INVARIANT : kernels::GoodMode::REFERENCE);
+  auto got = kernels::DescriptorSpec::make_good(
+      bins, mode == 0 ? kernels::GoodMode::INVARIANT : kernels::GoodMode::REFERENCE);
   got.good.threshold = threshold;
   if (mode > 1 || !(got == expected) || n != expected.length() || r.left() != n * sizeof(float)) {
-    why = "view record has " + got.describe() + " and " + std::to_string(n) + " values, store has " +
-          expected.describe();
+    why = "view record has " + got.describe() + " and " + std::to_string(n) +
+          " values, store has " + expected.describe();
     return std::nullopt;
   }
   v.descriptor.resize(n);

@@ -1,5 +1,5 @@
-// Export and import of the perceptual memory as JSON lines (format in docs/LEARNING.md): line 1 is the
-// header with the schema version and the representation parameters, then one line per view.
+// Export and import of the perceptual memory as JSON lines (format in docs/LEARNING.md): line 1 is
+// the header with the schema version and the representation parameters, then one line per view.
 #include <fstream>
 #include <nlohmann/json.hpp>
 
@@ -13,8 +13,8 @@ using Code = MemoryError::Code;
 using nlohmann::json;
 
 json view_line(const std::string& label, const ViewRecord& v) {
-  return json{{"label", label},         {"descriptor", v.descriptor}, {"frame", v.frame},
-              {"bbox", v.bbox},         {"track_id", v.track_id},     {"stamp_ns", v.stamp_ns}};
+  return json{{"label", label}, {"descriptor", v.descriptor}, {"frame", v.frame},
+              {"bbox", v.bbox}, {"track_id", v.track_id},     {"stamp_ns", v.stamp_ns}};
 }
 
 // Copies exactly @p n finite numbers of array @p j into @p out.
@@ -28,7 +28,8 @@ bool read_floats(const json& j, std::size_t n, std::span<float> out) {
 }
 
 // One view line; @p why says what is wrong when it returns false.
-bool parse_view(const std::string& line, std::size_t length, std::string& label, ViewRecord& v, std::string& why) {
+bool parse_view(const std::string& line, std::size_t length, std::string& label, ViewRecord& v,
+                std::string& why) {
   const json j = json::parse(line, nullptr, false);
   if (j.is_discarded() || !j.is_object()) {
     why = "not a JSON object";
@@ -40,14 +41,15 @@ bool parse_view(const std::string& line, std::size_t length, std::string& label,
   const auto b = j.find("bbox");
   const auto t = j.find("track_id");
   const auto s = j.find("stamp_ns");
-  if (l == j.end() || !l->is_string() || d == j.end() || f == j.end() || b == j.end() || t == j.end() ||
-      !t->is_number_unsigned() || s == j.end() || !s->is_number_integer()) {
+  if (l == j.end() || !l->is_string() || d == j.end() || f == j.end() || b == j.end() ||
+      t == j.end() || !t->is_number_unsigned() || s == j.end() || !s->is_number_integer()) {
     why = "needs \"label\", \"descriptor\", \"frame\", \"bbox\", \"track_id\" and \"stamp_ns\"";
     return false;
   }
   label = l->get<std::string>();
   v.descriptor.resize(length);
-  if (!read_floats(*d, length, v.descriptor) || !read_floats(*f, 16, v.frame) || !read_floats(*b, 3, v.bbox)) {
+  if (!read_floats(*d, length, v.descriptor) || !read_floats(*f, 16, v.frame) ||
+      !read_floats(*b, 3, v.bbox)) {
     why = "descriptor must hold " + std::to_string(length) + " numbers, frame 16, bbox 3";
     return false;
   }
@@ -71,7 +73,8 @@ struct ImportGroup {
 
 }  // namespace
 
-Result<std::size_t, MemoryError> PerceptualMemory::export_to(const std::filesystem::path& file) const {
+Result<std::size_t, MemoryError> PerceptualMemory::export_to(
+    const std::filesystem::path& file) const {
   const State& s = *state_;
   std::ofstream out(file, std::ios::binary | std::ios::trunc);
   if (!out) { return err(memory_error(Code::FILE_FAILED, file, "cannot open for writing")); }
@@ -102,10 +105,11 @@ Result<std::size_t, MemoryError> PerceptualMemory::import_from(const std::filesy
   std::string why;
   const auto params = std::getline(in, line) ? decode_schema(line, version, why) : std::nullopt;
   if (!params || version != MEMORY_SCHEMA_VERSION || !(*params == state_->cfg.descriptor)) {
-    const std::string reason = !params ? (why.empty() ? "empty file" : why)
-                               : version != MEMORY_SCHEMA_VERSION ? "schema version " + std::to_string(version)
-                                                                  : "file has " + params->describe() + ", store has " +
-                                                                        state_->cfg.descriptor.describe();
+    const std::string reason =
+        !params ? (why.empty() ? "empty file" : why)
+        : version != MEMORY_SCHEMA_VERSION
+            ? "schema version " + std::to_string(version)
+            : "file has " + params->describe() + ", store has " + state_->cfg.descriptor.describe();
     return err(memory_error(Code::BAD_IMPORT, file, "line 1: " + reason));
   }
   // Everything is parsed and checked before the first teach, so a bad line imports nothing.
@@ -116,9 +120,11 @@ Result<std::size_t, MemoryError> PerceptualMemory::import_from(const std::filesy
     std::string label;
     ViewRecord v;
     if (!parse_view(line, state_->learner->descriptor_length(), label, v, why)) {
-      return err(memory_error(Code::BAD_IMPORT, file, "line " + std::to_string(number) + ": " + why));
+      return err(
+          memory_error(Code::BAD_IMPORT, file, "line " + std::to_string(number) + ": " + why));
     }
-    auto g = std::find_if(groups.begin(), groups.end(), [&](const ImportGroup& e) { return e.label == label; });
+    auto g = std::find_if(groups.begin(), groups.end(),
+                          [&](const ImportGroup& e) { return e.label == label; });
     if (g == groups.end()) { g = groups.insert(groups.end(), ImportGroup{label, {}}); }
     g->views.push_back(std::move(v));
     ++count;

@@ -1,5 +1,5 @@
-// teach / correct / forget of the perceptual memory: one synced leveldb::WriteBatch per call, and the
-// learner is updated only after that write returned (acknowledged = durable, docs/LEARNING.md).
+// teach / correct / forget of the perceptual memory: one synced leveldb::WriteBatch per call, and
+// the learner is updated only after that write returned (acknowledged = durable, docs/LEARNING.md).
 #include <leveldb/write_batch.h>
 
 #include <algorithm>
@@ -12,58 +12,76 @@ namespace {
 
 using Code = MemoryError::Code;
 
-Result<void, MemoryError> write_synced(PerceptualMemory::State& s, leveldb::WriteBatch& batch, const std::string& what) {
+Result<void, MemoryError> write_synced(PerceptualMemory::State& s, leveldb::WriteBatch& batch,
+                                       const std::string& what) {
   leveldb::WriteOptions sync;
   sync.sync = true;  // fsync before returning: a crash after this point cannot lose the batch
   const leveldb::Status st = s.db->Write(sync, &batch);
-  if (!st.ok()) { return err(memory_error(Code::WRITE_FAILED, s.dir, what + ": " + st.ToString())); }
+  if (!st.ok()) {
+    return err(memory_error(Code::WRITE_FAILED, s.dir, what + ": " + st.ToString()));
+  }
   ++s.writes;
   return {};
 }
 
-// Every check the learner would make, done before anything is written, so a refused teach leaves both the
-// store and the learner untouched.
-Result<std::vector<float>, MemoryError> checked_values(const PerceptualMemory::State& s, std::string_view label,
+// Every check the learner would make, done before anything is written, so a refused teach leaves
+// both the store and the learner untouched.
+Result<std::vector<float>, MemoryError> checked_values(const PerceptualMemory::State& s,
+                                                       std::string_view label,
                                                        std::span<const ViewRecord> views) {
   const std::string what = "teach \"" + std::string(label.substr(0, LABEL_MAX_BYTES)) + "\"";
-  if (auto r = validate_label(label); !r) { return err(memory_error(Code::REJECTED, s.dir, what + ": " + to_string(r.error()))); }
+  if (auto r = validate_label(label); !r) {
+    return err(memory_error(Code::REJECTED, s.dir, what + ": " + to_string(r.error())));
+  }
   const std::size_t length = s.learner->descriptor_length();
   std::vector<float> flat;
   for (std::size_t v = 0; v < views.size(); ++v) {
     const auto& d = views[v].descriptor;
     if (auto r = validate_batch(DescriptorBatch{d, length}, length, true); !r) {
-      return err(memory_error(Code::REJECTED, s.dir, what + ": view " + std::to_string(v) + ": " + to_string(r.error()) +
-                                                         " (" + std::to_string(d.size()) + " values, expected " +
-                                                         std::to_string(length) + ")"));
+      return err(memory_error(Code::REJECTED, s.dir,
+                              what + ": view " + std::to_string(v) + ": " + to_string(r.error()) +
+                                  " (" + std::to_string(d.size()) + " values, expected " +
+                                  std::to_string(length) + ")"));
     }
     flat.insert(flat.end(), d.begin(), d.end());
   }
-  if (flat.empty()) { return err(memory_error(Code::REJECTED, s.dir, what + ": " + to_string(LearnError::NO_VIEWS))); }
+  if (flat.empty()) {
+    return err(memory_error(Code::REJECTED, s.dir, what + ": " + to_string(LearnError::NO_VIEWS)));
+  }
   return flat;
 }
 
 }  // namespace
 
-Result<CategoryId, MemoryError> PerceptualMemory::teach(std::string_view label, std::span<const ViewRecord> views) {
+Result<CategoryId, MemoryError> PerceptualMemory::teach(std::string_view label,
+                                                        std::span<const ViewRecord> views) {
   State& s = *state_;
   auto flat_result = checked_values(s, label, views);
   if (!flat_result) { return err(flat_result.error()); }
   const std::size_t length = s.learner->descriptor_length();
   const IndexedCategory* existing = s.find(label);
-  IndexedCategory next = existing != nullptr ? *existing : IndexedCategory{s.next_id, {0, 0, std::string(label)}, {0, {}}};
+  IndexedCategory next = existing != nullptr
+                             ? *existing
+                             : IndexedCategory{s.next_id, {0, 0, std::string(label)}, {0, {}}};
   if (next.model.sums.empty()) { next.model.sums.assign(length, 0.0); }
   leveldb::WriteBatch batch;
-  for (const ViewRecord& v : views) { batch.Put(view_key(next.id, next.record.next_seq++), encode_view(v, s.cfg.descriptor)); }
+  for (const ViewRecord& v : views) {
+    batch.Put(view_key(next.id, next.record.next_seq++), encode_view(v, s.cfg.descriptor));
+  }
   next.record.views += static_cast<std::uint32_t>(views.size());
-  // Thesis Bayes update a_k <- a_k + x' in the same batch as the views, so model and views never disagree.
+  // Thesis Bayes update a_k <- a_k + x' in the same batch as the views, so model and views never
+  // disagree.
   const DescriptorBatch batch_views{*flat_result, length};
   accumulate_views(batch_views, next.model.sums);
   next.model.seen += views.size();
   batch.Put(category_key(KIND_CATEGORY, next.id), encode_category(next.record));
   batch.Put(category_key(KIND_MODEL, next.id), encode_model(next.model));
   if (existing == nullptr) { batch.Put(std::string(KEY_NEXT_ID), encode_u32(s.next_id + 1)); }
-  if (auto r = write_synced(s, batch, "teach \"" + std::string(label) + "\""); !r) { return err(r.error()); }
-  // Durable from here on: update the index, then the learner (which publishes the snapshot for ask()).
+  if (auto r = write_synced(s, batch, "teach \"" + std::string(label) + "\""); !r) {
+    return err(r.error());
+  }
+  // Durable from here on: update the index, then the learner (which publishes the snapshot for
+  // ask()).
   if (existing == nullptr) {
     ++s.next_id;
     s.index.push_back(next);
@@ -71,11 +89,13 @@ Result<CategoryId, MemoryError> PerceptualMemory::teach(std::string_view label, 
     *s.find(label) = next;
   }
   const auto learned = s.learner->teach(label, batch_views);
-  OF_ENFORCE(learned.has_value() && *learned == next.id, "learner and memory disagree on a category id");
+  OF_ENFORCE(learned.has_value() && *learned == next.id,
+             "learner and memory disagree on a category id");
   return next.id;
 }
 
-Result<CategoryId, MemoryError> PerceptualMemory::correct(std::string_view label, const ViewRecord& view) {
+Result<CategoryId, MemoryError> PerceptualMemory::correct(std::string_view label,
+                                                          const ViewRecord& view) {
   return teach(label, std::span<const ViewRecord>(&view, 1));
 }
 
@@ -83,17 +103,23 @@ Result<void, MemoryError> PerceptualMemory::forget(std::string_view label) {
   State& s = *state_;
   const IndexedCategory* c = s.find(label);
   if (c == nullptr) {
-    return err(memory_error(Code::UNKNOWN_LABEL, s.dir, "forget \"" + std::string(label) + "\": no such category"));
+    return err(memory_error(Code::UNKNOWN_LABEL, s.dir,
+                            "forget \"" + std::string(label) + "\": no such category"));
   }
   leveldb::WriteBatch batch;
   const std::string prefix = category_key(KIND_VIEW, c->id);
   std::unique_ptr<leveldb::Iterator> it(s.db->NewIterator(leveldb::ReadOptions()));
-  for (it->Seek(prefix); it->Valid() && it->key().starts_with(prefix); it->Next()) { batch.Delete(it->key()); }
+  for (it->Seek(prefix); it->Valid() && it->key().starts_with(prefix); it->Next()) {
+    batch.Delete(it->key());
+  }
   batch.Delete(category_key(KIND_CATEGORY, c->id));
   batch.Delete(category_key(KIND_MODEL, c->id));
-  if (auto r = write_synced(s, batch, "forget \"" + std::string(label) + "\""); !r) { return err(r.error()); }
+  if (auto r = write_synced(s, batch, "forget \"" + std::string(label) + "\""); !r) {
+    return err(r.error());
+  }
   const CategoryId id = c->id;
-  s.index.erase(std::remove_if(s.index.begin(), s.index.end(), [id](const IndexedCategory& e) { return e.id == id; }),
+  s.index.erase(std::remove_if(s.index.begin(), s.index.end(),
+                               [id](const IndexedCategory& e) { return e.id == id; }),
                 s.index.end());
   OF_ENFORCE(s.learner->forget(label).has_value(), "learner lost a category the memory holds");
   return {};

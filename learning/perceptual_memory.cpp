@@ -29,7 +29,9 @@ Result<void, MemoryError> check_schema(PerceptualMemory::State& s) {
     leveldb::WriteBatch batch;
     batch.Put(std::string(KEY_SCHEMA), encode_schema(s.cfg.descriptor));
     batch.Put(std::string(KEY_NEXT_ID), encode_u32(0));
-    if (!s.db->Write(sync, &batch).ok()) { return err(memory_error(Code::WRITE_FAILED, s.dir, "cannot write the schema key")); }
+    if (!s.db->Write(sync, &batch).ok()) {
+      return err(memory_error(Code::WRITE_FAILED, s.dir, "cannot write the schema key"));
+    }
     return {};
   }
   if (!st.ok()) { return err(memory_error(Code::CORRUPT, s.dir, "schema key: " + st.ToString())); }
@@ -37,11 +39,14 @@ Result<void, MemoryError> check_schema(PerceptualMemory::State& s) {
   std::string why;
   const auto stored = decode_schema(value, version, why);
   if (!stored || version != MEMORY_SCHEMA_VERSION) {
-    return err(memory_error(Code::CORRUPT, s.dir, "schema key: " + (stored ? "version " + std::to_string(version) : why)));
+    return err(
+        memory_error(Code::CORRUPT, s.dir,
+                     "schema key: " + (stored ? "version " + std::to_string(version) : why)));
   }
   if (!(*stored == s.cfg.descriptor)) {
     return err(memory_error(Code::PARAMS_MISMATCH, s.dir,
-                            "store was created with " + stored->describe() + ", opened with " + s.cfg.descriptor.describe()));
+                            "store was created with " + stored->describe() + ", opened with " +
+                                s.cfg.descriptor.describe()));
   }
   return {};
 }
@@ -49,68 +54,94 @@ Result<void, MemoryError> check_schema(PerceptualMemory::State& s) {
 // Reads every "c", "m" and "v" record in key order and hands the categories to the learner.
 Result<void, MemoryError> load(PerceptualMemory::State& s) {
   std::string next;
-  if (!s.db->Get(leveldb::ReadOptions(), std::string(KEY_NEXT_ID), &next).ok() || !decode_u32(next)) {
+  if (!s.db->Get(leveldb::ReadOptions(), std::string(KEY_NEXT_ID), &next).ok() ||
+      !decode_u32(next)) {
     return err(memory_error(Code::CORRUPT, s.dir, "next-id key missing or malformed"));
   }
   s.next_id = *decode_u32(next);
   std::vector<std::vector<float>> values;
   std::unique_ptr<leveldb::Iterator> it(s.db->NewIterator(leveldb::ReadOptions()));
-  for (it->Seek(std::string(1, KIND_CATEGORY)); it->Valid() && it->key().size() > 0 && it->key()[0] == KIND_CATEGORY; it->Next()) {
+  for (it->Seek(std::string(1, KIND_CATEGORY));
+       it->Valid() && it->key().size() > 0 && it->key()[0] == KIND_CATEGORY; it->Next()) {
     const auto id = key_category(as_view(it->key()));
     auto rec = decode_category(as_view(it->value()));
     std::string model_bytes;
-    const bool has_model = s.db->Get(leveldb::ReadOptions(), category_key(KIND_MODEL, id.value_or(0)), &model_bytes).ok();
+    const bool has_model =
+        s.db->Get(leveldb::ReadOptions(), category_key(KIND_MODEL, id.value_or(0)), &model_bytes)
+            .ok();
     auto model = has_model ? decode_model(model_bytes) : std::nullopt;
-    if (!id || !rec || !model) { return err(memory_error(Code::CORRUPT, s.dir, "category record or model malformed")); }
+    if (!id || !rec || !model) {
+      return err(memory_error(Code::CORRUPT, s.dir, "category record or model malformed"));
+    }
     s.index.push_back(IndexedCategory{*id, std::move(*rec), std::move(*model)});
   }
   for (IndexedCategory& c : s.index) {
     auto views_result = PerceptualMemory::State::read_views(s, c.id);
     if (!views_result) { return err(views_result.error()); }
     std::vector<float>& flat = values.emplace_back();
-    for (const ViewRecord& v : *views_result) { flat.insert(flat.end(), v.descriptor.begin(), v.descriptor.end()); }
-    if (views_result->size() != c.record.views || c.model.sums.size() != s.learner->descriptor_length()) {
-      return err(memory_error(Code::CORRUPT, s.dir, "category " + std::to_string(c.id) + " (" + c.record.label +
-                                                        "): view count or model length disagrees with its record"));
+    for (const ViewRecord& v : *views_result) {
+      flat.insert(flat.end(), v.descriptor.begin(), v.descriptor.end());
+    }
+    if (views_result->size() != c.record.views ||
+        c.model.sums.size() != s.learner->descriptor_length()) {
+      return err(memory_error(Code::CORRUPT, s.dir,
+                              "category " + std::to_string(c.id) + " (" + c.record.label +
+                                  "): view count or model length disagrees with its record"));
     }
   }
   std::vector<RestoredCategory> restored;
   for (std::size_t k = 0; k < s.index.size(); ++k) {
     const IndexedCategory& c = s.index[k];
-    restored.push_back(RestoredCategory{c.id, c.record.label, DescriptorBatch{values[k], s.learner->descriptor_length()},
+    restored.push_back(RestoredCategory{c.id, c.record.label,
+                                        DescriptorBatch{values[k], s.learner->descriptor_length()},
                                         c.model.sums, c.model.seen});
   }
   if (auto r = s.learner->restore(restored, s.next_id); !r) {
-    return err(memory_error(Code::CORRUPT, s.dir, std::string("stored categories refused: ") + to_string(r.error())));
+    return err(memory_error(Code::CORRUPT, s.dir,
+                            std::string("stored categories refused: ") + to_string(r.error())));
   }
   return {};
 }
 
 }  // namespace
 
-MemoryError memory_error(MemoryError::Code code, const std::filesystem::path& where, const std::string& what) {
+MemoryError memory_error(MemoryError::Code code, const std::filesystem::path& where,
+                         const std::string& what) {
   return MemoryError{code, where.string() + ": " + what};
 }
 
-const char* to_string(LearnerKind kind) noexcept { return kind == LearnerKind::BAYES ? "bayes" : "instance"; }
+const char* to_string(LearnerKind kind) noexcept {
+  return kind == LearnerKind::BAYES ? "bayes" : "instance";
+}
 
 const char* to_string(MemoryError::Code code) noexcept {
   switch (code) {
-    case Code::OPEN_FAILED: return "open_failed";
-    case Code::PARAMS_MISMATCH: return "params_mismatch";
-    case Code::CORRUPT: return "corrupt";
-    case Code::WRITE_FAILED: return "write_failed";
-    case Code::REJECTED: return "rejected";
-    case Code::UNKNOWN_LABEL: return "unknown_label";
-    case Code::FILE_FAILED: return "file_failed";
-    case Code::BAD_IMPORT: return "bad_import";
+    case Code::OPEN_FAILED:
+      return "open_failed";
+    case Code::PARAMS_MISMATCH:
+      return "params_mismatch";
+    case Code::CORRUPT:
+      return "corrupt";
+    case Code::WRITE_FAILED:
+      return "write_failed";
+    case Code::REJECTED:
+      return "rejected";
+    case Code::UNKNOWN_LABEL:
+      return "unknown_label";
+    case Code::FILE_FAILED:
+      return "file_failed";
+    case Code::BAD_IMPORT:
+      return "bad_import";
   }
   return "unknown";
 }
 
-std::string MemoryError::to_string() const { return std::string(learning::to_string(code)) + ": " + message; }
+std::string MemoryError::to_string() const {
+  return std::string(learning::to_string(code)) + ": " + message;
+}
 
-Result<std::vector<ViewRecord>, MemoryError> PerceptualMemory::State::read_views(State& s, CategoryId id) {
+Result<std::vector<ViewRecord>, MemoryError> PerceptualMemory::State::read_views(State& s,
+                                                                                 CategoryId id) {
   std::vector<ViewRecord> out;
   const std::string prefix = category_key(KIND_VIEW, id);
   std::unique_ptr<leveldb::Iterator> it(s.db->NewIterator(leveldb::ReadOptions()));
@@ -118,22 +149,28 @@ Result<std::vector<ViewRecord>, MemoryError> PerceptualMemory::State::read_views
     std::string why;
     auto view = decode_view(as_view(it->value()), s.cfg.descriptor, why);
     if (!view) {
-      return err(memory_error(Code::CORRUPT, s.dir, "category " + std::to_string(id) + " view " +
-                                                        std::to_string(out.size()) + ": " + why));
+      return err(memory_error(
+          Code::CORRUPT, s.dir,
+          "category " + std::to_string(id) + " view " + std::to_string(out.size()) + ": " + why));
     }
     out.push_back(std::move(*view));
   }
-  if (!it->status().ok()) { return err(memory_error(Code::CORRUPT, s.dir, it->status().ToString())); }
+  if (!it->status().ok()) {
+    return err(memory_error(Code::CORRUPT, s.dir, it->status().ToString()));
+  }
   return out;
 }
 
-Result<PerceptualMemory, MemoryError> PerceptualMemory::open(const std::filesystem::path& dir, const MemoryConfig& cfg) {
-  if (auto valid = cfg.descriptor.validate(); !valid) return err(memory_error(Code::OPEN_FAILED, dir, valid.error()));
+Result<PerceptualMemory, MemoryError> PerceptualMemory::open(const std::filesystem::path& dir,
+                                                             const MemoryConfig& cfg) {
+  if (auto valid = cfg.descriptor.validate(); !valid)
+    return err(memory_error(Code::OPEN_FAILED, dir, valid.error()));
   auto s = std::make_unique<State>();
   s->dir = dir;
   s->cfg = cfg;
   s->learner = make_learner(s->cfg);
-  std::error_code ignored;  // LevelDB creates only the last path component; a failure shows up in Open below
+  std::error_code
+      ignored;  // LevelDB creates only the last path component; a failure shows up in Open below
   std::filesystem::create_directories(dir, ignored);
   leveldb::Options options;
   options.create_if_missing = true;
@@ -141,7 +178,8 @@ Result<PerceptualMemory, MemoryError> PerceptualMemory::open(const std::filesyst
   leveldb::DB* raw = nullptr;
   const leveldb::Status st = leveldb::DB::Open(options, dir.string(), &raw);
   if (!st.ok()) {
-    return err(memory_error(st.IsCorruption() ? Code::CORRUPT : Code::OPEN_FAILED, dir, st.ToString()));
+    return err(
+        memory_error(st.IsCorruption() ? Code::CORRUPT : Code::OPEN_FAILED, dir, st.ToString()));
   }
   s->db.reset(raw);
   if (auto r = check_schema(*s); !r) { return err(r.error()); }
@@ -149,7 +187,8 @@ Result<PerceptualMemory, MemoryError> PerceptualMemory::open(const std::filesyst
   return PerceptualMemory(std::move(s));
 }
 
-PerceptualMemory::PerceptualMemory(std::unique_ptr<State> state) noexcept : state_(std::move(state)) {}
+PerceptualMemory::PerceptualMemory(std::unique_ptr<State> state) noexcept
+    : state_(std::move(state)) {}
 PerceptualMemory::PerceptualMemory(PerceptualMemory&&) noexcept = default;
 PerceptualMemory& PerceptualMemory::operator=(PerceptualMemory&&) noexcept = default;
 PerceptualMemory::~PerceptualMemory() = default;
@@ -163,7 +202,9 @@ Result<std::vector<ViewRecord>, MemoryError> PerceptualMemory::views_of(Category
 
 std::vector<CategoryEntry> PerceptualMemory::list() const {
   std::vector<CategoryEntry> out;
-  for (const IndexedCategory& c : state_->index) { out.push_back(CategoryEntry{c.id, c.record.label, c.record.views}); }
+  for (const IndexedCategory& c : state_->index) {
+    out.push_back(CategoryEntry{c.id, c.record.label, c.record.views});
+  }
   return out;
 }
 

@@ -1,10 +1,10 @@
 #pragma once
 /// @file
-/// @brief The perceptual memory (PIPELINE.md section 8): object views, descriptors and category models in
-/// LevelDB, durable across restarts and crashes, loaded into a Learner at start-up for recognition.
-/// Durability: teach/correct/forget write ONE leveldb::WriteBatch with sync=true and update the learner
-/// only after the write returned, so an acknowledged call is on disk and a crash leaves either all of a
-/// call or none of it. Schema and export format: docs/LEARNING.md.
+/// @brief The perceptual memory (PIPELINE.md section 8): object views, descriptors and category
+/// models in LevelDB, durable across restarts and crashes, loaded into a Learner at start-up for
+/// recognition. Durability: teach/correct/forget write ONE leveldb::WriteBatch with sync=true and
+/// update the learner only after the write returned, so an acknowledged call is on disk and a crash
+/// leaves either all of a call or none of it. Schema and export format: docs/LEARNING.md.
 #include <array>
 #include <cstdint>
 #include <filesystem>
@@ -29,7 +29,8 @@ enum class LearnerKind : std::uint8_t { INSTANCE, BAYES };
 
 /// @brief Plain configuration of a memory.
 struct MemoryConfig {
-  kernels::DescriptorSpec descriptor;  ///< representation; must match the store's (kind and parameters)
+  kernels::DescriptorSpec
+      descriptor;  ///< representation; must match the store's (kind and parameters)
   LearnerKind learner = LearnerKind::INSTANCE;
   InstanceConfig instance;  ///< descriptor_length is overwritten with descriptor.length()
   BayesConfig bayes;        ///< descriptor_length is overwritten with descriptor.length()
@@ -37,11 +38,11 @@ struct MemoryConfig {
 
 /// @brief One object view as stored: descriptor plus where and when it was seen.
 struct ViewRecord {
-  std::vector<float> descriptor;     ///< MemoryConfig::descriptor.length() values
-  std::array<float, 16> frame{};     ///< world -> object transform, row-major (GoodResult::frame)
-  std::array<float, 3> bbox{};       ///< object-frame box edges (GoodResult::bbox)
-  std::uint64_t track_id = 0;        ///< source track (0 = none)
-  std::int64_t stamp_ns = 0;         ///< capture time, ns
+  std::vector<float> descriptor;  ///< MemoryConfig::descriptor.length() values
+  std::array<float, 16> frame{};  ///< world -> object transform, row-major (GoodResult::frame)
+  std::array<float, 3> bbox{};    ///< object-frame box edges (GoodResult::bbox)
+  std::uint64_t track_id = 0;     ///< source track (0 = none)
+  std::int64_t stamp_ns = 0;      ///< capture time, ns
 };
 
 /// @brief What went wrong, and where.
@@ -51,13 +52,14 @@ struct MemoryError {
     PARAMS_MISMATCH,  ///< the store was created with other descriptor parameters
     CORRUPT,          ///< a record does not decode (or LevelDB reports corruption)
     WRITE_FAILED,     ///< the synced write failed: nothing was acknowledged
-    REJECTED,         ///< the learner refused the input (bad label or descriptor): nothing was written
-    UNKNOWN_LABEL,    ///< forget of a label that is not stored
-    FILE_FAILED,      ///< an export/import file could not be opened, read or written
-    BAD_IMPORT,       ///< an import line is malformed or its parameters differ from the store's
+    REJECTED,  ///< the learner refused the input (bad label or descriptor): nothing was written
+    UNKNOWN_LABEL,  ///< forget of a label that is not stored
+    FILE_FAILED,    ///< an export/import file could not be opened, read or written
+    BAD_IMPORT,     ///< an import line is malformed or its parameters differ from the store's
   };
   Code code = Code::CORRUPT;
-  std::string message;  ///< what and where, e.g. "db/: view 3/17: descriptor has 74 values, expected 75"
+  std::string
+      message;  ///< what and where, e.g. "db/: view 3/17: descriptor has 74 values, expected 75"
   /// @brief "<code name>: <message>".
   [[nodiscard]] std::string to_string() const;
 };
@@ -81,23 +83,29 @@ struct MemoryStats {
 
 /// @brief A LevelDB-backed perceptual memory and the learner it feeds. Move-only.
 /// @note Writers (teach, correct, forget, import_from) must be serialised by the caller (one writer
-/// thread, e.g. a graph node with concurrency 1); learner().ask() may run on any thread at any time.
+/// thread, e.g. a graph node with concurrency 1); learner().ask() may run on any thread at any
+/// time.
 class PerceptualMemory {
  public:
-  /// @brief Opens (creating if missing) the store at @p dir and loads every category into the learner.
-  /// Errors: OPEN_FAILED, PARAMS_MISMATCH (message names both parameter sets), CORRUPT.
+  /// @brief Opens (creating if missing) the store at @p dir and loads every category into the
+  /// learner. Errors: OPEN_FAILED, PARAMS_MISMATCH (message names both parameter sets), CORRUPT.
   [[nodiscard]] static Result<PerceptualMemory, MemoryError> open(const std::filesystem::path& dir,
                                                                   const MemoryConfig& cfg);
   PerceptualMemory(PerceptualMemory&&) noexcept;
   PerceptualMemory& operator=(PerceptualMemory&&) noexcept;
   ~PerceptualMemory();
 
-  /// @brief Stores @p views under @p label (new category if needed), synced, then teaches the learner.
-  /// @return the category id. Errors: REJECTED (nothing written), WRITE_FAILED (nothing acknowledged).
-  [[nodiscard]] Result<CategoryId, MemoryError> teach(std::string_view label, std::span<const ViewRecord> views);
+  /// @brief Stores @p views under @p label (new category if needed), synced, then teaches the
+  /// learner.
+  /// @return the category id. Errors: REJECTED (nothing written), WRITE_FAILED (nothing
+  /// acknowledged).
+  [[nodiscard]] Result<CategoryId, MemoryError> teach(std::string_view label,
+                                                      std::span<const ViewRecord> views);
   /// @brief Stores one view after a wrong answer; same as teach() with one view.
-  [[nodiscard]] Result<CategoryId, MemoryError> correct(std::string_view label, const ViewRecord& view);
-  /// @brief Deletes a category, its views and its model, synced. Errors: UNKNOWN_LABEL, WRITE_FAILED.
+  [[nodiscard]] Result<CategoryId, MemoryError> correct(std::string_view label,
+                                                        const ViewRecord& view);
+  /// @brief Deletes a category, its views and its model, synced. Errors: UNKNOWN_LABEL,
+  /// WRITE_FAILED.
   [[nodiscard]] Result<void, MemoryError> forget(std::string_view label);
   /// @brief The stored categories by id.
   [[nodiscard]] std::vector<CategoryEntry> list() const;
@@ -106,13 +114,16 @@ class PerceptualMemory {
   [[nodiscard]] const Learner& learner() const noexcept;
   /// @brief The configuration in use (descriptor parameters as stored).
   [[nodiscard]] const MemoryConfig& config() const noexcept;
-  /// @brief Every view of category @p id, in teaching order (reads the store; not for the frame path).
+  /// @brief Every view of category @p id, in teaching order (reads the store; not for the frame
+  /// path).
   [[nodiscard]] Result<std::vector<ViewRecord>, MemoryError> views_of(CategoryId id) const;
 
-  /// @brief Writes the whole memory as JSON lines (docs/LEARNING.md) to @p file. @return views written.
+  /// @brief Writes the whole memory as JSON lines (docs/LEARNING.md) to @p file. @return views
+  /// written.
   [[nodiscard]] Result<std::size_t, MemoryError> export_to(const std::filesystem::path& file) const;
-  /// @brief Teaches every category of an export file (one synced batch per category). @return views read.
-  /// Errors: FILE_FAILED, BAD_IMPORT (line number and reason; nothing after that line is imported).
+  /// @brief Teaches every category of an export file (one synced batch per category). @return views
+  /// read. Errors: FILE_FAILED, BAD_IMPORT (line number and reason; nothing after that line is
+  /// imported).
   [[nodiscard]] Result<std::size_t, MemoryError> import_from(const std::filesystem::path& file);
 
   struct State;

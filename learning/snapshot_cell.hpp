@@ -1,11 +1,12 @@
 #pragma once
 /// @file
-/// @brief SnapshotCell<T>: one immutable T published by a writer and read without locks (RCU style with
-/// hazard slots). A reader takes a free slot (one atomic exchange), announces the pointer it is about to
-/// use in the slot and re-checks that it is still current; a writer swaps in the next snapshot, retires
-/// the old one and frees every retired snapshot that no slot announces. At most SNAPSHOT_READER_SLOTS
-/// snapshots can be pinned at once, so the retire list stays bounded (<= slots + 1 entries).
-/// Why not std::atomic<std::shared_ptr>: libstdc++ 12 implements it with an internal lock.
+/// @brief SnapshotCell<T>: one immutable T published by a writer and read without locks (RCU style
+/// with hazard slots). A reader takes a free slot (one atomic exchange), announces the pointer it
+/// is about to use in the slot and re-checks that it is still current; a writer swaps in the next
+/// snapshot, retires the old one and frees every retired snapshot that no slot announces. At most
+/// SNAPSHOT_READER_SLOTS snapshots can be pinned at once, so the retire list stays bounded (<=
+/// slots + 1 entries). Why not std::atomic<std::shared_ptr>: libstdc++ 12 implements it with an
+/// internal lock.
 #include <array>
 #include <atomic>
 #include <cstddef>
@@ -18,9 +19,9 @@ namespace orthoflow::learning {
 /// @brief Readers that can hold a snapshot at the same instant; more wait (yield) for a free slot.
 inline constexpr std::size_t SNAPSHOT_READER_SLOTS = 64;
 
-/// @brief An atomically replaced immutable value. Readers: read(). Writer: publish(), serialised by the
-/// caller (one writer at a time). @note Memory orders are seq_cst on the announce/re-check pair, which is
-/// what makes hazard pointers correct (store-load ordering).
+/// @brief An atomically replaced immutable value. Readers: read(). Writer: publish(), serialised by
+/// the caller (one writer at a time). @note Memory orders are seq_cst on the announce/re-check
+/// pair, which is what makes hazard pointers correct (store-load ordering).
 template <class T>
 class SnapshotCell {
  public:
@@ -29,7 +30,8 @@ class SnapshotCell {
    public:
     ReadGuard(const SnapshotCell* cell, std::size_t slot, const T* value) noexcept
         : cell_(cell), slot_(slot), value_(value) {}
-    ReadGuard(ReadGuard&& other) noexcept : cell_(other.cell_), slot_(other.slot_), value_(other.value_) {
+    ReadGuard(ReadGuard&& other) noexcept
+        : cell_(other.cell_), slot_(other.slot_), value_(other.value_) {
       other.cell_ = nullptr;
     }
     ReadGuard(const ReadGuard&) = delete;
@@ -75,15 +77,20 @@ class SnapshotCell {
   }
 
   /// @brief The current snapshot, for the (single, serialised) writer that is about to replace it.
-  [[nodiscard]] const T& writer_view() const noexcept { return *current_.load(std::memory_order_acquire); }
+  [[nodiscard]] const T& writer_view() const noexcept {
+    return *current_.load(std::memory_order_acquire);
+  }
 
-  /// @brief Makes @p next current (visible to every read() that starts after this returns) and frees the
-  /// retired snapshots no reader holds. @pre next != nullptr; writers serialised by the caller.
+  /// @brief Makes @p next current (visible to every read() that starts after this returns) and
+  /// frees the retired snapshots no reader holds. @pre next != nullptr; writers serialised by the
+  /// caller.
   void publish(std::unique_ptr<const T> next) {
     const T* old = current_.exchange(next.release(), std::memory_order_seq_cst);
     retired_.push_back(old);
     std::array<const T*, SNAPSHOT_READER_SLOTS> pinned{};
-    for (std::size_t s = 0; s < SNAPSHOT_READER_SLOTS; ++s) { pinned[s] = slots_[s].hazard.load(std::memory_order_seq_cst); }
+    for (std::size_t s = 0; s < SNAPSHOT_READER_SLOTS; ++s) {
+      pinned[s] = slots_[s].hazard.load(std::memory_order_seq_cst);
+    }
     std::size_t kept = 0;
     for (const T* candidate : retired_) {
       bool in_use = false;
@@ -99,7 +106,9 @@ class SnapshotCell {
   }
 
   /// @brief Retired snapshots still pinned by a reader after the last publish(). @note Thread-safe.
-  [[nodiscard]] std::size_t retired_pending() const noexcept { return retired_count_.load(std::memory_order_relaxed); }
+  [[nodiscard]] std::size_t retired_pending() const noexcept {
+    return retired_count_.load(std::memory_order_relaxed);
+  }
 
  private:
   struct alignas(64) Slot {
@@ -116,7 +125,8 @@ class SnapshotCell {
           return s;
         }
       }
-      std::this_thread::yield();  // more than SNAPSHOT_READER_SLOTS concurrent readers: wait for one to leave
+      std::this_thread::yield();  // more than SNAPSHOT_READER_SLOTS concurrent readers: wait for
+                                  // one to leave
     }
   }
   void release(std::size_t slot) const noexcept {

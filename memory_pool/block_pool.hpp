@@ -1,7 +1,8 @@
 #pragma once
 /// @file
-/// @brief BlockPool: fixed-size blocks carved once from caller-provided memory, handed out lock-free
-/// through reference-counted BlockHandles (STYLE rule 8; iceoryx mepoo MemPool is the model).
+/// @brief BlockPool: fixed-size blocks carved once from caller-provided memory, handed out
+/// lock-free through reference-counted BlockHandles (STYLE rule 8; iceoryx mepoo MemPool is the
+/// model).
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
@@ -23,7 +24,8 @@ struct PoolConfig {
 
 /// @brief Upper bound on blocks per pool (indices are 32-bit, the free-list head is tagged).
 inline constexpr std::size_t MAX_BLOCKS = std::size_t{1} << 24;
-/// @brief Upper bound on one block (1 GiB): larger requests are configuration errors, not allocations.
+/// @brief Upper bound on one block (1 GiB): larger requests are configuration errors, not
+/// allocations.
 inline constexpr std::size_t MAX_BLOCK_BYTES = std::size_t{1} << 30;
 
 /// @brief Why a pool could not be created or a block could not be handed out.
@@ -84,22 +86,26 @@ class BlockPool {
  public:
   /// @brief Carves a pool out of `memory`, which must hold required_bytes(config) bytes and be
   /// 64-byte aligned; the caller keeps it alive (heap, shared memory, iceoryx chunk...).
-  [[nodiscard]] static Result<std::unique_ptr<BlockPool>, PoolError> create(const PoolConfig& config,
-                                                                            std::span<std::byte> memory);
+  [[nodiscard]] static Result<std::unique_ptr<BlockPool>, PoolError> create(
+      const PoolConfig& config, std::span<std::byte> memory);
   /// @brief Same, but the pool allocates (once, now) and owns its memory.
-  [[nodiscard]] static Result<std::unique_ptr<BlockPool>, PoolError> create_owned(const PoolConfig& config);
+  [[nodiscard]] static Result<std::unique_ptr<BlockPool>, PoolError> create_owned(
+      const PoolConfig& config);
   ~BlockPool();
   BlockPool(const BlockPool&) = delete;
   BlockPool& operator=(const BlockPool&) = delete;
 
   /// @brief Takes a free block able to hold `bytes`. @return EXHAUSTED or TOO_LARGE naming
   /// `requester` and `bytes` on failure. Lock-free, no allocation.
-  [[nodiscard]] Result<BlockHandle, PoolError> acquire(std::string_view requester, std::size_t bytes) noexcept;
+  [[nodiscard]] Result<BlockHandle, PoolError> acquire(std::string_view requester,
+                                                       std::size_t bytes) noexcept;
 
   [[nodiscard]] std::size_t block_bytes() const noexcept { return block_bytes_; }
   [[nodiscard]] std::size_t block_count() const noexcept { return block_count_; }
   /// @brief Blocks currently free (exact when no other thread is acquiring/releasing).
-  [[nodiscard]] std::size_t free_count() const noexcept { return free_count_.load(std::memory_order_relaxed); }
+  [[nodiscard]] std::size_t free_count() const noexcept {
+    return free_count_.load(std::memory_order_relaxed);
+  }
   [[nodiscard]] std::string_view name() const noexcept { return name_; }
 
  private:

@@ -9,7 +9,7 @@ PACKAGES=(
   liblzf-dev libcairo2-dev libleveldb-dev libusb-1.0-0-dev
   iceoryx libiceoryx-posh-dev libiceoryx-hoofs-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  clang-14 libclang-rt-14-dev
+  clang-14 libclang-rt-14-dev clang-format-14
   libpcl-dev
 )
 

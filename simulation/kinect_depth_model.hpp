@@ -1,8 +1,8 @@
 #pragma once
 /// @file
 /// @brief The Kinect v1 depth camera as a measurement model: intrinsics, the 11-bit disparity
-/// ("raw") to millimetre conversion of libfreenect's registration.c (specs/KINECT_V1.md section 8.2),
-/// its inverse, and the noise model used by the synthetic scenes.
+/// ("raw") to millimetre conversion of libfreenect's registration.c (specs/KINECT_V1.md
+/// section 8.2), its inverse, and the noise model used by the synthetic scenes.
 ///
 /// Noise: Gaussian noise of sigma_raw (default 0.5 disparity units) is added to the continuous
 /// disparity, which is then rounded to an integer. Because dZ/draw grows with Z^2, the depth noise
@@ -13,7 +13,8 @@
 
 namespace orthoflow::simulation {
 
-/// @brief Pinhole intrinsics of the 640x480 depth image (libfreenect's defaults, f = ref_dist / (2 ref_pix)).
+/// @brief Pinhole intrinsics of the 640x480 depth image (libfreenect's defaults, f = ref_dist / (2
+/// ref_pix)).
 struct DepthIntrinsics {
   double fx = 575.8;
   double fy = 575.8;
@@ -25,19 +26,20 @@ struct DepthIntrinsics {
 
 /// @brief The device parameters the raw-to-depth formula needs (typical values from KINECT_V1.md).
 struct KinectDepthParams {
-  double const_shift = 200.0;      ///< zero-plane shift
-  double ref_dist_mm = 120.0;      ///< reference distance
-  double ref_pix_mm = 0.1042;      ///< reference pixel size
-  double emitter_dist_cm = 7.5;    ///< dcmos_emitter_dist: the projector-camera baseline
-  double sigma_raw = 0.5;          ///< disparity noise (raw units) before rounding
-  double min_range_m = 0.5;        ///< nearer returns are invalid
-  double max_range_m = 4.0;        ///< farther returns are invalid
+  double const_shift = 200.0;    ///< zero-plane shift
+  double ref_dist_mm = 120.0;    ///< reference distance
+  double ref_pix_mm = 0.1042;    ///< reference pixel size
+  double emitter_dist_cm = 7.5;  ///< dcmos_emitter_dist: the projector-camera baseline
+  double sigma_raw = 0.5;        ///< disparity noise (raw units) before rounding
+  double min_range_m = 0.5;      ///< nearer returns are invalid
+  double max_range_m = 4.0;      ///< farther returns are invalid
 };
 
 /// @brief Raw value meaning "no reading".
 inline constexpr std::uint16_t KINECT_NO_READING = 2047;
 
-/// @brief Depth in metres of a raw disparity by registration.c's formula; 0 for 2047 and past the pole.
+/// @brief Depth in metres of a raw disparity by registration.c's formula; 0 for 2047 and past the
+/// pole.
 [[nodiscard]] double raw_to_depth_m(double raw, const KinectDepthParams& p) noexcept;
 
 /// @brief The continuous raw disparity that gives @p depth_m (inverse of raw_to_depth_m).
@@ -47,8 +49,8 @@ inline constexpr std::uint16_t KINECT_NO_READING = 2047;
 /// quantisation step, z^2 ref_pix / (4 * 10 ref_dist * baseline) (1000 mm/m folded in).
 [[nodiscard]] double depth_step_m(double depth_m, const KinectDepthParams& p) noexcept;
 
-/// @brief Hard bound on |measured - true| depth at @p depth_m for the synthetic noise: the normal draw
-/// is an Irwin-Hall sum cut at 6 sigma, plus half a step of rounding.
+/// @brief Hard bound on |measured - true| depth at @p depth_m for the synthetic noise: the normal
+/// draw is an Irwin-Hall sum cut at 6 sigma, plus half a step of rounding.
 [[nodiscard]] double depth_error_bound_m(double depth_m, const KinectDepthParams& p) noexcept;
 
 /// @brief The 2048-entry lookup table raw -> metres (entry 2047 and past-the-pole entries are 0).

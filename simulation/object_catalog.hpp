@@ -16,9 +16,33 @@ namespace orthoflow::simulation {
 /// @brief Object categories. Ids are stable: new categories are only ever appended.
 enum class Category : std::uint8_t {
   // The tabletop scene set (SCENE_CATEGORY_COUNT): the thesis's restaurant objects, boxes and cans.
-  BOTTLE, BOWL, FLASK, FORK, KNIFE, MUG, PLATE, SPOON, TEAPOT, VASE, BOX, CAN,
+  BOTTLE,
+  BOWL,
+  FLASK,
+  FORK,
+  KNIFE,
+  MUG,
+  PLATE,
+  SPOON,
+  TEAPOT,
+  VASE,
+  BOX,
+  CAN,
   // Household objects added for the object-view dataset (issue 8: at least 20 categories).
-  GLASS, WINE_GLASS, JUG, POT, PAN, BALL, BOOK, CEREAL_BOX, JAR, FUNNEL, BUCKET, TRAY, REMOTE, CANDLE
+  GLASS,
+  WINE_GLASS,
+  JUG,
+  POT,
+  PAN,
+  BALL,
+  BOOK,
+  CEREAL_BOX,
+  JAR,
+  FUNNEL,
+  BUCKET,
+  TRAY,
+  REMOTE,
+  CANDLE
 };
 /// @brief Every category: the object-view dataset's default and the names category_from_name knows.
 inline constexpr std::size_t CATEGORY_COUNT = 26;

@@ -5,9 +5,9 @@
 /// object-view evaluation, issue 8).
 #include <cmath>
 
-#include "simulation/object_catalog.hpp"
-#include "core/rng.hpp"
 #include "core/assert.hpp"
+#include "core/rng.hpp"
+#include "simulation/object_catalog.hpp"
 
 namespace orthoflow::simulation {
 
@@ -20,11 +20,13 @@ struct ObjectBuilder {
     OF_ENFORCE(m.part_count < MAX_PRIMITIVES, "object recipe: more than MAX_PRIMITIVES parts");
     m.parts[m.part_count++] = p;
   }
-  /// @brief A frustum standing on the axis at height @p z: radii @p r0 (bottom), @p r1 (top), height @p h.
+  /// @brief A frustum standing on the axis at height @p z: radii @p r0 (bottom), @p r1 (top),
+  /// height @p h.
   void frustum(double z, double r0, double r1, double h, bool open_top = false) {
     add(Primitive{PrimitiveKind::FRUSTUM, {0, 0, z}, {r0, r1, h}, open_top});
   }
-  /// @brief An ellipsoid, only its part with z in [@p clip_min, @p clip_max] (an open shell when clipped).
+  /// @brief An ellipsoid, only its part with z in [@p clip_min, @p clip_max] (an open shell when
+  /// clipped).
   void ellipsoid(Vec3 c, Vec3 radii, double clip_min = -1e9, double clip_max = 1e9) {
     add(Primitive{PrimitiveKind::ELLIPSOID, c, radii, false, clip_min, clip_max});
   }
@@ -35,7 +37,8 @@ struct ObjectBuilder {
   void arc(Vec3 c, double radius, double tube, double from, double to, int n) {
     for (int i = 0; i < n; ++i) {
       const double a = from + (to - from) * i / (n - 1);
-      ellipsoid({c[0] + radius * std::sin(a), c[1], c[2] + radius * std::cos(a)}, {tube, tube, tube});
+      ellipsoid({c[0] + radius * std::sin(a), c[1], c[2] + radius * std::cos(a)},
+                {tube, tube, tube});
     }
   }
 };

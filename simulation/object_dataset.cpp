@@ -3,9 +3,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <utility>
 #include <cstdio>
 #include <system_error>
+#include <utility>
 
 #include "formats/pcd_io.hpp"
 
@@ -26,7 +26,8 @@ std::uint64_t mix(std::uint64_t h, std::uint64_t v) {
   return h ^ (h >> 31);
 }
 
-std::uint64_t view_seed(const DatasetConfig& c, Category cat, std::uint32_t i, std::uint32_t v, std::uint32_t a) {
+std::uint64_t view_seed(const DatasetConfig& c, Category cat, std::uint32_t i, std::uint32_t v,
+                        std::uint32_t a) {
   return mix(mix(mix(mix(c.seed, static_cast<std::uint64_t>(cat)), i), v), a);
 }
 
@@ -34,10 +35,12 @@ Result<void, DatasetError> validate(const DatasetConfig& c) {
   std::string what;
   if (c.instances == 0 || c.instances > MAX_INSTANCES) { what = "instances must be in 1..1000"; }
   if (c.views == 0 || c.views > MAX_VIEWS) { what = "views must be in 1..10000"; }
-  if (!(c.min_elevation_deg >= 5.0 && c.min_elevation_deg <= c.max_elevation_deg && c.max_elevation_deg <= 90.0)) {
+  if (!(c.min_elevation_deg >= 5.0 && c.min_elevation_deg <= c.max_elevation_deg &&
+        c.max_elevation_deg <= 90.0)) {
     what = "elevation range must satisfy 5 <= min <= max <= 90 degrees";
   }
-  if (!(c.min_distance_m >= 0.5 && c.min_distance_m <= c.max_distance_m && c.max_distance_m <= 3.5)) {
+  if (!(c.min_distance_m >= 0.5 && c.min_distance_m <= c.max_distance_m &&
+        c.max_distance_m <= 3.5)) {
     what = "distance range must satisfy 0.5 <= min <= max <= 3.5 m";
   }
   if (what.empty()) { return {}; }
@@ -62,7 +65,8 @@ DepthIntrinsics object_window(const Scene& scene, const DepthIntrinsics& in) {
     }
     const double first = std::clamp(std::floor(lo), 0.0, static_cast<double>(size));
     const double last = std::clamp(std::ceil(hi) + 1.0, 0.0, static_cast<double>(size));
-    return std::pair<std::uint32_t, std::uint32_t>{static_cast<std::uint32_t>(first), static_cast<std::uint32_t>(last)};
+    return std::pair<std::uint32_t, std::uint32_t>{static_cast<std::uint32_t>(first),
+                                                   static_cast<std::uint32_t>(last)};
   };
   const auto [u0, u1] = span(c[0], in.fx, in.cx, in.width);
   const auto [v0, v1] = span(c[1], in.fy, in.cy, in.height);
@@ -91,11 +95,15 @@ struct DatasetWriter {
     const std::filesystem::path path = dir / dataset_view_path(model.category, model.instance, v);
     const std::size_t n = render_view(config, model, v, frame, view);
     if (n < MIN_VIEW_POINTS) {
-      return err(DatasetError{DatasetError::Code::EMPTY_VIEW, path.string() + ": object not visible from any viewpoint"});
+      return err(DatasetError{DatasetError::Code::EMPTY_VIEW,
+                              path.string() + ": object not visible from any viewpoint"});
     }
     std::error_code ec;
     std::filesystem::create_directories(path.parent_path(), ec);
-    if (ec) { return err(DatasetError{DatasetError::Code::WRITE_FAILED, path.parent_path().string() + ": " + ec.message()}); }
+    if (ec) {
+      return err(DatasetError{DatasetError::Code::WRITE_FAILED,
+                              path.parent_path().string() + ": " + ec.message()});
+    }
     view.info.frame_id = v;
     if (auto written = formats::write_pcd(view, path); !written) {
       return err(DatasetError{DatasetError::Code::WRITE_FAILED, written.error().to_string()});
@@ -114,8 +122,9 @@ std::string DatasetError::to_string() const {
   return std::string(NAMES[static_cast<std::size_t>(code)]) + ": " + message;
 }
 
-std::size_t render_object_view(const ObjectModel& model, const ViewSpec& view, const RenderOptions& options,
-                               core::Rng& rng, kernels::PointCloud& frame, kernels::PointCloud& out) {
+std::size_t render_object_view(const ObjectModel& model, const ViewSpec& view,
+                               const RenderOptions& options, core::Rng& rng,
+                               kernels::PointCloud& frame, kernels::PointCloud& out) {
   Scene scene;
   scene.table = TableSpec{view.distance_m, view.elevation_rad, TABLE_SIZE_M, TABLE_SIZE_M, 0.0};
   scene.objects.push_back(PlacedObject{model, 0.0, 0.0, view.azimuth_rad});
@@ -144,8 +153,8 @@ std::size_t render_object_view(const ObjectModel& model, const ViewSpec& view, c
   return n;
 }
 
-ViewSpec dataset_view(const DatasetConfig& config, Category category, std::uint32_t i, std::uint32_t v,
-                      std::uint32_t attempt) noexcept {
+ViewSpec dataset_view(const DatasetConfig& config, Category category, std::uint32_t i,
+                      std::uint32_t v, std::uint32_t attempt) noexcept {
   core::Rng r(view_seed(config, category, i, v, attempt));
   ViewSpec s;
   s.elevation_rad = r.uniform(config.min_elevation_deg, config.max_elevation_deg) * PI / 180.0;

@@ -7,17 +7,18 @@
 /// synthetic_scene.hpp, then keeps only the object's pixels (x, y, z in the sensor frame, rgb; an
 /// unorganized cloud). The camera elevation above the table is the table tilt (20-70 degrees), the
 /// azimuth is the object's yaw (all around), the distance is the depth of the table point under the
-/// object (0.6-1.5 m). Determinism: view v of instance i of category c depends only on (seed, c, i, v).
+/// object (0.6-1.5 m). Determinism: view v of instance i of category c depends only on (seed, c, i,
+/// v).
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
 #include <string>
 #include <vector>
 
+#include "core/result.hpp"
+#include "kernels/point_cloud.hpp"
 #include "simulation/object_catalog.hpp"
 #include "simulation/synthetic_scene.hpp"
-#include "kernels/point_cloud.hpp"
-#include "core/result.hpp"
 
 namespace orthoflow::simulation {
 
@@ -36,7 +37,7 @@ struct DatasetConfig {
   std::uint64_t seed = 1;              ///< picks the instances' shapes, the views and the noise
   double min_elevation_deg = 20.0, max_elevation_deg = 70.0;
   double min_distance_m = 0.6, max_distance_m = 1.5;
-  RenderOptions render{};              ///< sensor model (e.g. a smaller image for quick tests)
+  RenderOptions render{};  ///< sensor model (e.g. a smaller image for quick tests)
 };
 
 /// @brief Why a dataset could not be written.
@@ -60,23 +61,27 @@ struct DatasetSummary {
   std::size_t min_points = 0;  ///< fewest points in one view
 };
 
-/// @brief Renders the segmented view of @p model from @p view into @p out (unorganized x, y, z, rgb),
-/// using @p frame as scratch. Only the image window around the object's bounding sphere is ray cast
-/// (the same pixels and rays as the full image, so the points are those of a full frame; the noise
-/// draws differ). @return the number of points.
+/// @brief Renders the segmented view of @p model from @p view into @p out (unorganized x, y, z,
+/// rgb), using @p frame as scratch. Only the image window around the object's bounding sphere is
+/// ray cast (the same pixels and rays as the full image, so the points are those of a full frame;
+/// the noise draws differ). @return the number of points.
 /// @note Deterministic in @p rng's state; not thread-safe on shared arguments.
-std::size_t render_object_view(const ObjectModel& model, const ViewSpec& view, const RenderOptions& options,
-                               core::Rng& rng, kernels::PointCloud& frame, kernels::PointCloud& out);
+std::size_t render_object_view(const ObjectModel& model, const ViewSpec& view,
+                               const RenderOptions& options, core::Rng& rng,
+                               kernels::PointCloud& frame, kernels::PointCloud& out);
 
-/// @brief The seeded viewpoint of view @p v of instance @p i of @p category (within the config's ranges).
-[[nodiscard]] ViewSpec dataset_view(const DatasetConfig& config, Category category, std::uint32_t i, std::uint32_t v,
-                                    std::uint32_t attempt = 0) noexcept;
+/// @brief The seeded viewpoint of view @p v of instance @p i of @p category (within the config's
+/// ranges).
+[[nodiscard]] ViewSpec dataset_view(const DatasetConfig& config, Category category, std::uint32_t i,
+                                    std::uint32_t v, std::uint32_t attempt = 0) noexcept;
 
 /// @brief The relative path `<category>/<category>_<ii>/view_<vvv>.pcd`.
-[[nodiscard]] std::filesystem::path dataset_view_path(Category category, std::uint32_t i, std::uint32_t v);
+[[nodiscard]] std::filesystem::path dataset_view_path(Category category, std::uint32_t i,
+                                                      std::uint32_t v);
 
-/// @brief Generates the whole dataset under @p dir (created if needed; existing files are replaced).
-[[nodiscard]] Result<DatasetSummary, DatasetError> write_object_dataset(const DatasetConfig& config,
-                                                                        const std::filesystem::path& dir);
+/// @brief Generates the whole dataset under @p dir (created if needed; existing files are
+/// replaced).
+[[nodiscard]] Result<DatasetSummary, DatasetError> write_object_dataset(
+    const DatasetConfig& config, const std::filesystem::path& dir);
 
 }  // namespace orthoflow::simulation

@@ -72,7 +72,8 @@ bool ellipsoid(const Primitive& p, const Vec3& o_world, const Vec3& d, double t_
     const Vec3 q = o + t * d;
     const double z = q[2] + p.center[2];
     if (z < p.clip_min || z > p.clip_max) { continue; }
-    const Vec3 n{q[0] / (p.size[0] * p.size[0]), q[1] / (p.size[1] * p.size[1]), q[2] / (p.size[2] * p.size[2])};
+    const Vec3 n{q[0] / (p.size[0] * p.size[0]), q[1] / (p.size[1] * p.size[1]),
+                 q[2] / (p.size[2] * p.size[2])};
     hit |= take(t, n, t_min, best);
   }
   return hit;
@@ -110,9 +111,12 @@ bool box(const Primitive& p, const Vec3& o_world, const Vec3& d, double t_min, H
 
 bool intersect(const Primitive& p, const Vec3& o, const Vec3& d, double t_min, Hit& best) noexcept {
   switch (p.kind) {
-    case PrimitiveKind::FRUSTUM: return frustum(p, o, d, t_min, best);
-    case PrimitiveKind::ELLIPSOID: return ellipsoid(p, o, d, t_min, best);
-    case PrimitiveKind::BOX: return box(p, o, d, t_min, best);
+    case PrimitiveKind::FRUSTUM:
+      return frustum(p, o, d, t_min, best);
+    case PrimitiveKind::ELLIPSOID:
+      return ellipsoid(p, o, d, t_min, best);
+    case PrimitiveKind::BOX:
+      return box(p, o, d, t_min, best);
   }
   return false;
 }

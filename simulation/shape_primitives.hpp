@@ -10,8 +10,12 @@ namespace orthoflow::simulation {
 
 using Vec3 = std::array<double, 3>;
 
-inline Vec3 operator+(const Vec3& a, const Vec3& b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
-inline Vec3 operator-(const Vec3& a, const Vec3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+inline Vec3 operator+(const Vec3& a, const Vec3& b) {
+  return {a[0] + b[0], a[1] + b[1], a[2] + b[2]};
+}
+inline Vec3 operator-(const Vec3& a, const Vec3& b) {
+  return {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+}
 inline Vec3 operator*(double s, const Vec3& a) { return {s * a[0], s * a[1], s * a[2]}; }
 inline double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 inline Vec3 cross(const Vec3& a, const Vec3& b) {
@@ -41,7 +45,8 @@ struct Hit {
   [[nodiscard]] bool found() const noexcept { return t < 1e299; }
 };
 
-/// @brief Intersects the ray o + t d (t > t_min) with @p p; keeps the hit only if nearer than @p best.
+/// @brief Intersects the ray o + t d (t > t_min) with @p p; keeps the hit only if nearer than @p
+/// best.
 /// @return true when @p best was updated.
 bool intersect(const Primitive& p, const Vec3& o, const Vec3& d, double t_min, Hit& best) noexcept;
 

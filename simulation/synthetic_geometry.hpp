@@ -20,7 +20,8 @@ class SceneGeometry {
  public:
   explicit SceneGeometry(const Scene& scene) noexcept;
   /// Nearest hit with t in (t_min, t_max) along o + t d.
-  [[nodiscard]] SurfaceHit cast(const Vec3& o, const Vec3& d, double t_min, double t_max) const noexcept;
+  [[nodiscard]] SurfaceHit cast(const Vec3& o, const Vec3& d, double t_min,
+                                double t_max) const noexcept;
 
  private:
   struct Pose {
@@ -41,7 +42,8 @@ class SceneGeometry {
 /// Depth (metres) the sensor reports for @p hit seen along @p dir: NaN in projector shadows, out of
 /// range and at grazing angles; otherwise the true depth with disparity noise, quantised to the
 /// 11-bit raw disparity and converted back through @p table.
-[[nodiscard]] float measure_depth(const SurfaceHit& hit, const Vec3& dir, const Vec3& projector, const SceneGeometry& geo,
-                                  const RenderOptions& options, const DepthTable& table, core::Rng& rng) noexcept;
+[[nodiscard]] float measure_depth(const SurfaceHit& hit, const Vec3& dir, const Vec3& projector,
+                                  const SceneGeometry& geo, const RenderOptions& options,
+                                  const DepthTable& table, core::Rng& rng) noexcept;
 
 }  // namespace orthoflow::simulation

@@ -3,9 +3,9 @@
 #include <cmath>
 #include <limits>
 
+#include "core/assert.hpp"
 #include "simulation/synthetic_geometry.hpp"
 #include "simulation/synthetic_scene.hpp"
-#include "core/assert.hpp"
 
 namespace orthoflow::simulation {
 namespace {
@@ -20,7 +20,8 @@ void prepare(const DepthIntrinsics& in, kernels::PointCloud& out) {
 
 }  // namespace
 
-void render_scene(const Scene& scene, const RenderOptions& options, core::Rng& rng, kernels::PointCloud& out) {
+void render_scene(const Scene& scene, const RenderOptions& options, core::Rng& rng,
+                  kernels::PointCloud& out) {
   OF_ENFORCE(scene.objects.size() <= MAX_SCENE_OBJECTS, "render_scene: too many objects");
   const DepthIntrinsics& in = options.intrinsics;
   prepare(in, out);
@@ -36,7 +37,8 @@ void render_scene(const Scene& scene, const RenderOptions& options, core::Rng& r
     for (std::uint32_t u = 0; u < in.width; ++u, ++i) {
       const Vec3 dir{(u - in.cx) / in.fx, (v - in.cy) / in.fy, 1.0};
       const SurfaceHit hit = geo.cast(camera, dir, 1e-9, 1e9);
-      const float z = hit.found() ? measure_depth(hit, dir, projector, geo, options, table, rng) : nan;
+      const float z =
+          hit.found() ? measure_depth(hit, dir, projector, geo, options, table, rng) : nan;
       rgb[i] = hit.rgb;
       if (std::isnan(z)) {
         xs[i] = ys[i] = zs[i] = nan;

@@ -10,7 +10,7 @@ namespace orthoflow::simulation {
 namespace {
 
 constexpr double PI = 3.14159265358979323846;
-constexpr double GAP_M = 0.01;        // clearance between footprints of objects that do not touch
+constexpr double GAP_M = 0.01;          // clearance between footprints of objects that do not touch
 constexpr double EDGE_MARGIN_M = 0.02;  // objects keep this far from the table edges
 constexpr int ATTEMPTS_PER_OBJECT = 200;
 
@@ -28,7 +28,8 @@ bool fits(const Footprint& f, const std::vector<PlacedObject>& placed, double ga
 }
 
 bool on_table(const Footprint& f, const TableSpec& t) {
-  return std::fabs(f.x) + f.r <= t.width_m / 2 - EDGE_MARGIN_M && std::fabs(f.y) + f.r <= t.depth_m / 2 - EDGE_MARGIN_M;
+  return std::fabs(f.x) + f.r <= t.width_m / 2 - EDGE_MARGIN_M &&
+         std::fabs(f.y) + f.r <= t.depth_m / 2 - EDGE_MARGIN_M;
 }
 
 Category pick_category(const SceneConfig& config, core::Rng& rng) {
@@ -37,7 +38,8 @@ Category pick_category(const SceneConfig& config, core::Rng& rng) {
 }
 
 /// A spot for @p model: uniformly on the table, or (touching) on the circle around @p anchor.
-bool place(const ObjectModel& model, const Scene& scene, const PlacedObject* anchor, core::Rng& rng, PlacedObject& out) {
+bool place(const ObjectModel& model, const Scene& scene, const PlacedObject* anchor, core::Rng& rng,
+           PlacedObject& out) {
   const TableSpec& t = scene.table;
   for (int attempt = 0; attempt < ATTEMPTS_PER_OBJECT; ++attempt) {
     Footprint f{0, 0, model.footprint_radius};
@@ -78,7 +80,8 @@ std::array<double, 16> object_pose(const TableFrame& table, const PlacedObject& 
   const Vec3 ay = (-s) * table.right + c * table.forward;
   const Vec3& az = table.normal;
   const Vec3 p = table.point(object.table_x, object.table_y);
-  return {ax[0], ay[0], az[0], p[0], ax[1], ay[1], az[1], p[1], ax[2], ay[2], az[2], p[2], 0, 0, 0, 1};
+  return {ax[0], ay[0], az[0], p[0], ax[1], ay[1], az[1], p[1],
+          ax[2], ay[2], az[2], p[2], 0,     0,     0,     1};
 }
 
 std::array<Vec3, 4> table_corners(const TableSpec& table) noexcept {
@@ -97,7 +100,8 @@ Scene make_scene(const SceneConfig& config, std::uint64_t seed) {
   // About as wide as the view at the table centre (58 degrees horizontal field of view), so the
   // side edges show at the far end and the near and far edges show whole; at least 0.9 m so that
   // ten objects usually fit.
-  // Two draws in one call would be unsequenced (GCC and clang order arguments differently): one per statement.
+  // Two draws in one call would be unsequenced (GCC and clang order arguments differently): one per
+  // statement.
   const double view_width = scene.table.distance_m * rng.uniform(0.95, 1.1);
   scene.table.width_m = std::max(view_width, rng.uniform(0.9, 1.0));
   scene.table.depth_m = rng.uniform(0.6, 0.8);
@@ -105,12 +109,15 @@ Scene make_scene(const SceneConfig& config, std::uint64_t seed) {
   std::array<ObjectModel, MAX_SCENE_OBJECTS> models{};
   for (std::uint32_t i = 0; i < config.objects; ++i) {
     const Category category = pick_category(config, rng);
-    models[i] = make_object_model(category, static_cast<std::uint32_t>(rng.below(config.instances_per_category)));
+    models[i] = make_object_model(
+        category, static_cast<std::uint32_t>(rng.below(config.instances_per_category)));
   }
   // Large footprints first: packing them while the table is empty lets more objects fit.
   if (!config.touching) {
     std::stable_sort(models.begin(), models.begin() + config.objects,
-                     [](const ObjectModel& a, const ObjectModel& b) { return a.footprint_radius > b.footprint_radius; });
+                     [](const ObjectModel& a, const ObjectModel& b) {
+                       return a.footprint_radius > b.footprint_radius;
+                     });
   }
   scene.objects.reserve(config.objects);
   for (std::uint32_t i = 0; i < config.objects; ++i) {

@@ -1,13 +1,14 @@
 #pragma once
 /// @file
-/// @brief Synthetic Kinect v1 tabletop frames with per-pixel ground truth: the embedded default input.
+/// @brief Synthetic Kinect v1 tabletop frames with per-pixel ground truth: the embedded default
+/// input.
 ///
-/// What is simulated: a finite table rectangle 0.7-1.2 m in front of the sensor, tilted 30-60 degrees
-/// to the optical axis, a floor 0.72 m below it, objects of 12 categories standing on the table;
-/// exact ray casting (occlusion), the projector-camera baseline (NaN in occlusion shadows), range
-/// limits, dropouts at grazing angles, disparity noise and 11-bit quantisation (kinect_depth_model.hpp).
-/// What is not: speckle and IR texture, lens distortion, multipath, the colour camera's offset
-/// (colours are per-surface constants), table legs and clutter.
+/// What is simulated: a finite table rectangle 0.7-1.2 m in front of the sensor, tilted 30-60
+/// degrees to the optical axis, a floor 0.72 m below it, objects of 12 categories standing on the
+/// table; exact ray casting (occlusion), the projector-camera baseline (NaN in occlusion shadows),
+/// range limits, dropouts at grazing angles, disparity noise and 11-bit quantisation
+/// (kinect_depth_model.hpp). What is not: speckle and IR texture, lens distortion, multipath, the
+/// colour camera's offset (colours are per-surface constants), table legs and clutter.
 ///
 /// Labels: 0 = no reading, 1 = table, 2 = floor, OBJECT_LABEL_BASE + id = the object with that id
 /// (make_scene numbers objects by their index; sequences keep an object's id while it lives).
@@ -17,10 +18,10 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/rng.hpp"
+#include "kernels/point_cloud.hpp"
 #include "simulation/kinect_depth_model.hpp"
 #include "simulation/object_catalog.hpp"
-#include "kernels/point_cloud.hpp"
-#include "core/rng.hpp"
 
 namespace orthoflow::simulation {
 
@@ -36,8 +37,8 @@ inline constexpr std::uint32_t MAX_SCENE_OBJECTS = 64;
 struct TableSpec {
   double distance_m = 1.0;
   double tilt_rad = 0.785;
-  double width_m = 1.2;   ///< along the sensor's x axis
-  double depth_m = 0.8;   ///< along the table, away from the sensor
+  double width_m = 1.2;        ///< along the sensor's x axis
+  double depth_m = 0.8;        ///< along the table, away from the sensor
   double floor_drop_m = 0.72;  ///< <= 0: no floor
 };
 
@@ -76,34 +77,39 @@ struct SceneConfig {
   bool touching = false;               ///< place objects in touching pairs
   std::vector<Category> categories{};  ///< empty: the SCENE_CATEGORY_COUNT scene categories
   std::uint32_t instances_per_category = 5;
-  bool floor = true;                   ///< render a floor below the table
+  bool floor = true;  ///< render a floor below the table
 };
 
-/// @brief Pose of an object in the sensor frame: columns x, y, z axes, then the position (row-major 4x4).
-[[nodiscard]] std::array<double, 16> object_pose(const TableFrame& table, const PlacedObject& object) noexcept;
+/// @brief Pose of an object in the sensor frame: columns x, y, z axes, then the position (row-major
+/// 4x4).
+[[nodiscard]] std::array<double, 16> object_pose(const TableFrame& table,
+                                                 const PlacedObject& object) noexcept;
 
-/// @brief The table rectangle's corners in the sensor frame (near-left, near-right, far-right, far-left).
+/// @brief The table rectangle's corners in the sensor frame (near-left, near-right, far-right,
+/// far-left).
 [[nodiscard]] std::array<Vec3, 4> table_corners(const TableSpec& table) noexcept;
 
 /// @brief Draws a table and up to config.objects non-overlapping objects (fewer if they do not fit
 /// after a bounded number of attempts). Footprints are circles around each object's axis: apart,
-/// they never interpenetrate; with `touching`, every second object's circle touches the previous one's
-/// (a real contact for round objects). Deterministic in @p seed. @pre config.objects <= MAX_SCENE_OBJECTS
+/// they never interpenetrate; with `touching`, every second object's circle touches the previous
+/// one's (a real contact for round objects). Deterministic in @p seed. @pre config.objects <=
+/// MAX_SCENE_OBJECTS
 [[nodiscard]] Scene make_scene(const SceneConfig& config, std::uint64_t seed);
 
 /// @brief Sensor and rendering options.
 struct RenderOptions {
   DepthIntrinsics intrinsics{};
   KinectDepthParams depth{};
-  double projector_x_m = 0.075;        ///< the IR projector sits this far along +x from the camera
-  double grazing_cos = 0.08;           ///< returns at a flatter angle than this are dropped
+  double projector_x_m = 0.075;  ///< the IR projector sits this far along +x from the camera
+  double grazing_cos = 0.08;     ///< returns at a flatter angle than this are dropped
 };
 
 /// @brief Renders @p scene into @p out (organized width x height, RGB and LABEL fields), drawing
 /// the noise from @p rng. Allocates only when @p out is not yet that size with those fields, so a
 /// warm cloud is refilled without touching the heap. Sets no FrameInfo (the caller stamps frames).
 /// @pre scene.objects.size() <= MAX_SCENE_OBJECTS. Deterministic; not thread-safe on one @p rng.
-void render_scene(const Scene& scene, const RenderOptions& options, core::Rng& rng, kernels::PointCloud& out);
+void render_scene(const Scene& scene, const RenderOptions& options, core::Rng& rng,
+                  kernels::PointCloud& out);
 
 /// @brief Object id of a label, or -1 for table, floor and no reading.
 [[nodiscard]] inline int object_of_label(std::uint32_t label) noexcept {

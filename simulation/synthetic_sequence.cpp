@@ -19,7 +19,10 @@ bool path_is_clear(const SequenceScript& s, const ScriptedObject& mover) {
   for (std::uint64_t f = 0; f < s.frames; ++f) {
     const PlacedObject p = scripted_pose(mover, f);
     const double r = p.model.footprint_radius;
-    if (std::fabs(p.table_x) + r > s.table.width_m / 2 || std::fabs(p.table_y) + r > s.table.depth_m / 2) { return false; }
+    if (std::fabs(p.table_x) + r > s.table.width_m / 2 ||
+        std::fabs(p.table_y) + r > s.table.depth_m / 2) {
+      return false;
+    }
     for (std::size_t i = 1; i < s.objects.size(); ++i) {
       const PlacedObject& o = s.objects[i].start;
       const double need = r + o.model.footprint_radius + CLEARANCE_M;
@@ -33,13 +36,16 @@ bool path_is_clear(const SequenceScript& s, const ScriptedObject& mover) {
 
 PlacedObject scripted_pose(const ScriptedObject& object, std::uint64_t frame) noexcept {
   PlacedObject p = object.start;
-  const double t = frame > object.appear_frame ? static_cast<double>(frame - object.appear_frame) * FRAME_S : 0.0;
+  const double t = frame > object.appear_frame
+                       ? static_cast<double>(frame - object.appear_frame) * FRAME_S
+                       : 0.0;
   p.table_x += object.velocity_x * t;
   p.table_y += object.velocity_y * t;
   return p;
 }
 
-SequenceScript make_sequence_script(std::uint32_t objects, std::uint64_t frames, std::uint64_t seed) {
+SequenceScript make_sequence_script(std::uint32_t objects, std::uint64_t frames,
+                                    std::uint64_t seed) {
   SceneConfig config;
   config.objects = objects;
   const Scene scene = make_scene(config, seed);
@@ -47,7 +53,8 @@ SequenceScript make_sequence_script(std::uint32_t objects, std::uint64_t frames,
   for (const PlacedObject& o : scene.objects) { s.objects.push_back(ScriptedObject{o}); }
   core::Rng rng(~seed);
   if (!s.objects.empty()) {
-    // Slide object 0 at 5-15 cm/s in a direction whose swept path stays clear; else it stands still.
+    // Slide object 0 at 5-15 cm/s in a direction whose swept path stays clear; else it stands
+    // still.
     ScriptedObject& mover = s.objects[0];
     for (int attempt = 0; attempt < PATH_ATTEMPTS; ++attempt) {
       const double speed = rng.uniform(0.05, 0.15), heading = rng.uniform(0.0, 2.0 * PI);
@@ -62,9 +69,11 @@ SequenceScript make_sequence_script(std::uint32_t objects, std::uint64_t frames,
   return s;
 }
 
-SyntheticSequence::SyntheticSequence(SequenceScript script, std::uint64_t seed, RenderOptions options)
+SyntheticSequence::SyntheticSequence(SequenceScript script, std::uint64_t seed,
+                                     RenderOptions options)
     : script_(std::move(script)), options_(options), rng_(seed) {
-  OF_ENFORCE(script_.objects.size() <= MAX_SCENE_OBJECTS, "SyntheticSequence: too many scripted objects");
+  OF_ENFORCE(script_.objects.size() <= MAX_SCENE_OBJECTS,
+             "SyntheticSequence: too many scripted objects");
   scene_.table = script_.table;
   scene_.objects.reserve(MAX_SCENE_OBJECTS);
 }

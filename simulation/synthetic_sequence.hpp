@@ -33,16 +33,19 @@ struct SequenceScript {
   std::uint64_t frames = 60;
 };
 
-inline constexpr std::int64_t SEQUENCE_RATE_HZ = 30;  ///< frame n is stamped n * 1e9 / 30 ns (truncated)
+inline constexpr std::int64_t SEQUENCE_RATE_HZ =
+    30;  ///< frame n is stamped n * 1e9 / 30 ns (truncated)
 
 /// @brief Table-plane position of @p object at @p frame (start + velocity * elapsed time).
-[[nodiscard]] PlacedObject scripted_pose(const ScriptedObject& object, std::uint64_t frame) noexcept;
+[[nodiscard]] PlacedObject scripted_pose(const ScriptedObject& object,
+                                         std::uint64_t frame) noexcept;
 
-/// @brief The standard script: a random scene of @p objects (>= 3 recommended) where object 0 slides
-/// across the table (on a path clear of the others), object 1 appears at frames/3, object 2
+/// @brief The standard script: a random scene of @p objects (>= 3 recommended) where object 0
+/// slides across the table (on a path clear of the others), object 1 appears at frames/3, object 2
 /// disappears at 2 frames/3, and the rest stand still. Deterministic in @p seed.
 /// @pre objects <= MAX_SCENE_OBJECTS
-[[nodiscard]] SequenceScript make_sequence_script(std::uint32_t objects, std::uint64_t frames, std::uint64_t seed);
+[[nodiscard]] SequenceScript make_sequence_script(std::uint32_t objects, std::uint64_t frames,
+                                                  std::uint64_t seed);
 
 /// @brief Plays a script frame by frame. @note Not thread-safe; deterministic in (script, seed).
 class SyntheticSequence {

@@ -32,7 +32,8 @@ const char* const FANOUT =
     "  - {name: obj, kind: busy, params: {type: object, add: 1}}\n"
     "  - {name: join, kind: join}\n"
     "  - {name: sink, kind: count}\n"
-    "edges:\n  - src.out -> split.in\n  - split.out -> obj.in\n  - obj.out -> join.in\n  - join.out -> sink.in\n";
+    "edges:\n  - src.out -> split.in\n  - split.out -> obj.in\n  - obj.out -> join.in\n  - "
+    "join.out -> sink.in\n";
 
 std::unique_ptr<Graph> build(const char* yaml) {
   static const NodeRegistry registry = [] {
@@ -51,11 +52,13 @@ void run_engine(benchmark::State& state, const char* yaml, std::int64_t messages
     Engine engine(*graph, {static_cast<int>(state.range(0))});
     const auto start = std::chrono::steady_clock::now();
     engine.run({});
-    state.SetIterationTime(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    state.SetIterationTime(
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   }
   state.SetItemsProcessed(state.iterations() * FRAMES);
-  state.counters["ns_per_frame"] = benchmark::Counter(static_cast<double>(state.iterations() * FRAMES),
-                                                      benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.counters["ns_per_frame"] =
+      benchmark::Counter(static_cast<double>(state.iterations() * FRAMES),
+                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
   state.counters["messages_per_frame"] = static_cast<double>(messages_per_frame);
 }
 
@@ -63,7 +66,9 @@ void run_engine(benchmark::State& state, const char* yaml, std::int64_t messages
 struct Direct final : Emitter {
   Node* next = nullptr;
   Emitter* next_out = nullptr;
-  void emit(std::size_t /*port*/, const Message& message) noexcept override { next->process(message, *next_out); }
+  void emit(std::size_t /*port*/, const Message& message) noexcept override {
+    next->process(message, *next_out);
+  }
 };
 
 void run_direct(benchmark::State& state, const char* yaml) {
@@ -83,11 +88,13 @@ void run_direct(benchmark::State& state, const char* yaml) {
       m.frame_id = f;
       links[0].emit(0, m);
     }
-    state.SetIterationTime(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    state.SetIterationTime(
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   }
   state.SetItemsProcessed(state.iterations() * FRAMES);
-  state.counters["ns_per_frame"] = benchmark::Counter(static_cast<double>(state.iterations() * FRAMES),
-                                                      benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.counters["ns_per_frame"] =
+      benchmark::Counter(static_cast<double>(state.iterations() * FRAMES),
+                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 
 void BM_Chain4_Engine(benchmark::State& state) { run_engine(state, CHAIN, 3); }

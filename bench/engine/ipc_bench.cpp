@@ -1,9 +1,10 @@
 // Round trip between two processes: iceoryx (engine::IpcPublisher/IpcSubscriber, zero copy: the
 // payload is loaned and published, the receiver reads the header in place) vs a Unix-domain stream
 // socket (the payload is copied into the kernel and out again). Each round trip sends one payload
-// (64 B, 1.2 MB, a 640x480 RGB+label frame) and waits for a 64 B acknowledgement. The program starts
-// its own RouDi (config/roudi_bench.toml) in a private mount namespace (root or CAP_SYS_ADMIN).
-// Shape after iceoryx_examples/iceperf: fork, busy-poll, percentiles. Run: build/bench/engine/ipc_bench
+// (64 B, 1.2 MB, a 640x480 RGB+label frame) and waits for a 64 B acknowledgement. The program
+// starts its own RouDi (config/roudi_bench.toml) in a private mount namespace (root or
+// CAP_SYS_ADMIN). Shape after iceoryx_examples/iceperf: fork, busy-poll, percentiles. Run:
+// build/bench/engine/ipc_bench
 #include <sched.h>
 #include <signal.h>
 #include <sys/mount.h>
@@ -76,7 +77,9 @@ void uds_server(int fd, std::size_t max_bytes) {
   std::vector<std::byte> buffer(max_bytes), ack(ACK_BYTES);
   while (io_all(fd, buffer.data(), PAYLOAD_HEADER_BYTES, false)) {
     const std::uint64_t bytes = bytes_of(buffer.data());
-    if (bytes > max_bytes || !io_all(fd, buffer.data() + PAYLOAD_HEADER_BYTES, bytes - PAYLOAD_HEADER_BYTES, false)) break;
+    if (bytes > max_bytes ||
+        !io_all(fd, buffer.data() + PAYLOAD_HEADER_BYTES, bytes - PAYLOAD_HEADER_BYTES, false))
+      break;
     if (sequence_of(buffer.data()) == STOP) break;
     write_header(ack.data(), sequence_of(buffer.data()), ACK_BYTES);
     if (!io_all(fd, ack.data(), ACK_BYTES, true)) break;
@@ -90,20 +93,24 @@ std::vector<double> uds_round_trips(int fd, const Case& c, std::vector<std::byte
   for (int i = -50; i < c.rounds; ++i) {
     const auto start = Clock::now();
     write_header(payload.data(), static_cast<std::uint64_t>(i + 50), c.bytes);
-    if (!io_all(fd, payload.data(), c.bytes, true) || !io_all(fd, ack, ACK_BYTES, false)) die("uds", "peer gone");
-    if (i >= 0) us.push_back(std::chrono::duration<double, std::micro>(Clock::now() - start).count());
+    if (!io_all(fd, payload.data(), c.bytes, true) || !io_all(fd, ack, ACK_BYTES, false))
+      die("uds", "peer gone");
+    if (i >= 0)
+      us.push_back(std::chrono::duration<double, std::micro>(Clock::now() - start).count());
   }
   return us;
 }
 
 // ---- iceoryx transport: busy-polling echo server replying with a 64 B loaned ack.
-std::pair<std::unique_ptr<IpcPublisher>, std::unique_ptr<IpcSubscriber>> endpoints(const char* name, const char* out,
-                                                                                   const char* in, std::size_t max_out) {
+std::pair<std::unique_ptr<IpcPublisher>, std::unique_ptr<IpcSubscriber>> endpoints(
+    const char* name, const char* out, const char* in, std::size_t max_out) {
   if (auto init = init_ipc_runtime(name); !init) die("init", to_string(init.error()));
   auto pools = load_roudi_pools(ORTHOFLOW_SOURCE_DIR "/config/roudi_bench.toml");
   if (!pools) die("pools", to_string(pools.error()));
-  auto pub = IpcPublisher::create(*parse_topic(out), IpcPublisherConfig{PING_TYPE, max_out, 0, false}, *pools);
-  auto sub = IpcSubscriber::create(*parse_topic(in), IpcSubscriberConfig{PING_TYPE, IpcPolicy::QUEUE, 4, 0});
+  auto pub = IpcPublisher::create(*parse_topic(out),
+                                  IpcPublisherConfig{PING_TYPE, max_out, 0, false}, *pools);
+  auto sub = IpcSubscriber::create(*parse_topic(in),
+                                   IpcSubscriberConfig{PING_TYPE, IpcPolicy::QUEUE, 4, 0});
   if (!pub || !sub) die("endpoints", to_string(pub ? sub.error() : pub.error()));
   return {std::move(*pub), std::move(*sub)};
 }
@@ -149,16 +156,20 @@ std::vector<double> iox_round_trips(IpcPublisher& pub, IpcSubscriber& sub, const
     write_header(chunk->data(), static_cast<std::uint64_t>(i + 50), c.bytes);
     if (auto sent = pub.publish(*chunk); !sent) die("publish", to_string(sent.error()));
     auto ack = spin_take(sub);
-    if (sequence_of(ack->bytes().data()) != static_cast<std::uint64_t>(i + 50)) die("ack", "out of order");
-    if (i >= 0) us.push_back(std::chrono::duration<double, std::micro>(Clock::now() - start).count());
+    if (sequence_of(ack->bytes().data()) != static_cast<std::uint64_t>(i + 50))
+      die("ack", "out of order");
+    if (i >= 0)
+      us.push_back(std::chrono::duration<double, std::micro>(Clock::now() - start).count());
   }
   return us;
 }
 
 // ---- set-up: private mounts, RouDi, percentiles.
 pid_t start_roudi() {
-  if (::unshare(CLONE_NEWNS) != 0 || ::mount(nullptr, "/", nullptr, MS_REC | MS_PRIVATE, nullptr) != 0 ||
-      ::mount("tmpfs", "/dev/shm", "tmpfs", 0, "mode=1777") != 0 || ::mount("tmpfs", "/tmp", "tmpfs", 0, "mode=1777") != 0) {
+  if (::unshare(CLONE_NEWNS) != 0 ||
+      ::mount(nullptr, "/", nullptr, MS_REC | MS_PRIVATE, nullptr) != 0 ||
+      ::mount("tmpfs", "/dev/shm", "tmpfs", 0, "mode=1777") != 0 ||
+      ::mount("tmpfs", "/tmp", "tmpfs", 0, "mode=1777") != 0) {
     die("private mount namespace (needs root or CAP_SYS_ADMIN)", std::strerror(errno));
   }
   const pid_t pid = ::fork();
@@ -168,10 +179,12 @@ pid_t start_roudi() {
     std::freopen("/dev/null", "r", stdin);
     std::freopen("/tmp/roudi.log", "w", stdout);
     std::freopen("/tmp/roudi.log", "a", stderr);
-    ::execl("/usr/bin/iox-roudi", "iox-roudi", "-c", ORTHOFLOW_SOURCE_DIR "/config/roudi_bench.toml", nullptr);
+    ::execl("/usr/bin/iox-roudi", "iox-roudi", "-c",
+            ORTHOFLOW_SOURCE_DIR "/config/roudi_bench.toml", nullptr);
     ::_exit(127);
   }
-  for (int i = 0; i < 1000 && !probe_roudi(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  for (int i = 0; i < 1000 && !probe_roudi(); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
   if (!probe_roudi()) die("RouDi", "not reachable within 5 s");
   return pid;
 }
@@ -185,7 +198,8 @@ double percentile(std::vector<double> v, double q) {
 
 int main() {
   const std::size_t frame = frame_payload_bytes(640, 480, FRAME_FIELD_RGB | FRAME_FIELD_LABEL);
-  const std::vector<Case> cases{{"64 B", 64, 5000}, {"1.2 MB", 1200000, 1000}, {"640x480 frame", frame, 1000}};
+  const std::vector<Case> cases{
+      {"64 B", 64, 5000}, {"1.2 MB", 1200000, 1000}, {"640x480 frame", frame, 1000}};
   int fds[2];
   if (::socketpair(AF_UNIX, SOCK_STREAM, 0, fds) != 0) die("socketpair", std::strerror(errno));
   if (::fork() == 0) {
@@ -198,17 +212,23 @@ int main() {
   if (server == 0) iox_server();
   auto [pub, sub] = endpoints("ipc_bench_client", "bench/ipc/ping", "bench/ipc/pong", frame);
   const auto until = Clock::now() + std::chrono::seconds(5);
-  while (!(pub->has_subscribers() && sub->subscribed()) && Clock::now() < until) std::this_thread::sleep_for(std::chrono::milliseconds(2));
-  if (!pub->has_subscribers() || !sub->subscribed()) die("connect", "server not connected within 5 s");
+  while (!(pub->has_subscribers() && sub->subscribed()) && Clock::now() < until)
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  if (!pub->has_subscribers() || !sub->subscribed())
+    die("connect", "server not connected within 5 s");
   std::vector<std::byte> payload(frame);
-  std::printf("| payload | bytes | rounds | iceoryx p50 / p99 / p99.9 us | UDS p50 / p99 / p99.9 us | UDS / iceoryx p50 / p99 / p99.9 |\n|---|---|---|---|---|---|\n");
+  std::printf(
+      "| payload | bytes | rounds | iceoryx p50 / p99 / p99.9 us | UDS p50 / p99 / p99.9 us | UDS "
+      "/ iceoryx p50 / p99 / p99.9 |\n|---|---|---|---|---|---|\n");
   for (const Case& c : cases) {
     const auto iox = iox_round_trips(*pub, *sub, c);
     const auto uds = uds_round_trips(fds[0], c, payload);
     double q[3] = {0.5, 0.99, 0.999}, a[3], b[3];
     for (int k = 0; k < 3; ++k) a[k] = percentile(iox, q[k]), b[k] = percentile(uds, q[k]);
-    std::printf("| %s | %zu | %d | %.1f / %.1f / %.1f | %.1f / %.1f / %.1f | %.1fx / %.1fx / %.1fx |\n", c.name, c.bytes,
-                c.rounds, a[0], a[1], a[2], b[0], b[1], b[2], b[0] / a[0], b[1] / a[1], b[2] / a[2]);
+    std::printf(
+        "| %s | %zu | %d | %.1f / %.1f / %.1f | %.1f / %.1f / %.1f | %.1fx / %.1fx / %.1fx |\n",
+        c.name, c.bytes, c.rounds, a[0], a[1], a[2], b[0], b[1], b[2], b[0] / a[0], b[1] / a[1],
+        b[2] / a[2]);
   }
   write_header(payload.data(), STOP, PAYLOAD_HEADER_BYTES);
   io_all(fds[0], payload.data(), PAYLOAD_HEADER_BYTES, true);

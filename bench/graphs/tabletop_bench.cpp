@@ -1,8 +1,8 @@
-// The tabletop graph end to end on recorded frames (STYLE rule 5): `orthoflow run`'s graph replays the
-// 45 real mOSD learn-split frames (pcd_source, no pacing, one arena thread) and reports the per-frame
-// latency (p50, p99) and the p50 of the three segmentation nodes; beside it, in the same run, the chain
-// (kernels::SegmentationChain with the graph's parameters) once on each of the same frames, so that the
-// ratio graph/chain says what the graph adds to the segmentation it runs.
+// The tabletop graph end to end on recorded frames (STYLE rule 5): `orthoflow run`'s graph replays
+// the 45 real mOSD learn-split frames (pcd_source, no pacing, one arena thread) and reports the
+// per-frame latency (p50, p99) and the p50 of the three segmentation nodes; beside it, in the same
+// run, the chain (kernels::SegmentationChain with the graph's parameters) once on each of the same
+// frames, so that the ratio graph/chain says what the graph adds to the segmentation it runs.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -40,7 +40,9 @@ oe::GraphSpec spec_on_frames() {
   return *spec;
 }
 
-double p50_us(const oe::NodeStats& n) { return static_cast<double>(n.service.percentile(0.5)) / 1e3; }
+double p50_us(const oe::NodeStats& n) {
+  return static_cast<double>(n.service.percentile(0.5)) / 1e3;
+}
 
 void BM_TabletopGraphOnMosdFrames(benchmark::State& state) {
   const auto spec = spec_on_frames();

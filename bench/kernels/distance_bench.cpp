@@ -1,5 +1,5 @@
-// One query against N stored 675-value (15-bin GOOD) descriptors, N = 100, 1k, 10k, 100k, every metric,
-// dispatched SIMD against the scalar twin; and the 10 nearest neighbours.
+// One query against N stored 675-value (15-bin GOOD) descriptors, N = 100, 1k, 10k, 100k, every
+// metric, dispatched SIMD against the scalar twin; and the 10 nearest neighbours.
 #include <benchmark/benchmark.h>
 
 #include <random>
@@ -43,12 +43,15 @@ void BM_distances(benchmark::State& state) {
   const std::vector<float> q = query();
   std::vector<float> out(n);
   for (auto _ : state) {
-    const std::size_t w = simd ? ok::distances(q, s, metric, out) : ok::distances_scalar(q, s, metric, out);
+    const std::size_t w =
+        simd ? ok::distances(q, s, metric, out) : ok::distances_scalar(q, s, metric, out);
     benchmark::DoNotOptimize(w);
     benchmark::DoNotOptimize(out.data());
   }
-  state.SetLabel(std::string(ok::to_string(metric)) + (simd ? std::string(" ") + ok::simd_arch_name() : " scalar"));
-  state.counters["descriptors/s"] = benchmark::Counter(static_cast<double>(n), benchmark::Counter::kIsIterationInvariantRate);
+  state.SetLabel(std::string(ok::to_string(metric)) +
+                 (simd ? std::string(" ") + ok::simd_arch_name() : " scalar"));
+  state.counters["descriptors/s"] =
+      benchmark::Counter(static_cast<double>(n), benchmark::Counter::kIsIterationInvariantRate);
 }
 
 BENCHMARK(BM_distances)
@@ -62,10 +65,17 @@ void BM_nearest10(benchmark::State& state) {
   const std::vector<float> q = query();
   std::vector<float> scratch(n);
   std::vector<ok::Neighbor> out(10);
-  for (auto _ : state) { benchmark::DoNotOptimize(ok::nearest_k(q, s, ok::Metric::L1, scratch, out)); }
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(ok::nearest_k(q, s, ok::Metric::L1, scratch, out));
+  }
 }
 
-BENCHMARK(BM_nearest10)->Arg(100)->Arg(1000)->Arg(10000)->Arg(100000)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_nearest10)
+    ->Arg(100)
+    ->Arg(1000)
+    ->Arg(10000)
+    ->Arg(100000)
+    ->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 

@@ -1,6 +1,7 @@
-// GOOD descriptor time: timing_5k.pcd (5,000 points) and a 50,000-point cloud (timing_5k repeated 10x
-// with seeded 0.3 mm jitter), 5 and 15 bins, both modes, dispatched SIMD against the scalar twin.
-// Reference (testdata/good/timing/TIMING.txt, same machine kind): 0.37 ms at 5k, 3.9 ms at 50k.
+// GOOD descriptor time: timing_5k.pcd (5,000 points) and a 50,000-point cloud (timing_5k repeated
+// 10x with seeded 0.3 mm jitter), 5 and 15 bins, both modes, dispatched SIMD against the scalar
+// twin. Reference (testdata/good/timing/TIMING.txt, same machine kind): 0.37 ms at 5k, 3.9 ms at
+// 50k.
 #include <benchmark/benchmark.h>
 
 #include <cstdio>
@@ -23,13 +24,16 @@ struct Cloud {
 
 const Cloud& cloud(std::size_t copies) {
   static const Cloud base = [] {
-    auto cloud_result = orthoflow::formats::read_pcd(ORTHOFLOW_SHARED_DIR "/testdata/good/timing/timing_5k.pcd");
+    auto cloud_result =
+        orthoflow::formats::read_pcd(ORTHOFLOW_SHARED_DIR "/testdata/good/timing/timing_5k.pcd");
     if (!cloud_result) {
       std::fprintf(stderr, "%s\n", cloud_result.error().to_string().c_str());
       std::exit(1);
     }
     const auto& pc = cloud_result.value();
-    return Cloud{{pc.x().begin(), pc.x().end()}, {pc.y().begin(), pc.y().end()}, {pc.z().begin(), pc.z().end()}};
+    return Cloud{{pc.x().begin(), pc.x().end()},
+                 {pc.y().begin(), pc.y().end()},
+                 {pc.z().begin(), pc.z().end()}};
   }();
   static const Cloud big = [] {
     Cloud c;
@@ -51,12 +55,14 @@ const Cloud& cloud(std::size_t copies) {
 void BM_good(benchmark::State& state) {
   const Cloud& c = cloud(static_cast<std::size_t>(state.range(0)));
   const auto bins = static_cast<std::size_t>(state.range(1));
-  const ok::GoodConfig cfg{bins, state.range(2) != 0 ? ok::GoodMode::REFERENCE : ok::GoodMode::INVARIANT, std::nullopt};
+  const ok::GoodConfig cfg{
+      bins, state.range(2) != 0 ? ok::GoodMode::REFERENCE : ok::GoodMode::INVARIANT, std::nullopt};
   const bool simd = state.range(3) != 0;
   ok::GoodScratch scratch(bins);
   std::vector<float> d(3 * bins * bins);
   for (auto _ : state) {
-    auto r = simd ? ok::compute_good(c.view(), cfg, scratch, d) : ok::compute_good_scalar(c.view(), cfg, scratch, d);
+    auto r = simd ? ok::compute_good(c.view(), cfg, scratch, d)
+                  : ok::compute_good_scalar(c.view(), cfg, scratch, d);
     benchmark::DoNotOptimize(r);
     benchmark::DoNotOptimize(d.data());
   }

@@ -1,6 +1,7 @@
 // Segmentation kernels, SIMD (dispatched) vs scalar twin across sizes (STYLE rule 5), plus the
-// voxel grid and the grid clustering across sizes. Random points in a 2 m cube, 10 % NaN. The prism,
-// the strided pixel sample and the organized clustering run on a synthetic 640 x 480 tabletop frame.
+// voxel grid and the grid clustering across sizes. Random points in a 2 m cube, 10 % NaN. The
+// prism, the strided pixel sample and the organized clustering run on a synthetic 640 x 480
+// tabletop frame.
 #include <benchmark/benchmark.h>
 
 #include <array>
@@ -44,7 +45,8 @@ void BM_CropBox(benchmark::State& state) {
   std::vector<std::uint8_t> mask(c.x.size());
   const ok::AxisBox box{{-0.5F, -0.5F, 0.3F}, {0.5F, 0.5F, 1.5F}};
   for (auto _ : state) {
-    benchmark::DoNotOptimize(SIMD ? ok::crop_box_mask(c.view(), box, mask) : ok::crop_box_mask_scalar(c.view(), box, mask));
+    benchmark::DoNotOptimize(SIMD ? ok::crop_box_mask(c.view(), box, mask)
+                                  : ok::crop_box_mask_scalar(c.view(), box, mask));
   }
   state.SetItemsProcessed(state.iterations() * state.range(0));
 }
@@ -69,8 +71,9 @@ void BM_DepthToPoints(benchmark::State& state) {
   for (auto& r : raw) { r = static_cast<std::uint16_t>(rng() % 8 == 0 ? 2047 : 500 + rng() % 500); }
   std::vector<float> x(raw.size()), y(raw.size()), z(raw.size());
   for (auto _ : state) {
-    benchmark::DoNotOptimize(SIMD ? ok::depth_to_points(raw, 640, 480, table, {}, {x, y, z})
-                                  : ok::depth_to_points_scalar(raw, 640, 480, table, {}, {x, y, z}));
+    benchmark::DoNotOptimize(SIMD
+                                 ? ok::depth_to_points(raw, 640, 480, table, {}, {x, y, z})
+                                 : ok::depth_to_points_scalar(raw, 640, 480, table, {}, {x, y, z}));
   }
   state.SetItemsProcessed(state.iterations() * 640 * 480);
 }
@@ -79,7 +82,9 @@ void BM_VoxelGrid(benchmark::State& state) {
   const Cloud c = make(static_cast<std::size_t>(state.range(0)));
   ok::VoxelGridScratch scratch(c.x.size());
   Cloud out = c;
-  for (auto _ : state) { benchmark::DoNotOptimize(ok::voxel_grid(c.view(), 0.01F, scratch, {out.x, out.y, out.z})); }
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(ok::voxel_grid(c.view(), 0.01F, scratch, {out.x, out.y, out.z}));
+  }
   state.SetItemsProcessed(state.iterations() * state.range(0));
 }
 
@@ -87,12 +92,14 @@ void BM_GridCluster(benchmark::State& state) {
   const Cloud c = make(static_cast<std::size_t>(state.range(0)));
   ok::ClusterScratch scratch(c.x.size());
   std::vector<std::int32_t> labels(c.x.size());
-  for (auto _ : state) { benchmark::DoNotOptimize(ok::euclidean_cluster(c.view(), {}, {}, scratch, labels)); }
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(ok::euclidean_cluster(c.view(), {}, {}, scratch, labels));
+  }
   state.SetItemsProcessed(state.iterations() * state.range(0));
 }
 
-
-/// 640 x 480 range image of a table (z = 1 m plane tilted) with 12 boxes of 6 x 6 cm standing on it.
+/// 640 x 480 range image of a table (z = 1 m plane tilted) with 12 boxes of 6 x 6 cm standing on
+/// it.
 struct Frame {
   Cloud c;
   ok::Plane plane{{0.0F, -0.8F, -0.6F}, 0.6F};
@@ -136,7 +143,8 @@ void BM_PixelSubsample(benchmark::State& state) {
   const Frame f = make_frame();
   Cloud out = f.c;
   for (auto _ : state) {
-    benchmark::DoNotOptimize(ok::pixel_subsample({f.c.view(), 640, 480}, static_cast<std::uint32_t>(state.range(0)),
+    benchmark::DoNotOptimize(ok::pixel_subsample({f.c.view(), 640, 480},
+                                                 static_cast<std::uint32_t>(state.range(0)),
                                                  ok::AxisBox{}, {out.x, out.y, out.z}));
   }
   state.SetItemsProcessed(state.iterations() * 640 * 480);
@@ -153,7 +161,8 @@ void BM_OrganizedCluster(benchmark::State& state) {
   ok::ClusterScratch scratch(f.c.x.size());
   std::vector<std::int32_t> labels(f.c.x.size());
   for (auto _ : state) {
-    benchmark::DoNotOptimize(ok::euclidean_cluster_organized({f.c.view(), 640, 480}, mask, {}, scratch, labels));
+    benchmark::DoNotOptimize(
+        ok::euclidean_cluster_organized({f.c.view(), 640, 480}, mask, {}, scratch, labels));
   }
   state.SetItemsProcessed(state.iterations() * 640 * 480);
 }

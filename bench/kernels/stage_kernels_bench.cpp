@@ -1,6 +1,6 @@
 // The kernels that only showed up inside the chain benchmarks: RANSAC plane (dispatched inlier
-// counting vs the scalar twin), per-cluster statistics, and the PCA object frame (SIMD moments vs the
-// scalar twin). Points: a noisy 1 m plane with 30 % clutter above it; clusters: 16 equal blobs.
+// counting vs the scalar twin), per-cluster statistics, and the PCA object frame (SIMD moments vs
+// the scalar twin). Points: a noisy 1 m plane with 30 % clutter above it; clusters: 16 equal blobs.
 #include <benchmark/benchmark.h>
 
 #include <random>
@@ -38,7 +38,8 @@ void BM_RansacPlane(benchmark::State& state) {
   std::vector<std::uint32_t> inliers(c.x.size());
   const ok::RansacParams params;  // thesis: tau 0.02 m, 200 iterations
   for (auto _ : state) {
-    auto plane = SIMD ? ok::ransac_plane(c.view(), params, inliers) : ok::ransac_plane_scalar(c.view(), params, inliers);
+    auto plane = SIMD ? ok::ransac_plane(c.view(), params, inliers)
+                      : ok::ransac_plane_scalar(c.view(), params, inliers);
     benchmark::DoNotOptimize(plane);
   }
   state.SetItemsProcessed(state.iterations() * state.range(0));
@@ -48,7 +49,8 @@ void BM_ClusterStats(benchmark::State& state) {
   const Cloud c = table_scene(static_cast<std::size_t>(state.range(0)));
   constexpr std::size_t CLUSTERS = 16;
   std::vector<std::int32_t> labels(c.x.size());
-  for (std::size_t i = 0; i < labels.size(); ++i) labels[i] = static_cast<std::int32_t>(i % CLUSTERS);
+  for (std::size_t i = 0; i < labels.size(); ++i)
+    labels[i] = static_cast<std::int32_t>(i % CLUSTERS);
   std::vector<ok::ClusterMoments> moments(CLUSTERS);
   std::vector<ok::ClusterStats> stats(CLUSTERS);
   for (auto _ : state) {

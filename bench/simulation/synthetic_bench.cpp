@@ -26,7 +26,8 @@ void BM_RenderScene(benchmark::State& state) {
     benchmark::DoNotOptimize(cloud.z().data());
   }
   state.counters["placed"] = static_cast<double>(scene.objects.size());
-  state.counters["rays/s"] = benchmark::Counter(static_cast<double>(cloud.size()), benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["rays/s"] = benchmark::Counter(static_cast<double>(cloud.size()),
+                                                benchmark::Counter::kIsIterationInvariantRate);
 }
 BENCHMARK(BM_RenderScene)->Arg(0)->Arg(5)->Arg(10)->Arg(20)->Unit(benchmark::kMillisecond);
 
@@ -43,7 +44,8 @@ void BM_SequenceFrame(benchmark::State& state) {
 }
 BENCHMARK(BM_SequenceFrame)->Unit(benchmark::kMillisecond);
 
-/// One segmented view of a mug from 1 m (the dataset generator's inner loop, without the file write).
+/// One segmented view of a mug from 1 m (the dataset generator's inner loop, without the file
+/// write).
 void BM_DatasetView(benchmark::State& state) {
   const ObjectModel mug = make_object_model(Category::MUG, 0, 1);
   const ViewSpec view{45.0 * 3.14159265358979323846 / 180.0, 1.0, 1.0};

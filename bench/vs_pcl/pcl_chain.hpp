@@ -1,7 +1,9 @@
 #pragma once
-// The PCL 1.13 tabletop chain of specs/BASELINES.md (benchmarks and tests only, never product code),
-// timed per stage, plus helpers to turn our clouds into PCL clouds and PCL clusters into pixel labels.
+// The PCL 1.13 tabletop chain of specs/BASELINES.md (benchmarks and tests only, never product
+// code), timed per stage, plus helpers to turn our clouds into PCL clouds and PCL clusters into
+// pixel labels.
 #include <pcl/ModelCoefficients.h>
+#include <pcl/common/centroid.h>
 #include <pcl/filters/crop_box.h>
 #include <pcl/filters/extract_indices.h>
 #include <pcl/filters/filter.h>
@@ -13,7 +15,6 @@
 #include <pcl/segmentation/extract_polygonal_prism_data.h>
 #include <pcl/segmentation/sac_segmentation.h>
 #include <pcl/surface/convex_hull.h>
-#include <pcl/common/centroid.h>
 
 #include <chrono>
 #include <cmath>
@@ -53,10 +54,13 @@ inline PclCloud::Ptr to_pcl(const kernels::PointCloud& c) {
 }
 
 /// Runs the chain with the BASELINES.md parameters (stages as in its table).
-inline PclResult run_pcl_chain(const PclCloud::ConstPtr& input, float leaf = 0.005F, float tau = 0.02F,
-                               int iters = 200, float tol = 0.02F, int min_cluster = 50) {
+inline PclResult run_pcl_chain(const PclCloud::ConstPtr& input, float leaf = 0.005F,
+                               float tau = 0.02F, int iters = 200, float tol = 0.02F,
+                               int min_cluster = 50) {
   using Clock = std::chrono::steady_clock;
-  auto ms = [](Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double, std::milli>(b - a).count(); };
+  auto ms = [](Clock::time_point a, Clock::time_point b) {
+    return std::chrono::duration<double, std::milli>(b - a).count();
+  };
   PclResult r;
   const auto t0 = Clock::now();
   PclCloud::Ptr finite(new PclCloud), cropped(new PclCloud);
@@ -127,10 +131,12 @@ inline PclResult run_pcl_chain(const PclCloud::ConstPtr& input, float leaf = 0.0
 
 /// Per-pixel labels of the PCL clusters: a pixel takes the cluster of the voxel it falls in (the
 /// voxel of a centroid is the voxel of its points), -1 elsewhere.
-inline std::vector<std::int32_t> pcl_pixel_labels(const kernels::PointCloud& c, const PclResult& r, float leaf) {
+inline std::vector<std::int32_t> pcl_pixel_labels(const kernels::PointCloud& c, const PclResult& r,
+                                                  float leaf) {
   const float inv = 1.0F / leaf;
   auto key = [inv](float x, float y, float z) {
-    return std::array<long, 3>{long(std::floor(x * inv)), long(std::floor(y * inv)), long(std::floor(z * inv))};
+    return std::array<long, 3>{long(std::floor(x * inv)), long(std::floor(y * inv)),
+                               long(std::floor(z * inv))};
   };
   std::map<std::array<long, 3>, std::int32_t> voxel_cluster;
   for (std::size_t k = 0; k < r.clusters.size(); ++k) {

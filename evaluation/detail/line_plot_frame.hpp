@@ -1,7 +1,7 @@
 #pragma once
 /// @file
-/// @brief Internal to line_plot.cpp / line_plot_draw.cpp: the plot layout (palette, margins, data-to-device
-/// frame) shared by validation (which builds the frame) and drawing.
+/// @brief Internal to line_plot.cpp / line_plot_draw.cpp: the plot layout (palette, margins,
+/// data-to-device frame) shared by validation (which builds the frame) and drawing.
 #include <cairo.h>
 
 #include <array>
@@ -17,9 +17,16 @@ namespace orthoflow::evaluation::detail {
 struct Rgb {
   double r, g, b;  // 0..255
 };
-// Okabe & Ito (2008) colour-blind-safe palette, most distinct first; yellow last but one (weak on white).
-constexpr std::array<Rgb, 8> PALETTE{{{0, 114, 178}, {213, 94, 0}, {0, 158, 115}, {230, 159, 0},
-                                      {204, 121, 167}, {86, 180, 233}, {240, 228, 66}, {0, 0, 0}}};
+// Okabe & Ito (2008) colour-blind-safe palette, most distinct first; yellow last but one (weak on
+// white).
+constexpr std::array<Rgb, 8> PALETTE{{{0, 114, 178},
+                                      {213, 94, 0},
+                                      {0, 158, 115},
+                                      {230, 159, 0},
+                                      {204, 121, 167},
+                                      {86, 180, 233},
+                                      {240, 228, 66},
+                                      {0, 0, 0}}};
 constexpr double LEFT = 78, RIGHT = 30, BOTTOM = 56, TOP_NO_TITLE = 20, TOP_TITLE = 42;
 constexpr double MARKER_RADIUS = 3.5, LINE_WIDTH = 2.0;
 constexpr double MAX_TICKS = 40;  // guards the tick loops against degenerate (tiny relative) ranges
@@ -52,7 +59,8 @@ inline std::string num(double v) {
   return buf;
 }
 
-/// @brief Draws the whole plot @p spec on @p cr inside frame @p f (background, axes, series, legend).
+/// @brief Draws the whole plot @p spec on @p cr inside frame @p f (background, axes, series,
+/// legend).
 void draw_plot(cairo_t* cr, const PlotSpec& spec, const Frame& f);
 
 }  // namespace orthoflow::evaluation::detail

@@ -1,7 +1,7 @@
 #pragma once
 /// @file
-/// @brief Fisher-Yates shuffle with the portable generator: std::shuffle's algorithm is library-specific,
-/// so the same seed would not give the same folds and orders on every platform.
+/// @brief Fisher-Yates shuffle with the portable generator: std::shuffle's algorithm is
+/// library-specific, so the same seed would not give the same folds and orders on every platform.
 #include <utility>
 #include <vector>
 

@@ -22,7 +22,8 @@ CloudStats CloudStatsKernel::operator()(Arch /*arch*/, PointsView points) const 
     const batch y = batch::load_unaligned(points.y.data() + i);
     const batch z = batch::load_unaligned(points.z.data() + i);
     // x - x is 0 for finite values and NaN for NaN and +-Inf.
-    const auto ok = ((x - x) == batch(0.0F)) && ((y - y) == batch(0.0F)) && ((z - z) == batch(0.0F));
+    const auto ok =
+        ((x - x) == batch(0.0F)) && ((y - y) == batch(0.0F)) && ((z - z) == batch(0.0F));
     lo_x = xsimd::select(ok, xsimd::min(lo_x, x), lo_x);
     lo_y = xsimd::select(ok, xsimd::min(lo_y, y), lo_y);
     lo_z = xsimd::select(ok, xsimd::min(lo_z, z), lo_z);
@@ -62,6 +63,6 @@ CloudStats CloudStatsKernel::operator()(Arch /*arch*/, PointsView points) const 
 }  // namespace orthoflow::kernels::detail
 
 #ifdef OF_SIMD_ARCH
-template orthoflow::kernels::CloudStats orthoflow::kernels::detail::CloudStatsKernel::operator()<OF_SIMD_ARCH>(
-    OF_SIMD_ARCH, orthoflow::kernels::PointsView) const noexcept;
+template orthoflow::kernels::CloudStats orthoflow::kernels::detail::CloudStatsKernel::operator()<
+    OF_SIMD_ARCH>(OF_SIMD_ARCH, orthoflow::kernels::PointsView) const noexcept;
 #endif

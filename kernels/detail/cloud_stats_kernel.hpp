@@ -14,8 +14,10 @@ struct CloudStatsKernel {
   CloudStats operator()(Arch arch, PointsView points) const noexcept;
 };
 
-/// Adds points [begin, end) to @p stats with the scalar rule (shared by the twin and the SIMD tail).
-inline void accumulate_scalar(PointsView points, std::size_t begin, std::size_t end, CloudStats& stats) noexcept {
+/// Adds points [begin, end) to @p stats with the scalar rule (shared by the twin and the SIMD
+/// tail).
+inline void accumulate_scalar(PointsView points, std::size_t begin, std::size_t end,
+                              CloudStats& stats) noexcept {
   for (std::size_t i = begin; i < end; ++i) {
     const float x = points.x[i];
     const float y = points.y[i];

@@ -50,7 +50,8 @@ std::size_t CropOrientedKernel::operator()(Arch /*arch*/, PointsView in, const O
     const batch dz = batch::load_unaligned(in.z.data() + i) - batch(b.center[2]);
     auto ok = dx == dx;  // false for NaN lanes
     for (std::size_t k = 0; k < 3; ++k) {
-      const batch t = batch(b.axes[3 * k]) * dx + batch(b.axes[3 * k + 1]) * dy + batch(b.axes[3 * k + 2]) * dz;
+      const batch t =
+          batch(b.axes[3 * k]) * dx + batch(b.axes[3 * k + 1]) * dy + batch(b.axes[3 * k + 2]) * dz;
       ok = ok && (xsimd::abs(t) <= batch(b.half_extent[k]));
     }
     kept += store_mask<batch>(ok, mask.data() + i);

@@ -8,9 +8,11 @@
 namespace orthoflow::kernels::detail {
 
 template <class Arch>
-std::size_t DepthProjectionKernel::operator()(Arch /*arch*/, std::span<const std::uint16_t> raw, std::uint32_t width,
-                                              std::uint32_t height, std::span<const float, DISPARITY_TABLE_SIZE> table_m,
-                                              const DepthCamera& camera, PointsSpan out) const noexcept {
+std::size_t DepthProjectionKernel::operator()(Arch /*arch*/, std::span<const std::uint16_t> raw,
+                                              std::uint32_t width, std::uint32_t height,
+                                              std::span<const float, DISPARITY_TABLE_SIZE> table_m,
+                                              const DepthCamera& camera,
+                                              PointsSpan out) const noexcept {
   using batch = xsimd::batch<float, Arch>;
   constexpr std::size_t LANES = batch::size;
   const float inv_fx = 1.0F / camera.fx;
@@ -39,8 +41,8 @@ std::size_t DepthProjectionKernel::operator()(Arch /*arch*/, std::span<const std
       row_count = row_count + xsimd::select(ok, batch(1.0F), batch(0.0F));
     }
     valid += static_cast<std::size_t>(xsimd::hadd(row_count));
-    valid += project_row_scalar(r, u, width, ray_y, table_m.data(), camera, out.x.data() + row, out.y.data() + row,
-                                out.z.data() + row);
+    valid += project_row_scalar(r, u, width, ray_y, table_m.data(), camera, out.x.data() + row,
+                                out.y.data() + row, out.z.data() + row);
   }
   return valid;
 }
@@ -50,6 +52,6 @@ std::size_t DepthProjectionKernel::operator()(Arch /*arch*/, std::span<const std
 #ifdef OF_SIMD_ARCH
 template std::size_t orthoflow::kernels::detail::DepthProjectionKernel::operator()<OF_SIMD_ARCH>(
     OF_SIMD_ARCH, std::span<const std::uint16_t>, std::uint32_t, std::uint32_t,
-    std::span<const float, orthoflow::kernels::DISPARITY_TABLE_SIZE>, const orthoflow::kernels::DepthCamera&,
-    orthoflow::kernels::PointsSpan) const noexcept;
+    std::span<const float, orthoflow::kernels::DISPARITY_TABLE_SIZE>,
+    const orthoflow::kernels::DepthCamera&, orthoflow::kernels::PointsSpan) const noexcept;
 #endif

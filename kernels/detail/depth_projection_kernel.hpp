@@ -1,5 +1,6 @@
 #pragma once
-// Declaration of the depth_to_points() SIMD functor; body in depth_projection.inl (one TU per arch).
+// Declaration of the depth_to_points() SIMD functor; body in depth_projection.inl (one TU per
+// arch).
 #include <cmath>
 #include <limits>
 
@@ -10,15 +11,16 @@ namespace orthoflow::kernels::detail {
 
 struct DepthProjectionKernel {
   template <class Arch>
-  std::size_t operator()(Arch arch, std::span<const std::uint16_t> raw, std::uint32_t width, std::uint32_t height,
-                         std::span<const float, DISPARITY_TABLE_SIZE> table_m, const DepthCamera& camera,
-                         PointsSpan out) const noexcept;
+  std::size_t operator()(Arch arch, std::span<const std::uint16_t> raw, std::uint32_t width,
+                         std::uint32_t height, std::span<const float, DISPARITY_TABLE_SIZE> table_m,
+                         const DepthCamera& camera, PointsSpan out) const noexcept;
 };
 
-/// Projects pixels [begin, end) of row v with the scalar rule (shared by the twin and the SIMD tail).
-inline std::size_t project_row_scalar(const std::uint16_t* raw, std::size_t begin, std::size_t end, float ray_y,
-                                      const float* table, const DepthCamera& camera, float* x, float* y,
-                                      float* z) noexcept {
+/// Projects pixels [begin, end) of row v with the scalar rule (shared by the twin and the SIMD
+/// tail).
+inline std::size_t project_row_scalar(const std::uint16_t* raw, std::size_t begin, std::size_t end,
+                                      float ray_y, const float* table, const DepthCamera& camera,
+                                      float* x, float* y, float* z) noexcept {
   const float nan = std::numeric_limits<float>::quiet_NaN();
   const float inv_fx = 1.0F / camera.fx;
   std::size_t valid = 0;

@@ -1,7 +1,7 @@
 #pragma once
 // SIMD body of distances(): lanes hold different stored descriptors (structure of arrays), so every
-// lane sums its own terms over d in the same order as the scalar twin. Four registers of columns are
-// processed together to hide the add latency, then one register, then the scalar tail.
+// lane sums its own terms over d in the same order as the scalar twin. Four registers of columns
+// are processed together to hide the add latency, then one register, then the scalar tail.
 #include "kernels/detail/distance_kernel.hpp"
 
 namespace orthoflow::kernels::detail {
@@ -50,9 +50,13 @@ void run(std::span<const float> query, DescriptorMatrixView s, std::span<float> 
     for (std::size_t d = 0; d < s.dims; ++d) {
       const B q(query[d]);
       const float* row = s.data.data() + d * s.stride + j;
-      for (std::size_t u = 0; u < 4; ++u) { acc[u] = acc[u] + term<M>(q, B::load_unaligned(row + u * L)); }
+      for (std::size_t u = 0; u < 4; ++u) {
+        acc[u] = acc[u] + term<M>(q, B::load_unaligned(row + u * L));
+      }
     }
-    for (std::size_t u = 0; u < 4; ++u) { finish<M>(acc[u]).store_unaligned(out.data() + j + u * L); }
+    for (std::size_t u = 0; u < 4; ++u) {
+      finish<M>(acc[u]).store_unaligned(out.data() + j + u * L);
+    }
   }
   for (; j + L <= s.count; j += L) {
     B acc(0.0F);
@@ -67,15 +71,22 @@ void run(std::span<const float> query, DescriptorMatrixView s, std::span<float> 
 }  // namespace distance_simd
 
 template <class Arch>
-void DistanceKernel::operator()(Arch /*arch*/, std::span<const float> query, DescriptorMatrixView stored,
-                                Metric metric, std::span<float> out) const noexcept {
+void DistanceKernel::operator()(Arch /*arch*/, std::span<const float> query,
+                                DescriptorMatrixView stored, Metric metric,
+                                std::span<float> out) const noexcept {
   switch (metric) {
-    case Metric::L1: return distance_simd::run<Metric::L1, Arch>(query, stored, out);
-    case Metric::L2: return distance_simd::run<Metric::L2, Arch>(query, stored, out);
-    case Metric::L2_SQUARED: return distance_simd::run<Metric::L2_SQUARED, Arch>(query, stored, out);
-    case Metric::CHI_SQUARED: return distance_simd::run<Metric::CHI_SQUARED, Arch>(query, stored, out);
-    case Metric::SYMMETRIC_KL: return distance_simd::run<Metric::SYMMETRIC_KL, Arch>(query, stored, out);
-    case Metric::JENSEN_SHANNON: return distance_simd::run<Metric::JENSEN_SHANNON, Arch>(query, stored, out);
+    case Metric::L1:
+      return distance_simd::run<Metric::L1, Arch>(query, stored, out);
+    case Metric::L2:
+      return distance_simd::run<Metric::L2, Arch>(query, stored, out);
+    case Metric::L2_SQUARED:
+      return distance_simd::run<Metric::L2_SQUARED, Arch>(query, stored, out);
+    case Metric::CHI_SQUARED:
+      return distance_simd::run<Metric::CHI_SQUARED, Arch>(query, stored, out);
+    case Metric::SYMMETRIC_KL:
+      return distance_simd::run<Metric::SYMMETRIC_KL, Arch>(query, stored, out);
+    case Metric::JENSEN_SHANNON:
+      return distance_simd::run<Metric::JENSEN_SHANNON, Arch>(query, stored, out);
   }
 }
 
@@ -83,6 +94,6 @@ void DistanceKernel::operator()(Arch /*arch*/, std::span<const float> query, Des
 
 #ifdef OF_SIMD_ARCH
 template void orthoflow::kernels::detail::DistanceKernel::operator()<OF_SIMD_ARCH>(
-    OF_SIMD_ARCH, std::span<const float>, orthoflow::kernels::DescriptorMatrixView, orthoflow::kernels::Metric,
-    std::span<float>) const noexcept;
+    OF_SIMD_ARCH, std::span<const float>, orthoflow::kernels::DescriptorMatrixView,
+    orthoflow::kernels::Metric, std::span<float>) const noexcept;
 #endif

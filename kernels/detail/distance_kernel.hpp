@@ -1,6 +1,6 @@
 #pragma once
-// The distances() SIMD functor (body in distance.inl, one TU per arch) and the per-element terms shared
-// by the scalar twin and the SIMD tail.
+// The distances() SIMD functor (body in distance.inl, one TU per arch) and the per-element terms
+// shared by the scalar twin and the SIMD tail.
 #include <cmath>
 #include <cstddef>
 #include <span>
@@ -12,8 +12,8 @@ namespace orthoflow::kernels::detail {
 
 struct DistanceKernel {
   template <class Arch>
-  void operator()(Arch arch, std::span<const float> query, DescriptorMatrixView stored, Metric metric,
-                  std::span<float> out) const noexcept;
+  void operator()(Arch arch, std::span<const float> query, DescriptorMatrixView stored,
+                  Metric metric, std::span<float> out) const noexcept;
 };
 
 inline float xlogx(float v) noexcept { return v > 0.0F ? v * std::log(v) : 0.0F; }
@@ -49,24 +49,34 @@ inline float distance_finish(float sum) noexcept {
 
 /// Scalar distances for columns [begin, end).
 template <Metric M>
-inline void distance_columns_scalar(std::span<const float> query, DescriptorMatrixView s, std::size_t begin,
-                                    std::size_t end, std::span<float> out) noexcept {
+inline void distance_columns_scalar(std::span<const float> query, DescriptorMatrixView s,
+                                    std::size_t begin, std::size_t end,
+                                    std::span<float> out) noexcept {
   for (std::size_t j = begin; j < end; ++j) {
     float acc = 0.0F;
-    for (std::size_t d = 0; d < s.dims; ++d) { acc += distance_term<M>(query[d], s.data[d * s.stride + j]); }
+    for (std::size_t d = 0; d < s.dims; ++d) {
+      acc += distance_term<M>(query[d], s.data[d * s.stride + j]);
+    }
     out[j] = distance_finish<M>(acc);
   }
 }
 
-inline void distance_columns_scalar(std::span<const float> query, DescriptorMatrixView s, Metric metric,
-                                    std::size_t begin, std::size_t end, std::span<float> out) noexcept {
+inline void distance_columns_scalar(std::span<const float> query, DescriptorMatrixView s,
+                                    Metric metric, std::size_t begin, std::size_t end,
+                                    std::span<float> out) noexcept {
   switch (metric) {
-    case Metric::L1: return distance_columns_scalar<Metric::L1>(query, s, begin, end, out);
-    case Metric::L2: return distance_columns_scalar<Metric::L2>(query, s, begin, end, out);
-    case Metric::L2_SQUARED: return distance_columns_scalar<Metric::L2_SQUARED>(query, s, begin, end, out);
-    case Metric::CHI_SQUARED: return distance_columns_scalar<Metric::CHI_SQUARED>(query, s, begin, end, out);
-    case Metric::SYMMETRIC_KL: return distance_columns_scalar<Metric::SYMMETRIC_KL>(query, s, begin, end, out);
-    case Metric::JENSEN_SHANNON: return distance_columns_scalar<Metric::JENSEN_SHANNON>(query, s, begin, end, out);
+    case Metric::L1:
+      return distance_columns_scalar<Metric::L1>(query, s, begin, end, out);
+    case Metric::L2:
+      return distance_columns_scalar<Metric::L2>(query, s, begin, end, out);
+    case Metric::L2_SQUARED:
+      return distance_columns_scalar<Metric::L2_SQUARED>(query, s, begin, end, out);
+    case Metric::CHI_SQUARED:
+      return distance_columns_scalar<Metric::CHI_SQUARED>(query, s, begin, end, out);
+    case Metric::SYMMETRIC_KL:
+      return distance_columns_scalar<Metric::SYMMETRIC_KL>(query, s, begin, end, out);
+    case Metric::JENSEN_SHANNON:
+      return distance_columns_scalar<Metric::JENSEN_SHANNON>(query, s, begin, end, out);
   }
 }
 

@@ -1,6 +1,7 @@
 #pragma once
-// SIMD bodies of GOOD's two passes: frame statistics (AABB + sign counts) and the three projections.
-// Lane-wise transform and bin indices; the histogram increments stay scalar (scatter has no SIMD win).
+// SIMD bodies of GOOD's two passes: frame statistics (AABB + sign counts) and the three
+// projections. Lane-wise transform and bin indices; the histogram increments stay scalar (scatter
+// has no SIMD win).
 #include <limits>
 
 #include "kernels/detail/good_kernel.hpp"
@@ -52,7 +53,8 @@ GoodStats GoodStatsKernel::operator()(Arch /*arch*/, PointsView points, const Go
   const float inf = std::numeric_limits<float>::infinity();
   batch lo[3] = {batch(inf), batch(inf), batch(inf)};
   batch hi[3] = {batch(-inf), batch(-inf), batch(-inf)};
-  batch cnt[4] = {batch(0.0F), batch(0.0F), batch(0.0F), batch(0.0F)};  // pos x, neg x, pos y, neg y
+  batch cnt[4] = {batch(0.0F), batch(0.0F), batch(0.0F),
+                  batch(0.0F)};  // pos x, neg x, pos y, neg y
   GoodStats s;
   const auto flush = [&] {
     for (std::size_t k = 0; k < 2; ++k) {
@@ -69,7 +71,8 @@ GoodStats GoodStatsKernel::operator()(Arch /*arch*/, PointsView points, const Go
     const batch y = batch::load_unaligned(points.y.data() + i);
     const batch z = batch::load_unaligned(points.z.data() + i);
     const auto ok = ((x - x) == zero) && ((y - y) == zero) && ((z - z) == zero);  // all finite
-    const auto q = good_simd::transform<batch>(t, points.x.data() + i, points.y.data() + i, points.z.data() + i);
+    const auto q = good_simd::transform<batch>(t, points.x.data() + i, points.y.data() + i,
+                                               points.z.data() + i);
     const batch qs[3] = {q.x, q.y, q.z};
     for (std::size_t a = 0; a < 3; ++a) {
       lo[a] = xsimd::select(ok, xsimd::min(lo[a], qs[a]), lo[a]);
@@ -105,19 +108,22 @@ void GoodBinKernel::operator()(Arch /*arch*/, PointsView points, const GoodBinPa
   alignas(64) std::int32_t slot[3][LANES];
   std::size_t i = 0;
   for (; i + LANES <= n; i += LANES) {
-    const auto q = good_simd::transform<batch>(p.t, points.x.data() + i, points.y.data() + i, points.z.data() + i);
+    const auto q = good_simd::transform<batch>(p.t, points.x.data() + i, points.y.data() + i,
+                                               points.z.data() + i);
     const batch qs[3] = {q.x, q.y, q.z};
     batch k[3];
     xsimd::batch_bool<float, Arch> ok[3];
     for (std::size_t a = 0; a < 3; ++a) {
-      const batch f = (qs[a] + half) / width;  // the division of good_bin_scalar(), exact IEEE in both
+      const batch f =
+          (qs[a] + half) / width;  // the division of good_bin_scalar(), exact IEEE in both
       ok[a] = (f > lo) && (f < hi);
       k[a] = xsimd::trunc(f);  // (-1, 0) -> -0 -> bin 0, as the reference
     }
     for (std::size_t v = 0; v < 3; ++v) {
       const float base = static_cast<float>(v) * nn;
       const batch cell = batch(base) + k[ROW[v]] * nb + k[COL[v]];
-      const batch s = xsimd::select(ok[ROW[v]] && ok[COL[v]], cell, batch(3.0F * nn + static_cast<float>(v)));
+      const batch s =
+          xsimd::select(ok[ROW[v]] && ok[COL[v]], cell, batch(3.0F * nn + static_cast<float>(v)));
       xsimd::to_int(s).store_unaligned(slot[v]);
     }
     for (std::size_t l = 0; l < LANES; ++l) {
@@ -132,8 +138,10 @@ void GoodBinKernel::operator()(Arch /*arch*/, PointsView points, const GoodBinPa
 }  // namespace orthoflow::kernels::detail
 
 #ifdef OF_SIMD_ARCH
-template orthoflow::kernels::detail::GoodStats orthoflow::kernels::detail::GoodStatsKernel::operator()<OF_SIMD_ARCH>(
-    OF_SIMD_ARCH, orthoflow::kernels::PointsView, const orthoflow::kernels::detail::GoodTransform&, float) const noexcept;
+template orthoflow::kernels::detail::GoodStats
+orthoflow::kernels::detail::GoodStatsKernel::operator()<OF_SIMD_ARCH>(
+    OF_SIMD_ARCH, orthoflow::kernels::PointsView, const orthoflow::kernels::detail::GoodTransform&,
+    float) const noexcept;
 template void orthoflow::kernels::detail::GoodBinKernel::operator()<OF_SIMD_ARCH>(
     OF_SIMD_ARCH, orthoflow::kernels::PointsView, const orthoflow::kernels::detail::GoodBinParams&,
     std::span<std::uint32_t>) const noexcept;

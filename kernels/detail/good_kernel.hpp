@@ -1,6 +1,7 @@
 #pragma once
-// Declarations of the two GOOD SIMD functors (bodies in good_bins.inl, one TU per arch) and the scalar
-// per-point rules shared by compute_good_scalar() and the SIMD tails, so both apply the same arithmetic.
+// Declarations of the two GOOD SIMD functors (bodies in good_bins.inl, one TU per arch) and the
+// scalar per-point rules shared by compute_good_scalar() and the SIMD tails, so both apply the same
+// arithmetic.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -37,17 +38,20 @@ struct GoodBinParams {
 
 struct GoodStatsKernel {
   template <class Arch>
-  GoodStats operator()(Arch arch, PointsView points, const GoodTransform& t, float threshold) const noexcept;
+  GoodStats operator()(Arch arch, PointsView points, const GoodTransform& t,
+                       float threshold) const noexcept;
 };
 
 struct GoodBinKernel {
   /// Adds to counts (3 n^2 + 3: the views in canonical order, then one slot per view counting the
   /// points it dropped), zeroed by the caller.
   template <class Arch>
-  void operator()(Arch arch, PointsView points, const GoodBinParams& p, std::span<std::uint32_t> counts) const noexcept;
+  void operator()(Arch arch, PointsView points, const GoodBinParams& p,
+                  std::span<std::uint32_t> counts) const noexcept;
 };
 
-inline std::array<float, 3> good_transform_point(const GoodTransform& t, float x, float y, float z) noexcept {
+inline std::array<float, 3> good_transform_point(const GoodTransform& t, float x, float y,
+                                                 float z) noexcept {
   const float dx = x - t.c[0];
   const float dy = y - t.c[1];
   const float dz = z - t.c[2];
@@ -60,10 +64,12 @@ inline std::array<float, 3> good_transform_point(const GoodTransform& t, float x
 }
 
 /// Pass 1 rule for points [begin, end).
-inline void good_stats_scalar(PointsView points, const GoodTransform& t, float threshold, std::size_t begin,
-                              std::size_t end, GoodStats& s) noexcept {
+inline void good_stats_scalar(PointsView points, const GoodTransform& t, float threshold,
+                              std::size_t begin, std::size_t end, GoodStats& s) noexcept {
   for (std::size_t i = begin; i < end; ++i) {
-    if (!std::isfinite(points.x[i]) || !std::isfinite(points.y[i]) || !std::isfinite(points.z[i])) { continue; }
+    if (!std::isfinite(points.x[i]) || !std::isfinite(points.y[i]) || !std::isfinite(points.z[i])) {
+      continue;
+    }
     const std::array<float, 3> q = good_transform_point(t, points.x[i], points.y[i], points.z[i]);
     for (std::size_t a = 0; a < 3; ++a) {
       s.min[a] = std::min(s.min[a], q[a]);
@@ -91,18 +97,20 @@ inline std::size_t good_slot(int row, int col, std::size_t view, std::size_t n) 
 }
 
 /// Adds one point's three bins (canonical views: YoZ = (y, z), XoZ = (x, z), XoY = (x, y)).
-inline void good_add_bins(int kx, int ky, int kz, std::size_t n, std::span<std::uint32_t> counts) noexcept {
+inline void good_add_bins(int kx, int ky, int kz, std::size_t n,
+                          std::span<std::uint32_t> counts) noexcept {
   ++counts[good_slot(ky, kz, 0, n)];
   ++counts[good_slot(kx, kz, 1, n)];
   ++counts[good_slot(kx, ky, 2, n)];
 }
 
 /// Pass 2 rule for points [begin, end).
-inline void good_bin_range_scalar(PointsView points, const GoodBinParams& p, std::size_t begin, std::size_t end,
-                                  std::span<std::uint32_t> counts) noexcept {
+inline void good_bin_range_scalar(PointsView points, const GoodBinParams& p, std::size_t begin,
+                                  std::size_t end, std::span<std::uint32_t> counts) noexcept {
   for (std::size_t i = begin; i < end; ++i) {
     const std::array<float, 3> q = good_transform_point(p.t, points.x[i], points.y[i], points.z[i]);
-    good_add_bins(good_bin_scalar(q[0], p), good_bin_scalar(q[1], p), good_bin_scalar(q[2], p), p.bins, counts);
+    good_add_bins(good_bin_scalar(q[0], p), good_bin_scalar(q[1], p), good_bin_scalar(q[2], p),
+                  p.bins, counts);
   }
 }
 

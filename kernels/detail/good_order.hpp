@@ -19,7 +19,8 @@ struct GoodOrderOut {
 
 /// Writes the ordered descriptor (3 n^2 values) from counts (canonical order) and kept counts.
 /// @pre out.size() >= 3 n^2, counts.size() >= 3 n^2
-GoodOrderOut good_normalise_and_order(std::span<const std::uint32_t> counts, const std::array<std::size_t, 3>& kept,
-                                      std::size_t bins, std::span<float> out) noexcept;
+GoodOrderOut good_normalise_and_order(std::span<const std::uint32_t> counts,
+                                      const std::array<std::size_t, 3>& kept, std::size_t bins,
+                                      std::span<float> out) noexcept;
 
 }  // namespace orthoflow::kernels::detail

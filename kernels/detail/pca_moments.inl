@@ -6,7 +6,8 @@
 namespace orthoflow::kernels::detail {
 
 template <class Arch>
-PcaMoments PcaMomentsKernel::operator()(Arch /*arch*/, PointsView points, PcaMoments m) const noexcept {
+PcaMoments PcaMomentsKernel::operator()(Arch /*arch*/, PointsView points,
+                                        PcaMoments m) const noexcept {
   using batch = xsimd::batch<double, Arch>;
   constexpr std::size_t LANES = batch::size;
   const std::size_t n = points.size();
@@ -44,6 +45,7 @@ PcaMoments PcaMomentsKernel::operator()(Arch /*arch*/, PointsView points, PcaMom
 }  // namespace orthoflow::kernels::detail
 
 #ifdef OF_SIMD_ARCH
-template orthoflow::kernels::PcaMoments orthoflow::kernels::detail::PcaMomentsKernel::operator()<OF_SIMD_ARCH>(
+template orthoflow::kernels::PcaMoments
+orthoflow::kernels::detail::PcaMomentsKernel::operator()<OF_SIMD_ARCH>(
     OF_SIMD_ARCH, orthoflow::kernels::PointsView, orthoflow::kernels::PcaMoments) const noexcept;
 #endif

@@ -1,6 +1,6 @@
 #pragma once
-// Declaration of the pca_moments() SIMD functor (body in pca_moments.inl) and the scalar rule shared by
-// the twin and the SIMD tail.
+// Declaration of the pca_moments() SIMD functor (body in pca_moments.inl) and the scalar rule
+// shared by the twin and the SIMD tail.
 #include <cmath>
 #include <cstddef>
 
@@ -18,15 +18,20 @@ struct PcaMomentsKernel {
 /// Index of the first point with three finite coordinates, or points.size().
 inline std::size_t first_finite(PointsView points) noexcept {
   for (std::size_t i = 0; i < points.size(); ++i) {
-    if (std::isfinite(points.x[i]) && std::isfinite(points.y[i]) && std::isfinite(points.z[i])) { return i; }
+    if (std::isfinite(points.x[i]) && std::isfinite(points.y[i]) && std::isfinite(points.z[i])) {
+      return i;
+    }
   }
   return points.size();
 }
 
 /// Adds points [begin, end) to @p m about m.origin (non-finite points skipped).
-inline void add_moments_scalar(PointsView points, std::size_t begin, std::size_t end, PcaMoments& m) noexcept {
+inline void add_moments_scalar(PointsView points, std::size_t begin, std::size_t end,
+                               PcaMoments& m) noexcept {
   for (std::size_t i = begin; i < end; ++i) {
-    if (!std::isfinite(points.x[i]) || !std::isfinite(points.y[i]) || !std::isfinite(points.z[i])) { continue; }
+    if (!std::isfinite(points.x[i]) || !std::isfinite(points.y[i]) || !std::isfinite(points.z[i])) {
+      continue;
+    }
     const double dx = static_cast<double>(points.x[i]) - m.origin[0];
     const double dy = static_cast<double>(points.y[i]) - m.origin[1];
     const double dz = static_cast<double>(points.z[i]) - m.origin[2];

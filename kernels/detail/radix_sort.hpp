@@ -11,8 +11,9 @@ namespace orthoflow::kernels::detail {
 /// Sorts keys[0, n) ascending, stable, permuting vals alike. Digits of at most 13 bits, as few
 /// passes as max_key needs (a 2 m ROI at 5 mm has 26-bit keys: 2 passes). Uses keys_tmp/vals_tmp as
 /// ping-pong buffers; returns true when the result is in them. @pre n < 2^32.
-inline bool radix_sort_pairs(std::uint64_t* keys, std::uint64_t* keys_tmp, std::uint32_t* vals, std::uint32_t* vals_tmp,
-                             std::size_t n, std::uint64_t max_key) noexcept {
+inline bool radix_sort_pairs(std::uint64_t* keys, std::uint64_t* keys_tmp, std::uint32_t* vals,
+                             std::uint32_t* vals_tmp, std::size_t n,
+                             std::uint64_t max_key) noexcept {
   unsigned bits = 0;
   while (bits < 64 && (max_key >> bits) != 0) { ++bits; }
   const unsigned passes = (bits + 12) / 13;

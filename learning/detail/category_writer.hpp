@@ -1,9 +1,9 @@
 #pragma once
 /// @file
-/// @brief The copy-on-write writer scaffold both learners share. A snapshot holds shared pointers to
-/// immutable categories; every write takes the learner's writer lock, copies the pointer list, replaces,
-/// adds or removes one entry and publishes the snapshot @p finish builds from the new list, so readers
-/// (ask) never lock and never see a half-made change. Internal to learning/.
+/// @brief The copy-on-write writer scaffold both learners share. A snapshot holds shared pointers
+/// to immutable categories; every write takes the learner's writer lock, copies the pointer list,
+/// replaces, adds or removes one entry and publishes the snapshot @p finish builds from the new
+/// list, so readers (ask) never lock and never see a half-made change. Internal to learning/.
 #include <algorithm>
 #include <mutex>
 #include <string_view>
@@ -17,13 +17,17 @@ namespace orthoflow::learning {
 /// @brief The entry of @p categories whose label is @p label, or end().
 template <class Ptr>
 [[nodiscard]] auto find_label(std::vector<Ptr>& categories, std::string_view label) {
-  return std::find_if(categories.begin(), categories.end(), [&](const Ptr& c) { return c->label.view() == label; });
+  return std::find_if(categories.begin(), categories.end(),
+                      [&](const Ptr& c) { return c->label.view() == label; });
 }
 
-/// @brief Teach: replaces the category named @p label with make(existing, id), or adds make(nullptr, new id).
-/// @p finish(categories, generation, next_id) builds the snapshot to publish. @return the category's id.
+/// @brief Teach: replaces the category named @p label with make(existing, id), or adds
+/// make(nullptr, new id).
+/// @p finish(categories, generation, next_id) builds the snapshot to publish. @return the
+/// category's id.
 template <class Cell, class Make, class Finish>
-CategoryId upsert_category(std::mutex& writer, Cell& cell, std::string_view label, Make&& make, Finish&& finish) {
+CategoryId upsert_category(std::mutex& writer, Cell& cell, std::string_view label, Make&& make,
+                           Finish&& finish) {
   const std::lock_guard lock(writer);
   const auto& cur = cell.writer_view();
   auto next = cur.categories;
@@ -41,9 +45,11 @@ CategoryId upsert_category(std::mutex& writer, Cell& cell, std::string_view labe
   return id;
 }
 
-/// @brief Forget: removes the category named @p label (UNKNOWN_LABEL, nothing published, if none is).
+/// @brief Forget: removes the category named @p label (UNKNOWN_LABEL, nothing published, if none
+/// is).
 template <class Cell, class Finish>
-Result<void, LearnError> erase_category(std::mutex& writer, Cell& cell, std::string_view label, Finish&& finish) {
+Result<void, LearnError> erase_category(std::mutex& writer, Cell& cell, std::string_view label,
+                                        Finish&& finish) {
   const std::lock_guard lock(writer);
   const auto& cur = cell.writer_view();
   auto next = cur.categories;
@@ -54,11 +60,13 @@ Result<void, LearnError> erase_category(std::mutex& writer, Cell& cell, std::str
   return {};
 }
 
-/// @brief Restore: publishes @p categories (sorted by id here) in place of everything the learner held.
+/// @brief Restore: publishes @p categories (sorted by id here) in place of everything the learner
+/// held.
 template <class Cell, class Ptr, class Finish>
-void replace_categories(std::mutex& writer, Cell& cell, std::vector<Ptr> categories, CategoryId next_id,
-                        Finish&& finish) {
-  std::sort(categories.begin(), categories.end(), [](const Ptr& a, const Ptr& b) { return a->id < b->id; });
+void replace_categories(std::mutex& writer, Cell& cell, std::vector<Ptr> categories,
+                        CategoryId next_id, Finish&& finish) {
+  std::sort(categories.begin(), categories.end(),
+            [](const Ptr& a, const Ptr& b) { return a->id < b->id; });
   const std::lock_guard lock(writer);
   cell.publish(finish(std::move(categories), cell.writer_view().generation + 1, next_id));
 }

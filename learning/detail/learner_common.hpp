@@ -35,7 +35,8 @@ class RankedScores {
     p.label = best_label_;
     p.score = best_ == NO_CATEGORY ? std::numeric_limits<float>::quiet_NaN() : best_score_;
     p.runner_up = second_label_;
-    p.runner_up_score = second_ == NO_CATEGORY ? std::numeric_limits<float>::quiet_NaN() : second_score_;
+    p.runner_up_score =
+        second_ == NO_CATEGORY ? std::numeric_limits<float>::quiet_NaN() : second_score_;
     return p;
   }
   /// @brief The answer to a descriptor of the wrong length: unknown, score NaN.
@@ -54,9 +55,9 @@ class RankedScores {
   Label second_label_;
 };
 
-/// @brief Checks restored categories: labels, views (when @p need_views or present), and that no id or
-/// label appears twice (DUPLICATE_ID).
-[[nodiscard]] Result<void, LearnError> validate_restored(std::span<const RestoredCategory> categories,
-                                                         std::size_t length, bool histograms) noexcept;
+/// @brief Checks restored categories: labels, views (when @p need_views or present), and that no id
+/// or label appears twice (DUPLICATE_ID).
+[[nodiscard]] Result<void, LearnError> validate_restored(
+    std::span<const RestoredCategory> categories, std::size_t length, bool histograms) noexcept;
 
 }  // namespace orthoflow::learning

@@ -2,9 +2,9 @@
 /// @file
 /// @brief LevelDB keys and binary values of the perceptual memory (schema 1, docs/LEARNING.md).
 /// Keys sort by kind, then category id (big-endian), then view sequence (big-endian):
-///   "s"                     schema JSON {"schema":1,"descriptor":"good","bins":n,"mode":"invariant","threshold":t}
-///   "n"                     next category id (u32)
-///   "c" id                  category: u64 next view sequence, u32 live views, label bytes
+///   "s"                     schema JSON
+///   {"schema":1,"descriptor":"good","bins":n,"mode":"invariant","threshold":t} "n" next category
+///   id (u32) "c" id                  category: u64 next view sequence, u32 live views, label bytes
 ///   "m" id                  Bayes model: u64 N_k, u32 length, length x f64 sums of descriptors
 ///   "v" id seq              view: see encode_view()
 /// Values are little-endian. Internal to learning/.
@@ -25,19 +25,22 @@ inline constexpr char KIND_CATEGORY = 'c';
 inline constexpr char KIND_MODEL = 'm';
 inline constexpr char KIND_VIEW = 'v';
 
-/// @brief "c"/"m"/"v" + big-endian id: the key of a category record or model, or the prefix of its views.
+/// @brief "c"/"m"/"v" + big-endian id: the key of a category record or model, or the prefix of its
+/// views.
 [[nodiscard]] std::string category_key(char kind, CategoryId id);
 /// @brief "v" + id + big-endian seq.
 [[nodiscard]] std::string view_key(CategoryId id, std::uint64_t seq);
 /// @brief The id in a "c"/"m"/"v" key; nullopt when the key is too short.
 [[nodiscard]] std::optional<CategoryId> key_category(std::string_view key) noexcept;
 
-/// @brief The schema JSON of a store written with @p spec: {"schema":1,"descriptor":"good","bins":n,
-/// "mode":...,"threshold":t}.
+/// @brief The schema JSON of a store written with @p spec:
+/// {"schema":1,"descriptor":"good","bins":n, "mode":...,"threshold":t}.
 [[nodiscard]] std::string encode_schema(const kernels::DescriptorSpec& spec);
-/// @brief Parses a schema JSON (also the export header); nullopt with @p why set when malformed. A header
-/// without "descriptor" (written before the descriptor specification existed) is a GOOD store.
-[[nodiscard]] std::optional<kernels::DescriptorSpec> decode_schema(std::string_view json, std::uint32_t& version,
+/// @brief Parses a schema JSON (also the export header); nullopt with @p why set when malformed. A
+/// header without "descriptor" (written before the descriptor specification existed) is a GOOD
+/// store.
+[[nodiscard]] std::optional<kernels::DescriptorSpec> decode_schema(std::string_view json,
+                                                                   std::uint32_t& version,
                                                                    std::string& why);
 
 /// @brief The category record of the memory's index.
@@ -57,11 +60,12 @@ struct ModelRecord {
 [[nodiscard]] std::string encode_model(const ModelRecord& m);
 [[nodiscard]] std::optional<ModelRecord> decode_model(std::string_view bytes);
 
-/// @brief u32 magic "OFV1", u32 bins, u8 mode, f32 threshold, 16 f32 frame, 3 f32 bbox, u64 track id,
-/// i64 stamp ns, u32 n, n f32 descriptor.
+/// @brief u32 magic "OFV1", u32 bins, u8 mode, f32 threshold, 16 f32 frame, 3 f32 bbox, u64 track
+/// id, i64 stamp ns, u32 n, n f32 descriptor.
 [[nodiscard]] std::string encode_view(const ViewRecord& v, const kernels::DescriptorSpec& spec);
 /// @brief Decodes a view; nullopt with @p why set when the size, magic or parameters are wrong.
-[[nodiscard]] std::optional<ViewRecord> decode_view(std::string_view bytes, const kernels::DescriptorSpec& expected,
+[[nodiscard]] std::optional<ViewRecord> decode_view(std::string_view bytes,
+                                                    const kernels::DescriptorSpec& expected,
                                                     std::string& why);
 
 /// @brief u32 little-endian.

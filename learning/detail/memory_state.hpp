@@ -1,7 +1,7 @@
 #pragma once
 /// @file
-/// @brief The state behind PerceptualMemory (shared by perceptual_memory.cpp and memory_export.cpp).
-/// Internal to learning/.
+/// @brief The state behind PerceptualMemory (shared by perceptual_memory.cpp and
+/// memory_export.cpp). Internal to learning/.
 #include <leveldb/db.h>
 
 #include <memory>
@@ -13,8 +13,8 @@
 
 namespace orthoflow::learning {
 
-/// @brief One category of the index: its record plus the Bayes accumulator, kept in RAM so that a teach
-/// can write the updated model in the same batch as the views.
+/// @brief One category of the index: its record plus the Bayes accumulator, kept in RAM so that a
+/// teach can write the updated model in the same batch as the views.
 struct IndexedCategory {
   CategoryId id = NO_CATEGORY;
   CategoryRecord record;
@@ -31,7 +31,8 @@ struct PerceptualMemory::State {
   std::uint64_t writes = 0;
 
   /// @brief Every view of category @p id in sequence order, decoded and checked against params.
-  [[nodiscard]] static Result<std::vector<ViewRecord>, MemoryError> read_views(State& s, CategoryId id);
+  [[nodiscard]] static Result<std::vector<ViewRecord>, MemoryError> read_views(State& s,
+                                                                               CategoryId id);
 
   /// @brief The index entry of @p label, or nullptr.
   [[nodiscard]] IndexedCategory* find(std::string_view label) noexcept {
@@ -43,9 +44,12 @@ struct PerceptualMemory::State {
 };
 
 /// @brief The bytes of a LevelDB slice.
-[[nodiscard]] inline std::string_view as_view(const leveldb::Slice& s) noexcept { return {s.data(), s.size()}; }
+[[nodiscard]] inline std::string_view as_view(const leveldb::Slice& s) noexcept {
+  return {s.data(), s.size()};
+}
 
 /// @brief A MemoryError with "<dir>: <what>".
-[[nodiscard]] MemoryError memory_error(MemoryError::Code code, const std::filesystem::path& where, const std::string& what);
+[[nodiscard]] MemoryError memory_error(MemoryError::Code code, const std::filesystem::path& where,
+                                       const std::string& what);
 
 }  // namespace orthoflow::learning

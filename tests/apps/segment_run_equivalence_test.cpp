@@ -1,7 +1,8 @@
 // One segmentation chain, and the product runs it (issue: the house): on every frame of
 // ../shared/data/scenes, ../shared/data/mosd_learn and a few synthetic scenes, `orthoflow segment
-// --graph tabletop --json FILE` and the objects of `orthoflow run --source pcd:DIR --json-out` agree:
-// the same object count, and centroids and point counts of the objects in the same order within 1 mm.
+// --graph tabletop --json FILE` and the objects of `orthoflow run --source pcd:DIR --json-out`
+// agree: the same object count, and centroids and point counts of the objects in the same order
+// within 1 mm.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -44,7 +45,8 @@ std::vector<fs::path> pcd_files(const fs::path& dir) {
 
 /// `orthoflow segment --graph tabletop --json` on @p file against the objects of @p frame.
 void expect_same_objects(const fs::path& file, const nlohmann::json& frame) {
-  const Output seg = run(std::string(ORTHOFLOW_CLI) + " segment --graph tabletop --json " + file.string());
+  const Output seg =
+      run(std::string(ORTHOFLOW_CLI) + " segment --graph tabletop --json " + file.string());
   if (seg.status != 0) {  // no table: the graph must have found none either, and no object
     EXPECT_FALSE(frame["table"].get<bool>());
     EXPECT_TRUE(frame["objects"].empty());
@@ -56,7 +58,8 @@ void expect_same_objects(const fs::path& file, const nlohmann::json& frame) {
   EXPECT_TRUE(frame["table"].get<bool>());
   ASSERT_EQ(got.size(), want.size());
   for (std::size_t k = 0; k < got.size(); ++k) {
-    EXPECT_EQ(got[k]["points"].get<std::size_t>(), want[k]["points"].get<std::size_t>()) << "object " << k;
+    EXPECT_EQ(got[k]["points"].get<std::size_t>(), want[k]["points"].get<std::size_t>())
+        << "object " << k;
     for (std::size_t a = 0; a < 3; ++a) {
       EXPECT_NEAR(got[k]["centroid"][a].get<double>(), want[k]["centroid"][a].get<double>(), 1e-3)
           << "object " << k << " axis " << a;
@@ -67,9 +70,10 @@ void expect_same_objects(const fs::path& file, const nlohmann::json& frame) {
 /// Runs both commands on every frame of @p dir and compares them; returns the frames compared.
 std::size_t expect_agreement(const fs::path& dir) {
   const std::string cli = ORTHOFLOW_CLI;
-  const fs::path lines = fs::path(ORTHOFLOW_BINARY_DIR) / ("equivalence_" + dir.filename().string() + ".jsonl");
-  const Output ran = run(cli + " run --source pcd:" + dir.string() + " --rate max --threads 1 --json-out " +
-                         lines.string());
+  const fs::path lines =
+      fs::path(ORTHOFLOW_BINARY_DIR) / ("equivalence_" + dir.filename().string() + ".jsonl");
+  const Output ran = run(cli + " run --source pcd:" + dir.string() +
+                         " --rate max --threads 1 --json-out " + lines.string());
   EXPECT_EQ(ran.status, 0) << ran.text;
   std::ifstream in(lines);
   std::vector<nlohmann::json> frames;
@@ -101,8 +105,9 @@ TEST(SegmentRunEquivalence, SyntheticScenesTouchingAndApart) {
   const std::string cli = ORTHOFLOW_CLI;
   for (int seed = 1; seed <= 4; ++seed) {
     const std::string touching = seed % 2 == 0 ? " --touching" : "";
-    const auto made = run(cli + " synth --objects " + std::to_string(2 + seed) + " --seed " + std::to_string(seed) +
-                          touching + " --out " + (dir / ("scene" + std::to_string(seed) + ".pcd")).string());
+    const auto made = run(cli + " synth --objects " + std::to_string(2 + seed) + " --seed " +
+                          std::to_string(seed) + touching + " --out " +
+                          (dir / ("scene" + std::to_string(seed) + ".pcd")).string());
     ASSERT_EQ(made.status, 0) << made.text;
   }
   EXPECT_EQ(expect_agreement(dir), 4U);

@@ -1,5 +1,6 @@
-// core/: the one random generator (pinned sequence, ranges), fixed-capacity text, the single-producer
-// ring (wrap-around, all-or-nothing pushes, in-place claim, two threads) and the spin lock.
+// core/: the one random generator (pinned sequence, ranges), fixed-capacity text, the
+// single-producer ring (wrap-around, all-or-nothing pushes, in-place claim, two threads) and the
+// spin lock.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -29,7 +30,8 @@ TEST(Rng, SameSeedSameSequenceDifferentSeedDifferent) {
 }
 
 TEST(Rng, FirstValuesArePinned) {
-  // xoshiro256** seeded by SplitMix64 from 0: the values every platform must produce (x86-64, aarch64).
+  // xoshiro256** seeded by SplitMix64 from 0: the values every platform must produce (x86-64,
+  // aarch64).
   Rng r(0);
   const std::uint64_t first = r.next(), second = r.next();
   Rng again(0);
@@ -41,7 +43,8 @@ TEST(Rng, FirstValuesArePinned) {
 
 TEST(Rng, BelowStaysInRangeForSmallAndHugeBounds) {
   Rng r(7);
-  for (const std::uint64_t n : {1ULL, 2ULL, 3ULL, 7ULL, 1000ULL, (1ULL << 32) + 1, (1ULL << 63) + 5, ~0ULL}) {
+  for (const std::uint64_t n :
+       {1ULL, 2ULL, 3ULL, 7ULL, 1000ULL, (1ULL << 32) + 1, (1ULL << 63) + 5, ~0ULL}) {
     for (int i = 0; i < 2000; ++i) EXPECT_LT(r.below(n), n);
   }
   std::vector<int> counts(6, 0);

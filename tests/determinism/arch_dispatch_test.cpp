@@ -1,6 +1,6 @@
 // The run-time dispatch picks the best architecture the build targets: NEON on aarch64, an x86 one
-// (AVX-512BW, AVX2+FMA or SSE2, depending on the CPU) on x86-64. Guards the aarch64 preset against a
-// build that silently falls back to an unexpected architecture list.
+// (AVX-512BW, AVX2+FMA or SSE2, depending on the CPU) on x86-64. Guards the aarch64 preset against
+// a build that silently falls back to an unexpected architecture list.
 #include <gtest/gtest.h>
 
 #include <set>

@@ -1,5 +1,6 @@
-// Writes the golden file of the determinism test: determinism_golden --out tests/golden/determinism.json
-// Run it on x86-64 only (the reference architecture) and commit the result with the change that moved it.
+// Writes the golden file of the determinism test: determinism_golden --out
+// tests/golden/determinism.json Run it on x86-64 only (the reference architecture) and commit the
+// result with the change that moved it.
 #include <cstdio>
 #include <cstring>
 #include <exception>

@@ -1,5 +1,6 @@
-// Computes the golden sections (see golden_outputs.hpp). Floats are written with 9 significant digits,
-// which round-trips a float exactly, so the x86 golden file holds the exact values it computed.
+// Computes the golden sections (see golden_outputs.hpp). Floats are written with 9 significant
+// digits, which round-trips a float exactly, so the x86 golden file holds the exact values it
+// computed.
 #include "golden_outputs.hpp"
 
 #include <algorithm>
@@ -12,13 +13,13 @@
 #include <stdexcept>
 #include <vector>
 
-#include "simulation/object_catalog.hpp"
-#include "simulation/object_dataset.hpp"
 #include "formats/pcd_io.hpp"
-#include "simulation/synthetic_scene.hpp"
 #include "kernels/good.hpp"
 #include "kernels/segmentation_chain.hpp"
 #include "kernels/simd_arch.hpp"
+#include "simulation/object_catalog.hpp"
+#include "simulation/object_dataset.hpp"
+#include "simulation/synthetic_scene.hpp"
 
 namespace orthoflow::testing {
 namespace {
@@ -31,15 +32,14 @@ template <class T>
 std::string fnv1a64(std::span<const T> values) {
   std::uint64_t h = 0xcbf29ce484222325ULL;
   const auto* bytes = reinterpret_cast<const unsigned char*>(values.data());
-  for (std::size_t i = 0; i < values.size_bytes(); ++i) {
-    h = (h ^ bytes[i]) * 0x100000001b3ULL;
-  }
+  for (std::size_t i = 0; i < values.size_bytes(); ++i) { h = (h ^ bytes[i]) * 0x100000001b3ULL; }
   char text[17];
   std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(h));
   return text;
 }
 
-// The scene `orthoflow synth --seed S` writes (apps/cmd_synth.cpp): make_scene(seed), noise from ~seed.
+// The scene `orthoflow synth --seed S` writes (apps/cmd_synth.cpp): make_scene(seed), noise from
+// ~seed.
 ok::PointCloud render_seeded_scene(std::uint64_t seed) {
   const osim::Scene scene = osim::make_scene(osim::SceneConfig{}, seed);
   ok::PointCloud cloud;
@@ -60,7 +60,9 @@ nlohmann::json good_entry(const ok::PointCloud& cloud) {
   ok::GoodScratch scratch(cfg.bins);
   std::vector<float> descriptor(3 * cfg.bins * cfg.bins);
   auto good_result = ok::compute_good(cloud.points(), cfg, scratch, descriptor);
-  if (!good_result) { throw std::runtime_error(std::string("compute_good: ") + ok::to_string(good_result.error())); }
+  if (!good_result) {
+    throw std::runtime_error(std::string("compute_good: ") + ok::to_string(good_result.error()));
+  }
   nlohmann::json entry;
   entry["points_used"] = good_result->points_used;
   entry["flags"] = good_result->flags;
@@ -78,13 +80,12 @@ nlohmann::json golden_scenes() {
   for (unsigned long long seed : GOLDEN_SCENE_SEEDS) {
     const ok::PointCloud cloud = render_seeded_scene(seed);
     std::size_t finite = 0;
-    for (std::size_t i = 0; i < cloud.size(); ++i) { finite += std::isfinite(cloud.z()[i]) ? 1U : 0U; }
-    out[std::to_string(seed)] = {{"points", cloud.size()},
-                                 {"finite", finite},
-                                 {"x", fnv1a64(cloud.x())},
-                                 {"y", fnv1a64(cloud.y())},
-                                 {"z", fnv1a64(cloud.z())},
-                                 {"rgb", fnv1a64(cloud.rgb())},
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+      finite += std::isfinite(cloud.z()[i]) ? 1U : 0U;
+    }
+    out[std::to_string(seed)] = {{"points", cloud.size()},         {"finite", finite},
+                                 {"x", fnv1a64(cloud.x())},        {"y", fnv1a64(cloud.y())},
+                                 {"z", fnv1a64(cloud.z())},        {"rgb", fnv1a64(cloud.rgb())},
                                  {"label", fnv1a64(cloud.label())}};
   }
   return out;
@@ -96,16 +97,19 @@ nlohmann::json golden_segmentation() {
     const ok::PointCloud cloud = render_seeded_scene(seed);
     ok::SegmentationChain chain(cloud.size(), ok::SegmentationParams{});
     auto seg_result = chain.run(cloud.view());
-    if (!seg_result) { throw std::runtime_error("segmentation of scene " + std::to_string(seed) + ": " +
-                                                seg_result.error().to_string()); }
+    if (!seg_result) {
+      throw std::runtime_error("segmentation of scene " + std::to_string(seed) + ": " +
+                               seg_result.error().to_string());
+    }
     std::vector<std::size_t> sizes;
     for (const ok::ClusterStats& c : seg_result->clusters) { sizes.push_back(c.points); }
     std::sort(sizes.begin(), sizes.end(), std::greater<>());
     const ok::Plane& p = seg_result->plane.plane;
-    out[std::to_string(seed)] = {{"normal", {exact(p.normal[0]), exact(p.normal[1]), exact(p.normal[2])}},
-                                 {"d", exact(p.d)},
-                                 {"inliers", seg_result->plane.inliers},
-                                 {"cluster_sizes", sizes}};
+    out[std::to_string(seed)] = {
+        {"normal", {exact(p.normal[0]), exact(p.normal[1]), exact(p.normal[2])}},
+        {"d", exact(p.d)},
+        {"inliers", seg_result->plane.inliers},
+        {"cluster_sizes", sizes}};
   }
   return out;
 }
@@ -119,14 +123,18 @@ nlohmann::json golden_good(const std::string& shared_dir) {
   std::sort(files.begin(), files.end());  // directory order is not portable
   for (const auto& f : files) {
     auto cloud_result = ofmt::read_pcd(f);
-    if (!cloud_result) { throw std::runtime_error(f.string() + ": " + cloud_result.error().to_string()); }
+    if (!cloud_result) {
+      throw std::runtime_error(f.string() + ": " + cloud_result.error().to_string());
+    }
     out[f.filename().string()] = good_entry(*cloud_result);
   }
-  // A rendered view: the renderer is bit-exact, so this also checks GOOD on a known-identical input.
+  // A rendered view: the renderer is bit-exact, so this also checks GOOD on a known-identical
+  // input.
   const osim::ObjectModel mug = osim::make_object_model(osim::Category::MUG, 1, 7);
   ok::PointCloud frame, view;
   core::Rng rng(42);
-  osim::render_object_view(mug, osim::ViewSpec{0.7, 0.4, 0.9}, osim::RenderOptions{}, rng, frame, view);
+  osim::render_object_view(mug, osim::ViewSpec{0.7, 0.4, 0.9}, osim::RenderOptions{}, rng, frame,
+                           view);
   out["synthetic_mug"] = good_entry(view);
   return out;
 }

@@ -1,6 +1,6 @@
 // Cross-architecture determinism: recomputes the golden sections (golden_outputs.hpp) on this build
-// and compares them with tests/golden/determinism.json, produced on x86-64. CTest runs this natively
-// and, in the aarch64 preset, under qemu: the same file must pass on both.
+// and compares them with tests/golden/determinism.json, produced on x86-64. CTest runs this
+// natively and, in the aarch64 preset, under qemu: the same file must pass on both.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -48,16 +48,20 @@ TEST_F(Determinism, SegmentationChainAgreesWithinTolerance) {
   for (const auto& [seed, expected] : golden()["segmentation"].items()) {
     const json& got = actual.at(seed);
     for (std::size_t k = 0; k < 3; ++k) {
-      EXPECT_NEAR(got["normal"][k].get<double>(), expected["normal"][k].get<double>(), ot::GOLDEN_PLANE_TOL)
+      EXPECT_NEAR(got["normal"][k].get<double>(), expected["normal"][k].get<double>(),
+                  ot::GOLDEN_PLANE_TOL)
           << "scene " << seed << " normal[" << k << "]";
     }
-    EXPECT_NEAR(got["d"].get<double>(), expected["d"].get<double>(), ot::GOLDEN_PLANE_TOL) << "scene " << seed;
+    EXPECT_NEAR(got["d"].get<double>(), expected["d"].get<double>(), ot::GOLDEN_PLANE_TOL)
+        << "scene " << seed;
     const double inliers = expected["inliers"].get<double>();
-    EXPECT_NEAR(got["inliers"].get<double>(), inliers, inliers * ot::GOLDEN_INLIER_REL_TOL) << "scene " << seed;
+    EXPECT_NEAR(got["inliers"].get<double>(), inliers, inliers * ot::GOLDEN_INLIER_REL_TOL)
+        << "scene " << seed;
     const json& sizes = expected["cluster_sizes"];
     ASSERT_EQ(got["cluster_sizes"].size(), sizes.size()) << "scene " << seed << ": object count";
     for (std::size_t c = 0; c < sizes.size(); ++c) {
-      EXPECT_LE(std::labs(got["cluster_sizes"][c].get<long>() - sizes[c].get<long>()), ot::GOLDEN_CLUSTER_POINTS_TOL)
+      EXPECT_LE(std::labs(got["cluster_sizes"][c].get<long>() - sizes[c].get<long>()),
+                ot::GOLDEN_CLUSTER_POINTS_TOL)
           << "scene " << seed << " cluster " << c;
     }
   }
@@ -73,7 +77,9 @@ TEST_F(Determinism, GoodDescriptorsAgreeWithinL1Tolerance) {
     const json& e = expected["descriptor"];
     ASSERT_EQ(got["descriptor"].size(), e.size()) << name;
     double l1 = 0.0;
-    for (std::size_t i = 0; i < e.size(); ++i) { l1 += std::fabs(got["descriptor"][i].get<double>() - e[i].get<double>()); }
+    for (std::size_t i = 0; i < e.size(); ++i) {
+      l1 += std::fabs(got["descriptor"][i].get<double>() - e[i].get<double>());
+    }
     std::printf("GOOD %s: L1 %.3g\n", name.c_str(), l1);
     EXPECT_LE(l1, ot::GOLDEN_GOOD_L1_TOL) << name;
   }
@@ -89,7 +95,8 @@ TEST_F(Determinism, LearnerDecisionsAreTheSame) {
       const json& got = actual[kind][s]["answers"];
       ASSERT_EQ(got.size(), expected.size());
       for (std::size_t a = 0; a < expected.size(); ++a) {
-        const std::string where = kind + " after teaching " + steps[s]["taught"].get<std::string>() + ", view " +
+        const std::string where = kind + " after teaching " +
+                                  steps[s]["taught"].get<std::string>() + ", view " +
                                   std::to_string(a);
         EXPECT_EQ(got[a]["label"], expected[a]["label"]) << where;
         EXPECT_EQ(got[a]["unknown"], expected[a]["unknown"]) << where;
@@ -100,7 +107,8 @@ TEST_F(Determinism, LearnerDecisionsAreTheSame) {
             continue;
           }
           const double e = expected[a][key].get<double>();
-          EXPECT_NEAR(got[a][key].get<double>(), e, std::fabs(e) * ot::GOLDEN_SCORE_REL_TOL) << where << " " << key;
+          EXPECT_NEAR(got[a][key].get<double>(), e, std::fabs(e) * ot::GOLDEN_SCORE_REL_TOL)
+              << where << " " << key;
         }
       }
     }

@@ -1,13 +1,13 @@
-// The USB seam without hardware: every UsbError code, the libusb code mappings, the retry wrapper, the
-// clocks, handle ownership, and LibusbTransport on a machine that may have no USB at all.
+// The USB seam without hardware: every UsbError code, the libusb code mappings, the retry wrapper,
+// the clocks, handle ownership, and LibusbTransport on a machine that may have no USB at all.
 #include <gtest/gtest.h>
 
+#include <sys/types.h>
 #include <array>
 #include <climits>
 #include <cstdint>
 #include <set>
 #include <string>
-#include <sys/types.h>
 #include <utility>
 
 #include "drivers/libusb_call.hpp"
@@ -31,10 +31,13 @@ class CountingTransport final : public drv::UsbTransport {
   int closes = 0;
   std::uint32_t last_closed = 0;
 
-  R<std::vector<drv::UsbDeviceInfo>> enumerate(std::uint16_t, std::optional<std::uint16_t>) override {
+  R<std::vector<drv::UsbDeviceInfo>> enumerate(std::uint16_t,
+                                               std::optional<std::uint16_t>) override {
     return std::vector<drv::UsbDeviceInfo>{};
   }
-  R<drv::UsbDeviceHandle> open(const drv::UsbDeviceInfo&) override { return make_handle(next_id_++); }
+  R<drv::UsbDeviceHandle> open(const drv::UsbDeviceInfo&) override {
+    return make_handle(next_id_++);
+  }
   R<void> claim_interface(Handle, std::uint8_t) override { return no(); }
   R<void> release_interface(Handle, std::uint8_t) override { return no(); }
   R<void> set_alt_setting(Handle, std::uint8_t, std::uint8_t) override { return no(); }
@@ -43,18 +46,24 @@ class CountingTransport final : public drv::UsbTransport {
   R<void> attach_kernel_driver(Handle, std::uint8_t) override { return no(); }
   R<void> reset_device(Handle) override { return no(); }
   R<void> clear_halt(Handle, std::uint8_t) override { return no(); }
-  R<std::size_t> control(Handle, const drv::UsbControlSetup&, Bytes, drv::UsbTimeout) override { return no(); }
+  R<std::size_t> control(Handle, const drv::UsbControlSetup&, Bytes, drv::UsbTimeout) override {
+    return no();
+  }
   R<std::size_t> bulk(Handle, std::uint8_t, Bytes, drv::UsbTimeout) override { return no(); }
   R<std::size_t> interrupt(Handle, std::uint8_t, Bytes, drv::UsbTimeout) override { return no(); }
   R<std::size_t> max_iso_packet_size(Handle, std::uint8_t) override { return no(); }
-  R<void> start_iso(Handle, std::uint8_t, const drv::UsbIsoConfig&, drv::UsbIsoCallback) override { return no(); }
+  R<void> start_iso(Handle, std::uint8_t, const drv::UsbIsoConfig&, drv::UsbIsoCallback) override {
+    return no();
+  }
   R<void> stop_iso(Handle, std::uint8_t) override { return no(); }
   R<drv::UsbIsoStats> iso_stats(Handle, std::uint8_t) const override { return no(); }
   R<void> handle_events(drv::UsbTimeout) override { return {}; }
   const drv::MonotonicClock& clock() const noexcept override { return clock_; }
 
  private:
-  static orthoflow::Unexpected<drv::UsbError> no() { return orthoflow::err(drv::refused(Code::NOT_SUPPORTED, "x")); }
+  static orthoflow::Unexpected<drv::UsbError> no() {
+    return orthoflow::err(drv::refused(Code::NOT_SUPPORTED, "x"));
+  }
   void close_device(std::uint32_t id) noexcept override {
     ++closes;
     last_closed = id;
@@ -89,15 +98,26 @@ TEST(UsbError, EveryCodeHasItsOwnNameAndMessage) {
   EXPECT_STREQ(drv::to_string(static_cast<Code>(drv::USB_ERROR_CODE_COUNT)), "unknown");
   EXPECT_STREQ(drv::to_string(Code::SHORT_TRANSFER), "short_transfer");
   // The message names the code, the operation and the native code.
-  EXPECT_EQ(drv::to_string(drv::UsbError{Code::NO_DEVICE, -4, "libusb_open"}), "no_device in libusb_open (native -4)");
+  EXPECT_EQ(drv::to_string(drv::UsbError{Code::NO_DEVICE, -4, "libusb_open"}),
+            "no_device in libusb_open (native -4)");
   EXPECT_EQ(drv::to_string(drv::UsbError{}), "other in (unnamed call) (native 0)");
 }
 
 TEST(LibusbCodes, EveryLibusbErrorMapsToItsOwnCode) {
   // libusb.h's documented LIBUSB_ERROR_* values, IO = -1 ... NOT_SUPPORTED = -12, OTHER = -99.
-  const std::array<std::pair<int, Code>, 13> table{{{-1, Code::IO}, {-2, Code::INVALID_PARAM}, {-3, Code::ACCESS},
-      {-4, Code::NO_DEVICE}, {-5, Code::NOT_FOUND}, {-6, Code::BUSY}, {-7, Code::TIMEOUT}, {-8, Code::OVERFLOW},
-      {-9, Code::PIPE}, {-10, Code::INTERRUPTED}, {-11, Code::NO_MEM}, {-12, Code::NOT_SUPPORTED}, {-99, Code::OTHER}}};
+  const std::array<std::pair<int, Code>, 13> table{{{-1, Code::IO},
+                                                    {-2, Code::INVALID_PARAM},
+                                                    {-3, Code::ACCESS},
+                                                    {-4, Code::NO_DEVICE},
+                                                    {-5, Code::NOT_FOUND},
+                                                    {-6, Code::BUSY},
+                                                    {-7, Code::TIMEOUT},
+                                                    {-8, Code::OVERFLOW},
+                                                    {-9, Code::PIPE},
+                                                    {-10, Code::INTERRUPTED},
+                                                    {-11, Code::NO_MEM},
+                                                    {-12, Code::NOT_SUPPORTED},
+                                                    {-99, Code::OTHER}}};
   std::set<Code> seen;
   for (const auto& [native, code] : table) {
     EXPECT_EQ(drv::usb_error_code_from_libusb(native), code) << "native " << native;
@@ -110,13 +130,16 @@ TEST(LibusbCodes, EveryLibusbErrorMapsToItsOwnCode) {
 }
 
 TEST(LibusbCodes, EveryTransferStatusMapsToItsOwnPacketStatus) {
-  // libusb_transfer_status: COMPLETED 0, ERROR 1, TIMED_OUT 2, CANCELLED 3, STALL 4, NO_DEVICE 5, OVERFLOW 6.
-  const std::array<UsbPacketStatus, 7> expected{UsbPacketStatus::COMPLETED, UsbPacketStatus::ERROR,
-      UsbPacketStatus::TIMED_OUT, UsbPacketStatus::CANCELLED, UsbPacketStatus::STALL, UsbPacketStatus::NO_DEVICE,
+  // libusb_transfer_status: COMPLETED 0, ERROR 1, TIMED_OUT 2, CANCELLED 3, STALL 4, NO_DEVICE 5,
+  // OVERFLOW 6.
+  const std::array<UsbPacketStatus, 7> expected{
+      UsbPacketStatus::COMPLETED, UsbPacketStatus::ERROR, UsbPacketStatus::TIMED_OUT,
+      UsbPacketStatus::CANCELLED, UsbPacketStatus::STALL, UsbPacketStatus::NO_DEVICE,
       UsbPacketStatus::OVERFLOW};
   std::set<std::string> names;
   for (int native = 0; native < 7; ++native) {
-    EXPECT_EQ(drv::usb_packet_status_from_libusb(native), expected[static_cast<std::size_t>(native)]);
+    EXPECT_EQ(drv::usb_packet_status_from_libusb(native),
+              expected[static_cast<std::size_t>(native)]);
     EXPECT_TRUE(names.insert(drv::to_string(expected[static_cast<std::size_t>(native)])).second);
   }
   EXPECT_EQ(drv::usb_packet_status_from_libusb(7), UsbPacketStatus::ERROR);
@@ -126,18 +149,21 @@ TEST(LibusbCodes, EveryTransferStatusMapsToItsOwnPacketStatus) {
 
 TEST(LibusbCall, RetriesInterruptedCallsThenReturnsTheValue) {
   int calls = 0;
-  auto value_result = drv::libusb_call("libusb_x", [&] { return ++calls < 3 ? drv::LIBUSB_INTERRUPTED_NATIVE : 42; });
+  auto value_result = drv::libusb_call(
+      "libusb_x", [&] { return ++calls < 3 ? drv::LIBUSB_INTERRUPTED_NATIVE : 42; });
   ASSERT_TRUE(value_result);
   EXPECT_EQ(*value_result, 42);
   EXPECT_EQ(calls, 3);
-  auto count_result = drv::libusb_call("libusb_get_device_list", [] { return ssize_t{0}; });  // ssize_t, as libusb's
+  auto count_result = drv::libusb_call("libusb_get_device_list",
+                                       [] { return ssize_t{0}; });  // ssize_t, as libusb's
   ASSERT_TRUE(count_result);
   EXPECT_EQ(*count_result, 0);
 }
 
 TEST(LibusbCall, GivesUpAfterBoundedRetries) {
   int calls = 0;
-  auto result = drv::libusb_call("libusb_open", [&] { return ++calls, drv::LIBUSB_INTERRUPTED_NATIVE; });
+  auto result =
+      drv::libusb_call("libusb_open", [&] { return ++calls, drv::LIBUSB_INTERRUPTED_NATIVE; });
   EXPECT_EQ(code_of(result), Code::INTERRUPTED);
   EXPECT_EQ(calls, drv::LIBUSB_CALL_MAX_ATTEMPTS);
   EXPECT_EQ(result.error().native, drv::LIBUSB_INTERRUPTED_NATIVE);
@@ -162,7 +188,8 @@ TEST(FinishTransfer, ShortInIsDataShortOutIsAnErrorAndLengthsAreClamped) {
   EXPECT_EQ(code_of(drv::finish_transfer(-9, 0, 64, false, "libusb_bulk_transfer")), Code::PIPE);
   // Impossible lengths are distrusted, never passed on.
   EXPECT_EQ(bytes_of(drv::finish_transfer(0, 1000, 64, false, "libusb_bulk_transfer")), 64u);
-  EXPECT_EQ(code_of(drv::finish_transfer(0, -5, 8, true, "libusb_bulk_transfer")), Code::SHORT_TRANSFER);
+  EXPECT_EQ(code_of(drv::finish_transfer(0, -5, 8, true, "libusb_bulk_transfer")),
+            Code::SHORT_TRANSFER);
 }
 
 TEST(Clocks, ManualClockMovesOnlyWhenTold) {
@@ -201,7 +228,8 @@ TEST(UsbDeviceInfo, PortsAndParentHub) {
   EXPECT_FALSE(drv::same_parent_hub(camera, device_at(2, {2, 3}))) << "other bus";
   EXPECT_FALSE(drv::same_parent_hub(camera, device_at(1, {3, 3}))) << "other hub";
   EXPECT_FALSE(drv::same_parent_hub(camera, device_at(1, {2, 1, 4}))) << "other depth";
-  EXPECT_FALSE(drv::same_parent_hub(device_at(1, {}), device_at(1, {}))) << "unknown paths never match";
+  EXPECT_FALSE(drv::same_parent_hub(device_at(1, {}), device_at(1, {})))
+      << "unknown paths never match";
   EXPECT_TRUE(camera.serial.view().empty());
 }
 
@@ -215,7 +243,8 @@ TEST(UsbDeviceHandle, ClosesOnceAndMovesOwnership) {
     EXPECT_TRUE(first.is_open());
     EXPECT_EQ(first.transport(), &transport);
     drv::UsbDeviceHandle moved(std::move(first));
-    EXPECT_FALSE(first.is_open());  // NOLINT(bugprone-use-after-move): the moved-from state is the point
+    EXPECT_FALSE(
+        first.is_open());  // NOLINT(bugprone-use-after-move): the moved-from state is the point
     EXPECT_EQ(transport.closes, 0);
     auto second_result = transport.open({});
     ASSERT_TRUE(second_result);
@@ -239,8 +268,10 @@ TEST(LibusbTransport, CreateGivesATransportOrANamedError) {
     GTEST_SKIP() << "libusb_init failed: " << drv::to_string(transport_result.error());
   }
   drv::LibusbTransport& transport = **transport_result;
-  for (const auto& product : {std::optional<std::uint16_t>{0x02AE}, std::optional<std::uint16_t>{}}) {
-    auto devices_result = transport.enumerate(0x045E, product);  // Kinect camera, then any Microsoft device
+  for (const auto& product :
+       {std::optional<std::uint16_t>{0x02AE}, std::optional<std::uint16_t>{}}) {
+    auto devices_result =
+        transport.enumerate(0x045E, product);  // Kinect camera, then any Microsoft device
     ASSERT_TRUE(devices_result) << drv::to_string(devices_result.error());
     for (const auto& device : *devices_result) {
       EXPECT_EQ(device.vendor, 0x045E);
@@ -290,7 +321,8 @@ TEST(LibusbTransport, EveryDeviceCallRefusesAHandleItDidNotOpen) {
     EXPECT_EQ(code_of(transport.bulk(*handle, 0x81, buffer, 500ms)), Code::NOT_OPEN);
     EXPECT_EQ(code_of(transport.interrupt(*handle, 0x82, buffer, 500ms)), Code::NOT_OPEN);
     EXPECT_EQ(code_of(transport.max_iso_packet_size(*handle, 0x82)), Code::NOT_OPEN);
-    EXPECT_EQ(code_of(transport.start_iso(*handle, 0x82, {}, [](auto, auto, auto) {})), Code::NOT_OPEN);
+    EXPECT_EQ(code_of(transport.start_iso(*handle, 0x82, {}, [](auto, auto, auto) {})),
+              Code::NOT_OPEN);
     EXPECT_EQ(code_of(transport.stop_iso(*handle, 0x82)), Code::NOT_OPEN);
     EXPECT_EQ(code_of(transport.iso_stats(*handle, 0x82)), Code::NOT_OPEN);
   }

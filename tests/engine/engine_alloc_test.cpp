@@ -40,7 +40,8 @@ TEST(EngineAllocations, SteadyStateAllocatesNothingPerFrame) {
   std::thread runner([&] { engine.run({}); });
   auto wait_for = [&](std::uint64_t frames) {
     const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(20);
-    while (engine.stats().frames_done.load() < frames && std::chrono::steady_clock::now() < give_up) {
+    while (engine.stats().frames_done.load() < frames &&
+           std::chrono::steady_clock::now() < give_up) {
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
     }
   };

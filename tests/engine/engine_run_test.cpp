@@ -4,8 +4,8 @@
 
 #include <algorithm>
 #include <chrono>
-#include <ctime>
 #include <csignal>
+#include <ctime>
 #include <thread>
 
 #include "engine/engine.hpp"
@@ -17,7 +17,8 @@ namespace {
 
 using test::must_build;
 
-std::string graph_text(const std::string& header, const std::string& nodes, const std::string& edges) {
+std::string graph_text(const std::string& header, const std::string& nodes,
+                       const std::string& edges) {
   return "graph:\n" + header + "nodes:\n" + nodes + "edges:\n" + edges;
 }
 
@@ -30,12 +31,13 @@ CountSink& sink_of(const Engine& engine, const char* name = "sink") {
 class ThreadCounts : public ::testing::TestWithParam<int> {};
 
 TEST_P(ThreadCounts, ChainDeliversEveryFrameInOrderWithPayload) {
-  auto graph = must_build(graph_text("  pool: {block_bytes: 64, blocks: 4}\n",
-                                     "  - {name: src, kind: ticker, params: {frames: 500, payload_bytes: 16}}\n"
-                                     "  - {name: a, kind: busy, params: {add: 1}}\n"
-                                     "  - {name: b, kind: busy, params: {add: 2, serial: 1}}\n"
-                                     "  - {name: sink, kind: count}\n",
-                                     "  - src.out -> a.in\n  - a.out -> b.in\n  - b.out -> sink.in\n"));
+  auto graph = must_build(
+      graph_text("  pool: {block_bytes: 64, blocks: 4}\n",
+                 "  - {name: src, kind: ticker, params: {frames: 500, payload_bytes: 16}}\n"
+                 "  - {name: a, kind: busy, params: {add: 1}}\n"
+                 "  - {name: b, kind: busy, params: {add: 2, serial: 1}}\n"
+                 "  - {name: sink, kind: count}\n",
+                 "  - src.out -> a.in\n  - a.out -> b.in\n  - b.out -> sink.in\n"));
   ASSERT_TRUE(graph);
   Engine engine(*graph, {GetParam()});
   EXPECT_EQ(engine.run({}), StopReason::SOURCE_END);
@@ -61,14 +63,15 @@ std::int64_t expected_join_sum(std::int64_t frames, std::int64_t objects, std::i
 }
 
 TEST(Engine, FanOutProcessesObjectsAndJoinsPerFrame) {
-  auto graph = must_build(graph_text("  pool: {block_bytes: 64, blocks: 6}\n",
-                                     "  - {name: src, kind: ticker, params: {frames: 300, payload_bytes: 8}}\n"
-                                     "  - {name: split, kind: fanout, params: {objects: 5, vary: 1}}\n"
-                                     "  - {name: per_object, kind: busy, params: {type: object, add: 1000}}\n"
-                                     "  - {name: join, kind: join}\n"
-                                     "  - {name: sink, kind: count, ordered: true}\n",
-                                     "  - src.out -> split.in\n  - split.out -> per_object.in\n"
-                                     "  - per_object.out -> join.in\n  - join.out -> sink.in\n"));
+  auto graph = must_build(
+      graph_text("  pool: {block_bytes: 64, blocks: 6}\n",
+                 "  - {name: src, kind: ticker, params: {frames: 300, payload_bytes: 8}}\n"
+                 "  - {name: split, kind: fanout, params: {objects: 5, vary: 1}}\n"
+                 "  - {name: per_object, kind: busy, params: {type: object, add: 1000}}\n"
+                 "  - {name: join, kind: join}\n"
+                 "  - {name: sink, kind: count, ordered: true}\n",
+                 "  - src.out -> split.in\n  - split.out -> per_object.in\n"
+                 "  - per_object.out -> join.in\n  - join.out -> sink.in\n"));
   ASSERT_TRUE(graph);
   Engine engine(*graph, {2});
   engine.run({});
@@ -90,19 +93,21 @@ TEST(Engine, ObjectsOfOneFrameRunInParallel) {
   std::uint32_t max_running = 0;
   double best_cpus = 0.0;
   for (int attempt = 0; attempt < 8 && max_running < 2; ++attempt) {
-    auto graph = must_build(graph_text("  pool: {blocks: 2}\n",
-                                       "  - {name: src, kind: ticker, params: {frames: 4}}\n"
-                                       "  - {name: split, kind: fanout, params: {objects: 8}}\n"
-                                       "  - {name: work, kind: busy, params: {type: object, spin_us: 2000}}\n"
-                                       "  - {name: join, kind: join}\n  - {name: sink, kind: count}\n",
-                                       "  - src.out -> split.in\n  - split.out -> work.in\n"
-                                       "  - work.out -> join.in\n  - join.out -> sink.in\n"));
+    auto graph = must_build(
+        graph_text("  pool: {blocks: 2}\n",
+                   "  - {name: src, kind: ticker, params: {frames: 4}}\n"
+                   "  - {name: split, kind: fanout, params: {objects: 8}}\n"
+                   "  - {name: work, kind: busy, params: {type: object, spin_us: 2000}}\n"
+                   "  - {name: join, kind: join}\n  - {name: sink, kind: count}\n",
+                   "  - src.out -> split.in\n  - split.out -> work.in\n"
+                   "  - work.out -> join.in\n  - join.out -> sink.in\n"));
     ASSERT_TRUE(graph);
     Engine engine(*graph, {2});
     const std::clock_t cpu_start = std::clock();
     const auto wall_start = std::chrono::steady_clock::now();
     engine.run({});
-    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+    const double wall =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
     const double cpu = static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC;
     best_cpus = std::max(best_cpus, cpu / wall);
     EXPECT_EQ(sink_of(engine).received.load(), 4u);
@@ -110,21 +115,26 @@ TEST(Engine, ObjectsOfOneFrameRunInParallel) {
     EXPECT_EQ(engine.stats().nodes[4].max_running.load(), 1u);  // the stateful sink never overlaps
   }
   if (max_running < 2 && best_cpus < 1.5) {
-    GTEST_SKIP() << "host never gave this process 1.5 CPUs (best " << best_cpus << "): cannot observe parallelism";
+    GTEST_SKIP() << "host never gave this process 1.5 CPUs (best " << best_cpus
+                 << "): cannot observe parallelism";
   }
   EXPECT_GE(max_running, 2u);
 }
 
 TEST(Engine, SequencerRestoresFrameOrderAfterParallelStages) {
   // Frames with many objects finish later than empty ones, so the join emits out of order.
-  const std::string nodes = "  - {name: src, kind: ticker, params: {frames: 200}}\n"
-                            "  - {name: split, kind: fanout, params: {objects: 6, vary: 1}}\n"
-                            "  - {name: work, kind: busy, params: {type: object, spin_us: 50}}\n"
-                            "  - {name: join, kind: join}\n";
-  const std::string edges = "  - src.out -> split.in\n  - split.out -> work.in\n  - work.out -> join.in\n"
-                            "  - join.out -> sink.in\n";
-  auto ordered = must_build(graph_text("  pool: {blocks: 8}\n", nodes + "  - {name: sink, kind: count, ordered: true}\n", edges));
-  auto unordered = must_build(graph_text("  pool: {blocks: 8}\n", nodes + "  - {name: sink, kind: count}\n", edges));
+  const std::string nodes =
+      "  - {name: src, kind: ticker, params: {frames: 200}}\n"
+      "  - {name: split, kind: fanout, params: {objects: 6, vary: 1}}\n"
+      "  - {name: work, kind: busy, params: {type: object, spin_us: 50}}\n"
+      "  - {name: join, kind: join}\n";
+  const std::string edges =
+      "  - src.out -> split.in\n  - split.out -> work.in\n  - work.out -> join.in\n"
+      "  - join.out -> sink.in\n";
+  auto ordered = must_build(graph_text(
+      "  pool: {blocks: 8}\n", nodes + "  - {name: sink, kind: count, ordered: true}\n", edges));
+  auto unordered = must_build(
+      graph_text("  pool: {blocks: 8}\n", nodes + "  - {name: sink, kind: count}\n", edges));
   ASSERT_TRUE(ordered && unordered);
   Engine with_sequencer(*ordered, {4});
   Engine without(*unordered, {4});
@@ -133,7 +143,8 @@ TEST(Engine, SequencerRestoresFrameOrderAfterParallelStages) {
   EXPECT_EQ(sink_of(with_sequencer).received.load(), 200u);
   EXPECT_EQ(sink_of(with_sequencer).out_of_order.load(), 0u);
   // Not asserted (depends on the scheduler), but shows the sequencer had work to do.
-  RecordProperty("out_of_order_without_sequencer", static_cast<int>(sink_of(without).out_of_order.load()));
+  RecordProperty("out_of_order_without_sequencer",
+                 static_cast<int>(sink_of(without).out_of_order.load()));
 }
 
 std::string slow_graph(const char* policy) {
@@ -196,11 +207,12 @@ TEST(Engine, PeriodPacesTheSourceAndCountsDeadlineMisses) {
 }
 
 TEST(Engine, PoolExhaustionAtTheSourceIsADrop) {
-  auto graph = must_build(graph_text("  pool: {block_bytes: 64, blocks: 2}\n",
-                                     "  - {name: src, kind: ticker, params: {frames: 50, payload_bytes: 8}}\n"
-                                     "  - {name: slow, kind: busy, params: {spin_us: 200}}\n"
-                                     "  - {name: sink, kind: count}\n",
-                                     "  - src.out -> slow.in\n  - slow.out -> sink.in\n"));
+  auto graph = must_build(
+      graph_text("  pool: {block_bytes: 64, blocks: 2}\n",
+                 "  - {name: src, kind: ticker, params: {frames: 50, payload_bytes: 8}}\n"
+                 "  - {name: slow, kind: busy, params: {spin_us: 200}}\n"
+                 "  - {name: sink, kind: count}\n",
+                 "  - src.out -> slow.in\n  - slow.out -> sink.in\n"));
   ASSERT_TRUE(graph);
   auto held = graph->pool->acquire("test", 8);  // leaves one block for two frames in flight
   ASSERT_TRUE(held);
@@ -227,7 +239,8 @@ TEST(Engine, RequestStopDrainsInFlightFramesQuickly) {
   Engine engine(*graph, {2});
   StopReason reason = StopReason::SOURCE_END;
   std::thread runner([&] { reason = engine.run({}); });
-  while (engine.stats().frames_done.load() < 20) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  while (engine.stats().frames_done.load() < 20)
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
   const auto asked = std::chrono::steady_clock::now();
   engine.request_stop();
   runner.join();
@@ -247,7 +260,8 @@ TEST(Engine, SignalFlagStopsTheRun) {
   Engine engine(*graph, {1});
   auto previous = std::signal(SIGTERM, on_signal);
   std::thread raiser([&] {
-    while (engine.stats().frames_done.load() < 10) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    while (engine.stats().frames_done.load() < 10)
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
     std::raise(SIGTERM);
   });
   EXPECT_EQ(engine.run({0, &g_signalled}), StopReason::STOP_REQUESTED);

@@ -12,7 +12,8 @@ namespace {
 
 std::uint64_t messages_handled(const GraphStats& stats) {
   std::uint64_t total = 0;
-  for (const auto& n : stats.nodes) total += n.processed.load() + n.skipped.load() + n.dropped.load();
+  for (const auto& n : stats.nodes)
+    total += n.processed.load() + n.skipped.load() + n.dropped.load();
   return total;
 }
 
@@ -20,7 +21,9 @@ TEST(EngineStress, MillionMessagesNoneLost) {
   constexpr std::uint64_t FRAMES = 42000;  // 24 messages per frame: > 1e6 messages
   auto graph = test::must_build(
       "graph:\n  pool: {block_bytes: 128, blocks: 8}\nnodes:\n"
-      "  - {name: src, kind: ticker, params: {frames: " + std::to_string(FRAMES) + ", payload_bytes: 16}}\n"
+      "  - {name: src, kind: ticker, params: {frames: " +
+      std::to_string(FRAMES) +
+      ", payload_bytes: 16}}\n"
       "  - {name: split, kind: fanout, params: {objects: 10}}\n"
       "  - {name: obj, kind: busy, params: {type: object, add: 1}}\n"
       "  - {name: join, kind: join}\n"
@@ -41,7 +44,8 @@ TEST(EngineStress, MillionMessagesNoneLost) {
   EXPECT_EQ(sink->out_of_order.load(), 0u);
   EXPECT_EQ(sink->payload_errors.load(), 0u);
   // On a loaded machine the source may find the pool empty for a frame (a finishing task still
-  // holds the previous block); such frames are counted drops at the source and travel as tombstones.
+  // holds the previous block); such frames are counted drops at the source and travel as
+  // tombstones.
   const std::uint64_t source_drops = stats.source_drops.load();
   EXPECT_LT(source_drops, FRAMES / 100);
   EXPECT_EQ(stats.nodes[2].processed.load(), 10 * (FRAMES - source_drops));

@@ -14,7 +14,7 @@ using Code = GraphError::Code;
 const std::string HEADER = "graph:\n  name: t\n  pool: {block_bytes: 256, blocks: 4}\nnodes:\n";
 //                           1          2         3                                4
 const std::string SRC = "  - {name: src, kind: ticker, params: {frames: 5}}\n";  // line 5
-const std::string SINK = "  - {name: sink, kind: count}\n";                     // line 6
+const std::string SINK = "  - {name: sink, kind: count}\n";                      // line 6
 
 void expect_error(const std::string& yaml, Code code, int line, const std::string& needle) {
   const auto built = build_yaml(yaml, "bad.yaml");
@@ -24,7 +24,9 @@ void expect_error(const std::string& yaml, Code code, int line, const std::strin
   EXPECT_EQ(built.error.file, "bad.yaml");
   const std::string text = to_string(built.error);
   EXPECT_NE(text.find(needle), std::string::npos) << text;
-  EXPECT_EQ(text.rfind("bad.yaml:" + std::to_string(line) + ": error [" + to_string(code) + "]", 0), 0u) << text;
+  EXPECT_EQ(text.rfind("bad.yaml:" + std::to_string(line) + ": error [" + to_string(code) + "]", 0),
+            0u)
+      << text;
 }
 
 TEST(GraphValidation, AcceptsAMinimalGraph) {
@@ -56,7 +58,8 @@ TEST(GraphValidation, SyntaxErrorNamesLine) {
 }
 
 TEST(GraphValidation, BadStructure) {
-  expect_error(HEADER + SRC + SINK + "edges:\n  - src.out => sink.in\n", Code::BAD_STRUCTURE, 8, "node.port -> node.port");
+  expect_error(HEADER + SRC + SINK + "edges:\n  - src.out => sink.in\n", Code::BAD_STRUCTURE, 8,
+               "node.port -> node.port");
   expect_error(HEADER + SRC + "  - {name: sink}\n", Code::BAD_STRUCTURE, 6, "'kind'");
 }
 
@@ -65,21 +68,27 @@ TEST(GraphValidation, DuplicateNode) {
 }
 
 TEST(GraphValidation, UnknownKind) {
-  expect_error(HEADER + SRC + "  - {name: sink, kind: teleport}\n", Code::UNKNOWN_KIND, 6, "'teleport'");
+  expect_error(HEADER + SRC + "  - {name: sink, kind: teleport}\n", Code::UNKNOWN_KIND, 6,
+               "'teleport'");
 }
 
 TEST(GraphValidation, UnknownNode) {
-  expect_error(HEADER + SRC + SINK + "edges:\n  - src.out -> sinc.in\n", Code::UNKNOWN_NODE, 8, "'sinc'");
+  expect_error(HEADER + SRC + SINK + "edges:\n  - src.out -> sinc.in\n", Code::UNKNOWN_NODE, 8,
+               "'sinc'");
 }
 
 TEST(GraphValidation, UnknownPort) {
-  expect_error(HEADER + SRC + SINK + "edges:\n  - src.out -> sink.input\n", Code::UNKNOWN_PORT, 8, "'input'");
-  expect_error(HEADER + SRC + SINK + "edges:\n  - src.output -> sink.in\n", Code::UNKNOWN_PORT, 8, "'output'");
+  expect_error(HEADER + SRC + SINK + "edges:\n  - src.out -> sink.input\n", Code::UNKNOWN_PORT, 8,
+               "'input'");
+  expect_error(HEADER + SRC + SINK + "edges:\n  - src.output -> sink.in\n", Code::UNKNOWN_PORT, 8,
+               "'output'");
 }
 
 TEST(GraphValidation, TypeMismatch) {
-  expect_error(HEADER + SRC + "  - {name: sink, kind: count, params: {type: object}}\nedges:\n  - src.out -> sink.in\n",
-               Code::TYPE_MISMATCH, 8, "'frame'");
+  expect_error(
+      HEADER + SRC +
+          "  - {name: sink, kind: count, params: {type: object}}\nedges:\n  - src.out -> sink.in\n",
+      Code::TYPE_MISMATCH, 8, "'frame'");
 }
 
 TEST(GraphValidation, UnconnectedRequiredInput) {
@@ -88,16 +97,17 @@ TEST(GraphValidation, UnconnectedRequiredInput) {
 
 TEST(GraphValidation, Cycle) {
   const std::string nodes = HEADER + SRC + "  - {name: a, kind: pass}\n  - {name: b, kind: pass}\n";
-  expect_error(nodes + "edges:\n  - src.out -> a.in\n  - a.out -> b.in\n  - b.out -> a.in\n", Code::CYCLE, 6,
-               "a -> b -> a");
+  expect_error(nodes + "edges:\n  - src.out -> a.in\n  - a.out -> b.in\n  - b.out -> a.in\n",
+               Code::CYCLE, 6, "a -> b -> a");
 }
 
 TEST(GraphValidation, BadParameterNamesKeyAndLine) {
-  expect_error(HEADER + "  - name: src\n    kind: ticker\n    params:\n      frames: -3\n" + SINK, Code::BAD_PARAMETER, 5,
-               "parameter 'frames' (line 8)");
-  expect_error(HEADER + SRC + "  - {name: sink, kind: count, params: {colour: red}}\n", Code::BAD_PARAMETER, 6,
-               "'colour'");
-  expect_error(HEADER + SRC + "  - {name: sink, kind: count, policy: newest}\n", Code::BAD_PARAMETER, 6, "newest");
+  expect_error(HEADER + "  - name: src\n    kind: ticker\n    params:\n      frames: -3\n" + SINK,
+               Code::BAD_PARAMETER, 5, "parameter 'frames' (line 8)");
+  expect_error(HEADER + SRC + "  - {name: sink, kind: count, params: {colour: red}}\n",
+               Code::BAD_PARAMETER, 6, "'colour'");
+  expect_error(HEADER + SRC + "  - {name: sink, kind: count, policy: newest}\n",
+               Code::BAD_PARAMETER, 6, "newest");
   expect_error("graph:\n  period_ms: fast\nnodes:\n" + SRC, Code::BAD_PARAMETER, 2, "period_ms");
 }
 
@@ -107,8 +117,10 @@ TEST(GraphValidation, SourceCount) {
 }
 
 TEST(GraphValidation, PoolErrors) {
-  expect_error("graph:\n  pool: {block_bytes: 0, blocks: 2}\nnodes:\n" + SRC, Code::POOL, 0, "block_bytes");
-  expect_error("graph:\n  max_in_flight: 9\n  pool: {blocks: 4}\nnodes:\n" + SRC, Code::POOL, 0, "exceeds");
+  expect_error("graph:\n  pool: {block_bytes: 0, blocks: 2}\nnodes:\n" + SRC, Code::POOL, 0,
+               "block_bytes");
+  expect_error("graph:\n  max_in_flight: 9\n  pool: {blocks: 4}\nnodes:\n" + SRC, Code::POOL, 0,
+               "exceeds");
 }
 
 TEST(ParamMap, TypedGettersReportKeyAndLine) {

@@ -20,7 +20,8 @@ TEST(LatencyHistogram, BucketsAreMonotoneAndBoundTheValue) {
     EXPECT_GE(b, previous);
     EXPECT_LE(v, LatencyHistogram::bucket_upper(b));
     if (v >= 16) {
-      EXPECT_LE(static_cast<double>(LatencyHistogram::bucket_upper(b)), 1.125 * static_cast<double>(v) + 1);
+      EXPECT_LE(static_cast<double>(LatencyHistogram::bucket_upper(b)),
+                1.125 * static_cast<double>(v) + 1);
     }
     previous = b;
   }
@@ -37,7 +38,8 @@ TEST(LatencyHistogram, PercentilesWithinStatedError) {
   for (auto v : values) h.record(v);
   std::sort(values.begin(), values.end());
   for (double q : {0.5, 0.9, 0.99, 0.999}) {
-    const auto exact = values[static_cast<std::size_t>(std::ceil(q * static_cast<double>(values.size()))) - 1];
+    const auto exact =
+        values[static_cast<std::size_t>(std::ceil(q * static_cast<double>(values.size()))) - 1];
     EXPECT_GE(h.percentile(q), exact) << q;
     EXPECT_LE(static_cast<double>(h.percentile(q)), 1.125 * static_cast<double>(exact) + 1) << q;
   }

@@ -1,15 +1,15 @@
 #pragma once
-// A small dataset on disk for the file-level tests: category k is a box of its own proportions, each view
-// 400 seeded points on the box's surface, rotated about the vertical by a per-view angle. Written as
-// DIR/box<k>/inst<i>/view<v>.pcd under a directory unique to the test process.
+// A small dataset on disk for the file-level tests: category k is a box of its own proportions,
+// each view 400 seeded points on the box's surface, rotated about the vertical by a per-view angle.
+// Written as DIR/box<k>/inst<i>/view<v>.pcd under a directory unique to the test process.
 #include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
 #include <string>
 
-#include "formats/pcd_io.hpp"
 #include "core/rng.hpp"
+#include "formats/pcd_io.hpp"
 
 namespace orthoflow::evaluation::testing {
 
@@ -23,7 +23,8 @@ inline std::filesystem::path unique_dir(const std::string& name) {
 
 inline kernels::PointCloud box_view(int category, int instance, int view) {
   core::Rng rng(static_cast<std::uint64_t>(category * 1000 + instance * 100 + view + 1));
-  const double hx = 0.02 + 0.03 * category + 0.002 * instance, hy = 0.03, hz = 0.02 + 0.015 * (category % 3);
+  const double hx = 0.02 + 0.03 * category + 0.002 * instance, hy = 0.03,
+               hz = 0.02 + 0.015 * (category % 3);
   const double angle = 0.6 * view + 0.3 * instance;
   kernels::PointCloud cloud;
   cloud.resize_unorganized(400);
@@ -40,13 +41,16 @@ inline kernels::PointCloud box_view(int category, int instance, int view) {
 }
 
 /// Writes categories x instances x views box views under @p root.
-inline void write_box_dataset(const std::filesystem::path& root, int categories, int instances, int views) {
+inline void write_box_dataset(const std::filesystem::path& root, int categories, int instances,
+                              int views) {
   for (int c = 0; c < categories; ++c) {
     for (int i = 0; i < instances; ++i) {
-      const std::filesystem::path dir = root / ("box" + std::to_string(c)) / ("inst" + std::to_string(i));
+      const std::filesystem::path dir =
+          root / ("box" + std::to_string(c)) / ("inst" + std::to_string(i));
       std::filesystem::create_directories(dir);
       for (int v = 0; v < views; ++v) {
-        (void)formats::write_pcd(box_view(c, i, v), dir / ("view" + std::to_string(v) + ".pcd"), formats::PcdEncoding::BINARY);
+        (void)formats::write_pcd(box_view(c, i, v), dir / ("view" + std::to_string(v) + ".pcd"),
+                                 formats::PcdEncoding::BINARY);
       }
     }
   }

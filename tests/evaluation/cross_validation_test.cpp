@@ -1,5 +1,6 @@
-// Metrics on hand-counted confusion matrices, stratified folds, and k-fold cross-validation on hand-made
-// datasets (separable: accuracy 1; two identical categories: every view of one is taken for the other).
+// Metrics on hand-counted confusion matrices, stratified folds, and k-fold cross-validation on
+// hand-made datasets (separable: accuracy 1; two identical categories: every view of one is taken
+// for the other).
 #include <gtest/gtest.h>
 
 #include <set>
@@ -15,7 +16,8 @@ using testing::E1;
 using testing::E2;
 
 TEST(Metrics, HandCountedConfusion) {
-  // truth 0: 3 right, 1 as class 1; truth 1: 2 right, 1 unknown; class 2 never asked, predicted once (from 0).
+  // truth 0: 3 right, 1 as class 1; truth 1: 2 right, 1 unknown; class 2 never asked, predicted
+  // once (from 0).
   Confusion c(3);
   for (int i = 0; i < 3; ++i) { c.add(0, 0); }
   c.add(0, 1);
@@ -54,7 +56,8 @@ TEST(Folds, StratifiedDeterministicAndSeeded) {
   ASSERT_TRUE(f1 && f2 && f3);
   EXPECT_EQ(f1->fold_of_view, f2->fold_of_view);
   EXPECT_NE(f1->fold_of_view, f3->fold_of_view);
-  // Category a (10 views): exactly one per fold; b (13): every fold 1 or 2; c (3): 3 distinct folds.
+  // Category a (10 views): exactly one per fold; b (13): every fold 1 or 2; c (3): 3 distinct
+  // folds.
   for (std::uint32_t c = 0; c < 3; ++c) {
     std::vector<int> per_fold(10, 0);
     for (const std::size_t v : h.dataset.views_of(c)) { per_fold[f1->fold_of_view[v]] += 1; }
@@ -89,8 +92,8 @@ TEST(CrossValidation, SeparableCategoriesAreAllRight) {
   }
 }
 
-// a and b have identical views: nearest neighbour ties go to the category taught first (a), so every b
-// view is answered "a": accuracy 10/20, recall a = 1, recall b = 0.
+// a and b have identical views: nearest neighbour ties go to the category taught first (a), so
+// every b view is answered "a": accuracy 10/20, recall a = 1, recall b = 0.
 TEST(CrossValidation, IdenticalCategoriesAreConfused) {
   const auto h = testing::hand_made({{"a", 10, E0}, {"b", 10, E0}});
   auto folds = make_folds(h.dataset, 10, 3);
@@ -101,14 +104,15 @@ TEST(CrossValidation, IdenticalCategoriesAreConfused) {
   EXPECT_DOUBLE_EQ(r.scores.macro_recall, 0.5);
 }
 
-// Perturbed test views: training on clean rows, testing on rows of another table (here: the test table
-// swaps the descriptors of a and b, so every answer is wrong).
+// Perturbed test views: training on clean rows, testing on rows of another table (here: the test
+// table swaps the descriptors of a and b, so every answer is wrong).
 TEST(CrossValidation, TestTableIsTheOneAsked) {
   const auto h = testing::hand_made({{"a", 6, E0}, {"b", 6, E1}});
   const auto swapped = testing::hand_made({{"a", 6, E1}, {"b", 6, E0}});
   auto folds = make_folds(h.dataset, 3, 1);
   ASSERT_TRUE(folds);
-  const CvResult r = cross_validate(h.dataset, *folds, h.table, swapped.table, testing::nn_variant());
+  const CvResult r =
+      cross_validate(h.dataset, *folds, h.table, swapped.table, testing::nn_variant());
   EXPECT_DOUBLE_EQ(r.scores.accuracy, 0.0);
 }
 

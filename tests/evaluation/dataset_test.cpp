@@ -1,5 +1,5 @@
-// Dataset scanning (layout rules and errors), describing views (parallel, perturbed, cached) and the
-// descriptor cache (reuse, invalidation on a changed file, corrupt cache files ignored).
+// Dataset scanning (layout rules and errors), describing views (parallel, perturbed, cached) and
+// the descriptor cache (reuse, invalidation on a changed file, corrupt cache files ignored).
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -76,11 +76,13 @@ TEST(Descriptors, BadViewIsNamedAndBadSpecRefused) {
   EXPECT_NE(t.error().message.find("view9.pcd"), std::string::npos) << t.error().message;
   ViewDescription zero_bins;
   zero_bins.descriptor.good.bins = 0;
-  EXPECT_EQ(describe_dataset(*ds, zero_bins, {}, nullptr, nullptr, nullptr).error().code, EvalError::Code::BAD_CONFIG);
+  EXPECT_EQ(describe_dataset(*ds, zero_bins, {}, nullptr, nullptr, nullptr).error().code,
+            EvalError::Code::BAD_CONFIG);
   ViewDescription nan_noise;
   nan_noise.perturbation = Perturbation::NOISE;
   nan_noise.amount_m = std::nan("");
-  EXPECT_EQ(describe_dataset(*ds, nan_noise, {}, nullptr, nullptr, nullptr).error().code, EvalError::Code::BAD_CONFIG);
+  EXPECT_EQ(describe_dataset(*ds, nan_noise, {}, nullptr, nullptr, nullptr).error().code,
+            EvalError::Code::BAD_CONFIG);
   fs::remove_all(root);
 }
 
@@ -99,17 +101,21 @@ TEST(Descriptors, CacheIsReusedAndInvalidatedByAChangedFile) {
   EXPECT_EQ(first.computed, 12U);
   EXPECT_EQ(second.cached, 12U);
   EXPECT_EQ(a->values, b->values);
-  // A rewritten file (other points, other size) is described again; the others still come from the cache.
+  // A rewritten file (other points, other size) is described again; the others still come from the
+  // cache.
   kernels::PointCloud other = testing::box_view(1, 1, 1);
   other.resize_unorganized(300);
-  ASSERT_TRUE(formats::write_pcd(other, root / "box0/inst0/view0.pcd", formats::PcdEncoding::BINARY));
+  ASSERT_TRUE(
+      formats::write_pcd(other, root / "box0/inst0/view0.pcd", formats::PcdEncoding::BINARY));
   auto c = describe_dataset(*ds, spec, cache, nullptr, &third, nullptr);
   ASSERT_TRUE(c);
   EXPECT_EQ(third.computed, 1U);
   EXPECT_EQ(third.cached, 11U);
   EXPECT_NE(c->row(0)[0], a->row(0)[0]);
   // A corrupt cache file is ignored: everything is recomputed and the cache rewritten.
-  for (const auto& e : fs::directory_iterator(cache)) { std::ofstream(e.path(), std::ios::trunc) << "OFDC garbage"; }
+  for (const auto& e : fs::directory_iterator(cache)) {
+    std::ofstream(e.path(), std::ios::trunc) << "OFDC garbage";
+  }
   auto d = describe_dataset(*ds, spec, cache, nullptr, &fourth, nullptr);
   ASSERT_TRUE(d);
   EXPECT_EQ(fourth.computed, 12U);
@@ -131,7 +137,9 @@ TEST(Descriptors, PerturbationsAreDeterministicAndDoWhatTheySay) {
   EXPECT_TRUE(std::equal(n1.x().begin(), n1.x().end(), n2.x().begin()));
   EXPECT_FALSE(std::equal(n1.x().begin(), n1.x().end(), n3.x().begin()));
   double sq = 0.0;
-  for (std::size_t i = 0; i < cloud.size(); ++i) { sq += (n1.x()[i] - cloud.x()[i]) * (n1.x()[i] - cloud.x()[i]); }
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    sq += (n1.x()[i] - cloud.x()[i]) * (n1.x()[i] - cloud.x()[i]);
+  }
   EXPECT_NEAR(std::sqrt(sq / static_cast<double>(cloud.size())), 0.005, 0.001);
   ViewDescription voxel;
   voxel.perturbation = Perturbation::DOWNSAMPLE;
@@ -156,7 +164,8 @@ TEST(DescriptorCache, RoundTripAndMalformedBytesGiveAnEmptyCache) {
   EXPECT_EQ(back.entries.at("a/b/c.pcd").descriptor[2], 0.7F);
   EXPECT_TRUE(parse_descriptor_cache(bytes, 4).entries.empty());  // other descriptor length
   for (std::size_t cut = 0; cut < bytes.size(); ++cut) {
-    EXPECT_TRUE(parse_descriptor_cache(std::string_view(bytes).substr(0, cut), 3).entries.empty()) << cut;
+    EXPECT_TRUE(parse_descriptor_cache(std::string_view(bytes).substr(0, cut), 3).entries.empty())
+        << cut;
   }
   std::string extra = bytes + "x";
   EXPECT_TRUE(parse_descriptor_cache(extra, 3).entries.empty());

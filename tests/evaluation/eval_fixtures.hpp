@@ -1,6 +1,7 @@
 #pragma once
-// Hand-made datasets for the protocol tests: categories whose views are given descriptors (length 3, i.e.
-// GOOD with 1 bin), so the expected learner answers, and hence NLC / QCI / GCA, can be worked out by hand.
+// Hand-made datasets for the protocol tests: categories whose views are given descriptors (length
+// 3, i.e. GOOD with 1 bin), so the expected learner answers, and hence NLC / QCI / GCA, can be
+// worked out by hand.
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -30,8 +31,10 @@ inline HandMade hand_made(const std::vector<HandCategory>& cats) {
     h.dataset.categories.push_back(cats[c].name);
     h.dataset.instances.push_back(cats[c].name + "/i0");
     for (std::size_t v = 0; v < cats[c].views; ++v) {
-      h.dataset.views.push_back(DatasetView{c, c, cats[c].name + "/i0/v" + std::to_string(v) + ".pcd"});
-      h.table.values.insert(h.table.values.end(), cats[c].descriptor.begin(), cats[c].descriptor.end());
+      h.dataset.views.push_back(
+          DatasetView{c, c, cats[c].name + "/i0/v" + std::to_string(v) + ".pcd"});
+      h.table.values.insert(h.table.values.end(), cats[c].descriptor.begin(),
+                            cats[c].descriptor.end());
     }
   }
   return h;

@@ -52,7 +52,8 @@ fs::path* Experiment::root_ = nullptr;
 
 TEST_F(Experiment, SameSeedSameResultsForAnyThreadCount) {
   const Dataset ds = dataset();
-  for (const Protocol p : {Protocol::CV10, Protocol::TEACHER, Protocol::TEACHER_CONTEXT, Protocol::NOISE, Protocol::DOWNSAMPLE}) {
+  for (const Protocol p : {Protocol::CV10, Protocol::TEACHER, Protocol::TEACHER_CONTEXT,
+                           Protocol::NOISE, Protocol::DOWNSAMPLE}) {
     auto one = evaluate(ds, options(p, 1), nullptr);
     auto two = evaluate(ds, options(p, 2), nullptr);
     ASSERT_TRUE(one && two) << to_string(p);
@@ -61,7 +62,9 @@ TEST_F(Experiment, SameSeedSameResultsForAnyThreadCount) {
     other_seed.seed = 12;
     auto three = evaluate(ds, other_seed, nullptr);
     ASSERT_TRUE(three);
-    if (p != Protocol::DOWNSAMPLE && p != Protocol::NOISE) { EXPECT_NE(stable_json(*one), stable_json(*three)) << to_string(p); }
+    if (p != Protocol::DOWNSAMPLE && p != Protocol::NOISE) {
+      EXPECT_NE(stable_json(*one), stable_json(*three)) << to_string(p);
+    }
   }
 }
 

@@ -1,5 +1,6 @@
-// Line plots (evaluation/line_plot.hpp): PNG decodes with the series colours in the plot, SVG structure and
-// byte-for-byte determinism, degenerate data that must still draw, and every PlotError code.
+// Line plots (evaluation/line_plot.hpp): PNG decodes with the series colours in the plot, SVG
+// structure and byte-for-byte determinism, degenerate data that must still draw, and every
+// PlotError code.
 #include "evaluation/line_plot.hpp"
 
 #include <cairo.h>
@@ -40,20 +41,29 @@ PlotSpec accuracy_spec() {
   spec.y_label = "accuracy";
   spec.y_min = 0.0, spec.y_max = 1.0;
   spec.width = 640, spec.height = 400;
-  spec.series.push_back({"instance-based", {0, 10, 20, 30, 40}, {0.3, 0.3, 0.3, 0.3, 0.3}, {}, false});
-  spec.series.push_back({"bayesian", {0, 10, 20, 30, 40}, {0.7, 0.7, 0.7, 0.7, 0.7}, {0.05, 0.05, 0.1, 0.02, 0}, true});
+  spec.series.push_back(
+      {"instance-based", {0, 10, 20, 30, 40}, {0.3, 0.3, 0.3, 0.3, 0.3}, {}, false});
+  spec.series.push_back({"bayesian",
+                         {0, 10, 20, 30, 40},
+                         {0.7, 0.7, 0.7, 0.7, 0.7},
+                         {0.05, 0.05, 0.1, 0.02, 0},
+                         true});
   return spec;
 }
 
 // Pixels of column x whose colour is within 1 per channel of (r, g, b).
-int count_in_column(cairo_surface_t* img, int x, std::uint32_t r, std::uint32_t g, std::uint32_t b) {
+int count_in_column(cairo_surface_t* img, int x, std::uint32_t r, std::uint32_t g,
+                    std::uint32_t b) {
   const unsigned char* data = cairo_image_surface_get_data(img);
   const int stride = cairo_image_surface_get_stride(img);
-  const auto near = [](std::uint32_t a, std::uint32_t want) { return (a > want ? a - want : want - a) <= 1; };
+  const auto near = [](std::uint32_t a, std::uint32_t want) {
+    return (a > want ? a - want : want - a) <= 1;
+  };
   int hits = 0;
   for (int y = 0; y < cairo_image_surface_get_height(img); ++y) {
     std::uint32_t px = 0;
-    std::memcpy(&px, data + static_cast<std::ptrdiff_t>(y) * stride + x * 4, 4);  // ARGB32, native endian
+    std::memcpy(&px, data + static_cast<std::ptrdiff_t>(y) * stride + x * 4,
+                4);  // ARGB32, native endian
     hits += near((px >> 16) & 0xFF, r) && near((px >> 8) & 0xFF, g) && near(px & 0xFF, b) ? 1 : 0;
   }
   return hits;
@@ -68,7 +78,8 @@ TEST(LinePlot, PngDecodesWithSizeBackgroundAndSeriesColours) {
   ASSERT_EQ(cairo_surface_status(img.get()), CAIRO_STATUS_SUCCESS);
   EXPECT_EQ(cairo_image_surface_get_width(img.get()), 640);
   EXPECT_EQ(cairo_image_surface_get_height(img.get()), 400);
-  // The flat series cross the middle column (the legend sits in a corner): Okabe-Ito blue, then vermillion.
+  // The flat series cross the middle column (the legend sits in a corner): Okabe-Ito blue, then
+  // vermillion.
   EXPECT_GE(count_in_column(img.get(), 320, 0, 114, 178), 1);
   EXPECT_GE(count_in_column(img.get(), 320, 213, 94, 0), 1);
   EXPECT_EQ(count_in_column(img.get(), 320, 0, 158, 115), 0);  // the third colour: no third series
@@ -81,13 +92,15 @@ TEST(LinePlot, SvgIsWellFormedAndCarriesTheTitleGlyphs) {
   ASSERT_TRUE(write_plot_svg(spec, dir / "with_title.svg"));
   spec.title.clear();
   ASSERT_TRUE(write_plot_svg(spec, dir / "without_title.svg"));
-  const std::string with_title = read_all(dir / "with_title.svg"), without = read_all(dir / "without_title.svg");
+  const std::string with_title = read_all(dir / "with_title.svg"),
+                    without = read_all(dir / "without_title.svg");
   EXPECT_EQ(with_title.rfind("<?xml", 0), 0u);
   EXPECT_NE(with_title.find("<svg"), std::string::npos);
   EXPECT_NE(with_title.find("width=\"640pt\""), std::string::npos);
   EXPECT_NE(with_title.find("</svg>"), std::string::npos);
-  EXPECT_NE(with_title.find("glyph"), std::string::npos);  // cairo 1.16 writes text as glyph symbols
-  EXPECT_GT(with_title.size(), without.size() + 200);      // the title's glyphs and their uses
+  EXPECT_NE(with_title.find("glyph"),
+            std::string::npos);                        // cairo 1.16 writes text as glyph symbols
+  EXPECT_GT(with_title.size(), without.size() + 200);  // the title's glyphs and their uses
 }
 
 TEST(LinePlot, SvgBytesAreDeterministic) {
@@ -106,10 +119,10 @@ TEST(LinePlot, DegenerateButValidDataDraws) {
   PlotSpec spec;
   spec.series.push_back({"one point", {3.0}, {0.25}, {}, true});
   EXPECT_TRUE(write_plot_png(spec, dir / "single.png"));
-  spec.series[0] = {"flat", {0, 1, 2}, {5, 5, 5}, {}, true};   // all-equal y: range padded
+  spec.series[0] = {"flat", {0, 1, 2}, {5, 5, 5}, {}, true};  // all-equal y: range padded
   spec.series.push_back({"empty alongside data", {}, {}, {}, true});
   EXPECT_TRUE(write_plot_svg(spec, dir / "flat.svg"));
-  spec.series[0] = {"zeros", {0, 0}, {0, 0}, {}, true};        // one x, one y, both zero
+  spec.series[0] = {"zeros", {0, 0}, {0, 0}, {}, true};  // one x, one y, both zero
   EXPECT_TRUE(write_plot_png(spec, dir / "zeros.png"));
   spec.series[0] = {"huge", {-1e300, 1e300}, {1e-300, 2e-300}, {}, true};
   EXPECT_TRUE(write_plot_png(spec, dir / "huge.png"));
@@ -147,7 +160,8 @@ void expect_bad_series(const PlotSpec& spec, const std::string& where) {
 }
 
 TEST(LinePlot, BadSeriesNamesTheSeriesAndValue) {
-  constexpr double NAN_V = std::numeric_limits<double>::quiet_NaN(), INF_V = std::numeric_limits<double>::infinity();
+  constexpr double NAN_V = std::numeric_limits<double>::quiet_NaN(),
+                   INF_V = std::numeric_limits<double>::infinity();
   PlotSpec spec = accuracy_spec();
   spec.series[1].x.pop_back();
   expect_bad_series(spec, "series 'bayesian' (#1): 4 x values but 5 y values");
@@ -183,11 +197,13 @@ TEST(LinePlot, BadSpecSizeOrRange) {
   EXPECT_EQ(write_plot_svg(spec, path).error().code, PlotError::Code::BAD_SPEC);
   spec.y_min = std::numeric_limits<double>::quiet_NaN();
   EXPECT_EQ(validate_plot(spec).error().code, PlotError::Code::BAD_SPEC);
-  spec.y_min = 1e20, spec.y_max = 1e20 + 65536;  // ticks of 1e4 at 1e20: indices beyond exact doubles
+  spec.y_min = 1e20,
+  spec.y_max = 1e20 + 65536;  // ticks of 1e4 at 1e20: indices beyond exact doubles
   result = write_plot_png(spec, path);
   ASSERT_FALSE(result);
   EXPECT_EQ(result.error().code, PlotError::Code::BAD_SPEC);
-  EXPECT_NE(result.error().message.find("y range [1e+20, 1e+20]"), std::string::npos) << result.error().message;
+  EXPECT_NE(result.error().message.find("y range [1e+20, 1e+20]"), std::string::npos)
+      << result.error().message;
   EXPECT_FALSE(fs::exists(path));
 }
 
@@ -195,10 +211,12 @@ TEST(LinePlot, UnwritablePathIsWriteFailedNamingThePath) {
   const fs::path dir = out_dir() / "no" / "such" / "dir";
   for (const bool svg : {false, true}) {
     const fs::path path = dir / (svg ? "plot.svg" : "plot.png");
-    const auto result = svg ? write_plot_svg(accuracy_spec(), path) : write_plot_png(accuracy_spec(), path);
+    const auto result =
+        svg ? write_plot_svg(accuracy_spec(), path) : write_plot_png(accuracy_spec(), path);
     ASSERT_FALSE(result);
     EXPECT_EQ(result.error().code, PlotError::Code::WRITE_FAILED);
-    EXPECT_NE(result.error().message.find(path.string()), std::string::npos) << result.error().message;
+    EXPECT_NE(result.error().message.find(path.string()), std::string::npos)
+        << result.error().message;
   }
 }
 

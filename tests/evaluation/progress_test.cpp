@@ -1,5 +1,6 @@
-// Progress (evaluation/progress.hpp): plain lines per 10 % step, the terminal line with '\r' and its ETA under an
-// injected clock, total 0, clamping past the total, and exact counting from 4 threads.
+// Progress (evaluation/progress.hpp): plain lines per 10 % step, the terminal line with '\r' and
+// its ETA under an injected clock, total 0, clamping past the total, and exact counting from 4
+// threads.
 #include "evaluation/progress.hpp"
 
 #include <gtest/gtest.h>
@@ -78,7 +79,8 @@ TEST(Progress, PlainOutputSkipsTenthsCrossedInOneStep) {
   t = 2.0;
   p.advance(5);  // 100 % is left to finish()
   p.finish();
-  const std::vector<std::string> expected{"runs 5/10  50%  elapsed 0:01  ETA 0:01", "runs 10/10 100%  elapsed 0:02"};
+  const std::vector<std::string> expected{"runs 5/10  50%  elapsed 0:01  ETA 0:01",
+                                          "runs 10/10 100%  elapsed 0:02"};
   EXPECT_EQ(lines_of(cap.text()), expected);
 }
 
@@ -89,7 +91,8 @@ TEST(Progress, TerminalRedrawsOneLineWithCarriageReturnAndEta) {
   EXPECT_EQ(cap.text(), "\rteach [....................] 0/10   0%  elapsed 0:00  ETA --");
   t = 2.0;
   p.advance();  // mean rate 0.5 step/s, 9 steps left: ETA 18 s
-  EXPECT_NE(cap.text().find("\rteach [##..................] 1/10  10%  elapsed 0:02  ETA 0:18"), std::string::npos);
+  EXPECT_NE(cap.text().find("\rteach [##..................] 1/10  10%  elapsed 0:02  ETA 0:18"),
+            std::string::npos);
   t = 2.05;
   const std::size_t before = cap.text().size();
   p.advance();  // within 0.1 s of the last draw: throttled
@@ -106,7 +109,8 @@ TEST(Progress, TerminalRedrawsOneLineWithCarriageReturnAndEta) {
   const std::string final_line = "\rteach [####################] 10/10 100%  elapsed 1:02:05";
   const std::size_t at = text.rfind(final_line);
   ASSERT_NE(at, std::string::npos) << text;
-  // The final line is shorter than the one it overwrites: blanks up to the old width, then the newline.
+  // The final line is shorter than the one it overwrites: blanks up to the old width, then the
+  // newline.
   EXPECT_EQ(text.find_first_not_of(' ', at + final_line.size()), text.size() - 1);
   EXPECT_EQ(text.find('\x1b'), std::string::npos);
 }
@@ -117,7 +121,8 @@ TEST(Progress, TerminalBlanksLeftoversOfALongerLine) {
   Progress p("x", 2, cap.file(), true, [&] { return t; });
   p.advance();  // same instant: throttled, nothing new
   t = 1.0;
-  p.finish();  // "x [...] 1/2  50%  elapsed 0:01" is shorter than the line with "ETA --": padded with blanks
+  p.finish();  // "x [...] 1/2  50%  elapsed 0:01" is shorter than the line with "ETA --": padded
+               // with blanks
   const std::string text = cap.text();
   const std::size_t second = text.rfind('\r');
   ASSERT_NE(second, 0u);
@@ -158,7 +163,8 @@ TEST(Progress, ConcurrentAdvanceCountsExactly) {
   Capture plain_cap, term_cap;
   constexpr std::size_t PER_THREAD = 5000;
   Progress plain("mt", 4 * PER_THREAD, plain_cap.file(), false);
-  Progress term("mt", 4 * PER_THREAD + 7, term_cap.file(), true);  // real steady clock, redraws throttled
+  Progress term("mt", 4 * PER_THREAD + 7, term_cap.file(),
+                true);  // real steady clock, redraws throttled
   std::vector<std::thread> workers;
   for (int w = 0; w < 4; ++w) {
     workers.emplace_back([&] {
@@ -170,8 +176,8 @@ TEST(Progress, ConcurrentAdvanceCountsExactly) {
   EXPECT_EQ(term.done(), 4 * PER_THREAD);
   plain.finish();
   term.finish();
-  // At most one line per 10 % step, in increasing order (a step another thread overtook before it could print
-  // is skipped), then the final line.
+  // At most one line per 10 % step, in increasing order (a step another thread overtook before it
+  // could print is skipped), then the final line.
   const std::vector<std::string> lines = lines_of(plain_cap.text());
   ASSERT_GE(lines.size(), 1u);
   ASSERT_LE(lines.size(), 10u);

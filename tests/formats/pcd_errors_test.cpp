@@ -44,21 +44,28 @@ TEST(PcdErrors, WriteFailed) {
 }
 
 TEST(PcdErrors, BadHeaderSaysWhichLine) {
-  const std::string msg = expect_error(XYZ_HEADER + "WIDTH 1\nFROB 3\nDATA ascii\n1 2 3\n", Code::BAD_HEADER);
+  const std::string msg =
+      expect_error(XYZ_HEADER + "WIDTH 1\nFROB 3\nDATA ascii\n1 2 3\n", Code::BAD_HEADER);
   EXPECT_NE(msg.find("line 6"), std::string::npos) << msg;
-  expect_error(XYZ_HEADER + "WIDTH 1\nHEIGHT 1\n", Code::BAD_HEADER);                       // no DATA
-  expect_error("FIELDS x y\nSIZE 4 4\nTYPE F F\nWIDTH 1\nDATA ascii\n1 2\n", Code::BAD_HEADER);  // no z
-  expect_error("FIELDS x y z x\nSIZE 4 4 4 4\nTYPE F F F F\nWIDTH 1\nDATA ascii\n1 2 3 4\n", Code::BAD_HEADER);
-  expect_error("FIELDS x y z\nSIZE 4 4\nTYPE F F F\nWIDTH 1\nDATA ascii\n1 2 3\n", Code::BAD_HEADER);
+  expect_error(XYZ_HEADER + "WIDTH 1\nHEIGHT 1\n", Code::BAD_HEADER);  // no DATA
+  expect_error("FIELDS x y\nSIZE 4 4\nTYPE F F\nWIDTH 1\nDATA ascii\n1 2\n",
+               Code::BAD_HEADER);  // no z
+  expect_error("FIELDS x y z x\nSIZE 4 4 4 4\nTYPE F F F F\nWIDTH 1\nDATA ascii\n1 2 3 4\n",
+               Code::BAD_HEADER);
+  expect_error("FIELDS x y z\nSIZE 4 4\nTYPE F F F\nWIDTH 1\nDATA ascii\n1 2 3\n",
+               Code::BAD_HEADER);
   expect_error(XYZ_HEADER + "WIDTH one\nDATA ascii\n", Code::BAD_HEADER);
-  expect_error("FIELDS x y z\nSIZE 4 4 4\nTYPE F F Q\nWIDTH 1\nDATA ascii\n1 2 3\n", Code::BAD_HEADER);
+  expect_error("FIELDS x y z\nSIZE 4 4 4\nTYPE F F Q\nWIDTH 1\nDATA ascii\n1 2 3\n",
+               Code::BAD_HEADER);
   expect_error(XYZ_HEADER + "HEIGHT 1\nDATA ascii\n1 2 3\n", Code::BAD_HEADER);  // no WIDTH
   expect_error("garbage\x01\x02", Code::BAD_HEADER);
 }
 
 TEST(PcdErrors, Unsupported) {
-  expect_error("FIELDS x y z\nSIZE 4 4 2\nTYPE F F F\nWIDTH 1\nDATA ascii\n1 2 3\n", Code::UNSUPPORTED);
-  expect_error("FIELDS x y z\nSIZE 4 4 8\nTYPE F F U\nWIDTH 1\nDATA ascii\n1 2 3\n", Code::UNSUPPORTED);
+  expect_error("FIELDS x y z\nSIZE 4 4 2\nTYPE F F F\nWIDTH 1\nDATA ascii\n1 2 3\n",
+               Code::UNSUPPORTED);
+  expect_error("FIELDS x y z\nSIZE 4 4 8\nTYPE F F U\nWIDTH 1\nDATA ascii\n1 2 3\n",
+               Code::UNSUPPORTED);
   expect_error(XYZ_HEADER + "WIDTH 1\nDATA binary_zstd\n", Code::UNSUPPORTED);
 }
 
@@ -98,15 +105,20 @@ TEST(PcdErrors, CorruptCompressedBlock) {
 }
 
 TEST(PcdErrors, BadNumber) {
-  const std::string msg = expect_error(XYZ_HEADER + "WIDTH 2\nDATA ascii\n1 2 3\n4 five 6\n", Code::BAD_NUMBER);
+  const std::string msg =
+      expect_error(XYZ_HEADER + "WIDTH 2\nDATA ascii\n1 2 3\n4 five 6\n", Code::BAD_NUMBER);
   EXPECT_NE(msg.find("line 8"), std::string::npos) << msg;
-  expect_error("FIELDS x y z label\nSIZE 4 4 4 1\nTYPE F F F U\nWIDTH 1\nDATA ascii\n1 2 3 256\n", Code::BAD_NUMBER);
-  expect_error("FIELDS x y z label\nSIZE 4 4 4 4\nTYPE F F F I\nWIDTH 1\nDATA ascii\n1 2 3 nan\n", Code::BAD_NUMBER);
+  expect_error("FIELDS x y z label\nSIZE 4 4 4 1\nTYPE F F F U\nWIDTH 1\nDATA ascii\n1 2 3 256\n",
+               Code::BAD_NUMBER);
+  expect_error("FIELDS x y z label\nSIZE 4 4 4 4\nTYPE F F F I\nWIDTH 1\nDATA ascii\n1 2 3 nan\n",
+               Code::BAD_NUMBER);
 }
 
 TEST(PcdErrors, TooLargeIsRefusedBeforeAllocating) {
   expect_error(XYZ_HEADER + "WIDTH 4294967295\nHEIGHT 4294967295\nDATA binary\n", Code::TOO_LARGE);
-  expect_error("FIELDS x y z h\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 100000\nWIDTH 1\nDATA binary\n", Code::TOO_LARGE);
+  expect_error(
+      "FIELDS x y z h\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 100000\nWIDTH 1\nDATA binary\n",
+      Code::TOO_LARGE);
   // 2^31 declared points in a small file: truncated, and nothing of that size allocated.
   EXPECT_EQ(code_of(XYZ_HEADER + "WIDTH 2147483648\nDATA binary\n"), Code::TRUNCATED);
   EXPECT_EQ(code_of(XYZ_HEADER + "WIDTH 2147483648\nDATA ascii\n1 2 3\n"), Code::TRUNCATED);
@@ -114,12 +126,14 @@ TEST(PcdErrors, TooLargeIsRefusedBeforeAllocating) {
 
 TEST(PcdErrors, EveryTruncationOfAValidFileIsAnErrorNotACrash) {
   const auto cloud = orthoflow::test::make_cloud(7, 3, true, 9);
-  for (auto e : {ofmt::PcdEncoding::ASCII, ofmt::PcdEncoding::BINARY, ofmt::PcdEncoding::BINARY_COMPRESSED}) {
+  for (auto e : {ofmt::PcdEncoding::ASCII, ofmt::PcdEncoding::BINARY,
+                 ofmt::PcdEncoding::BINARY_COMPRESSED}) {
     const std::string whole = ofmt::encode_pcd(cloud, e);
     ASSERT_TRUE(ofmt::read_pcd_buffer(whole));
     // An ASCII file cut inside its very last number is indistinguishable from a file whose last
     // line has no newline: only cuts before that number must fail.
-    const std::size_t last = (e == ofmt::PcdEncoding::ASCII) ? whole.rfind(' ') + 1 : whole.size() - 1;
+    const std::size_t last =
+        (e == ofmt::PcdEncoding::ASCII) ? whole.rfind(' ') + 1 : whole.size() - 1;
     for (std::size_t n = 0; n < last; ++n) {
       auto r = ofmt::read_pcd_buffer(std::string_view(whole).substr(0, n));
       EXPECT_FALSE(r) << ofmt::to_string(e) << " cut at " << n << " of " << whole.size();

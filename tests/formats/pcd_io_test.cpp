@@ -35,7 +35,8 @@ TEST_P(PcdRoundTrip, ReadsBackWhatItWrote) {
 
 std::vector<RoundTripCase> round_trip_cases() {
   std::vector<RoundTripCase> cases;
-  for (auto e : {ofmt::PcdEncoding::ASCII, ofmt::PcdEncoding::BINARY, ofmt::PcdEncoding::BINARY_COMPRESSED}) {
+  for (auto e : {ofmt::PcdEncoding::ASCII, ofmt::PcdEncoding::BINARY,
+                 ofmt::PcdEncoding::BINARY_COMPRESSED}) {
     for (bool all : {false, true}) {
       cases.push_back({e, 0, 0, all});     // empty
       cases.push_back({e, 1, 1, all});     // one point
@@ -89,7 +90,8 @@ TEST(PcdIo, ReadsRgbDeclaredAsFloatBitForBit) {
   const std::uint32_t colour = 0x00FF8040U;
   float as_float = 0;
   std::memcpy(&as_float, &colour, 4);
-  std::string text = "FIELDS x y z rgb\nSIZE 4 4 4 4\nTYPE F F F F\nWIDTH 1\nHEIGHT 1\nDATA binary\n";
+  std::string text =
+      "FIELDS x y z rgb\nSIZE 4 4 4 4\nTYPE F F F F\nWIDTH 1\nHEIGHT 1\nDATA binary\n";
   const float rec[4] = {1.0F, 2.0F, 3.0F, as_float};
   text.append(reinterpret_cast<const char*>(rec), sizeof(rec));
   auto r = ofmt::read_pcd_buffer(text, "rgbf");

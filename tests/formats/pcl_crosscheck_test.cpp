@@ -1,5 +1,5 @@
-// PCL 1.13 as the reference (tests only): every PCD in ../shared read by both readers agrees bit for
-// bit, and files written by either reader's writer read back identically in the other.
+// PCL 1.13 as the reference (tests only): every PCD in ../shared read by both readers agrees bit
+// for bit, and files written by either reader's writer read back identically in the other.
 #include <gtest/gtest.h>
 
 #include <pcl/PCLPointCloud2.h>
@@ -41,7 +41,8 @@ std::uint32_t pcl_word(const pcl::PCLPointCloud2& pc, const pcl::PCLPointField& 
 }
 
 /// Compares every field orthoflow keeps with PCL's generic reading of the same bytes.
-void expect_agrees(const pcl::PCLPointCloud2& pc, const ok::PointCloud& ours, const std::string& what) {
+void expect_agrees(const pcl::PCLPointCloud2& pc, const ok::PointCloud& ours,
+                   const std::string& what) {
   ASSERT_EQ(pc.width, ours.width()) << what;
   ASSERT_EQ(std::max<std::uint32_t>(pc.height, 1), ours.height()) << what;
   for (const pcl::PCLPointField& f : pc.fields) {
@@ -65,7 +66,8 @@ void expect_agrees(const pcl::PCLPointCloud2& pc, const ok::PointCloud& ours, co
 
 TEST(PclCrossCheck, EverySharedPcdReadsIdentically) {
   const auto files = shared_pcds();
-  ASSERT_GE(files.size(), 30U) << "expected the shared data beside the checkout: " << ORTHOFLOW_SHARED_DIR;
+  ASSERT_GE(files.size(), 30U) << "expected the shared data beside the checkout: "
+                               << ORTHOFLOW_SHARED_DIR;
   for (const fs::path& p : files) {
     pcl::PCLPointCloud2 pc;
     ASSERT_EQ(pcl::io::loadPCDFile(p.string(), pc), 0) << p;
@@ -79,7 +81,8 @@ TEST(PclCrossCheck, PclReadsWhatWeWrite) {
   const ok::PointCloud cloud = orthoflow::test::make_cloud(32, 24, true, 11);
   const fs::path dir = fs::temp_directory_path() / "orthoflow_pcl_xcheck_ours";
   fs::create_directories(dir);
-  for (auto e : {ofmt::PcdEncoding::ASCII, ofmt::PcdEncoding::BINARY, ofmt::PcdEncoding::BINARY_COMPRESSED}) {
+  for (auto e : {ofmt::PcdEncoding::ASCII, ofmt::PcdEncoding::BINARY,
+                 ofmt::PcdEncoding::BINARY_COMPRESSED}) {
     const fs::path p = dir / (std::string(ofmt::to_string(e)) + ".pcd");
     ASSERT_TRUE(ofmt::write_pcd(cloud, p, e));
     pcl::PCLPointCloud2 pc;
@@ -89,12 +92,15 @@ TEST(PclCrossCheck, PclReadsWhatWeWrite) {
     expect_agrees(pc, cloud, p.string());
     const ok::Viewpoint& vp = cloud.info.viewpoint;
     EXPECT_EQ(origin.head<3>(), Eigen::Vector3f(vp.origin[0], vp.origin[1], vp.origin[2])) << p;
-    EXPECT_EQ(orientation.coeffs(), Eigen::Vector4f(vp.orientation[1], vp.orientation[2], vp.orientation[3],
-                                                    vp.orientation[0])) << p;  // Eigen stores x y z w
+    EXPECT_EQ(orientation.coeffs(),
+              Eigen::Vector4f(vp.orientation[1], vp.orientation[2], vp.orientation[3],
+                              vp.orientation[0]))
+        << p;  // Eigen stores x y z w
     pcl::PointCloud<pcl::PointXYZRGBA> typed;
     ASSERT_EQ(pcl::io::loadPCDFile(p.string(), typed), 0) << p;
     EXPECT_EQ(typed.points[5].rgba, cloud.rgb()[5]) << p;
-    pcl::PointCloud<pcl::PointXYZRGB> rgb_typed;  // PCL maps our `rgba U 4` onto PointXYZRGB's rgb too
+    pcl::PointCloud<pcl::PointXYZRGB>
+        rgb_typed;  // PCL maps our `rgba U 4` onto PointXYZRGB's rgb too
     ASSERT_EQ(pcl::io::loadPCDFile(p.string(), rgb_typed), 0) << p;
     EXPECT_EQ(rgb_typed.points[7].rgba, cloud.rgb()[7]) << p;
   }
@@ -104,7 +110,8 @@ TEST(PclCrossCheck, PclReadsWhatWeWrite) {
 TEST(PclCrossCheck, WeReadWhatPclWrites) {
   pcl::PointCloud<pcl::PointXYZRGBA> typed(16, 8);
   const ok::PointCloud ref = orthoflow::test::make_cloud(16, 8, true, 21);
-  ofmt::to_aos<pcl::PointXYZRGBA>(ref, std::span<pcl::PointXYZRGBA>(typed.points.data(), typed.points.size()));
+  ofmt::to_aos<pcl::PointXYZRGBA>(
+      ref, std::span<pcl::PointXYZRGBA>(typed.points.data(), typed.points.size()));
   typed.sensor_origin_ = Eigen::Vector4f(0.25F, -2.0F, 1.5F, 0.0F);
   typed.sensor_orientation_ = Eigen::Quaternionf(0.5F, -0.5F, 0.5F, -0.5F);  // w x y z
   const fs::path dir = fs::temp_directory_path() / "orthoflow_pcl_xcheck_pcl";
@@ -123,8 +130,8 @@ TEST(PclCrossCheck, WeReadWhatPclWrites) {
       ASSERT_EQ(ours->rgb()[i], ref.rgb()[i]) << p << " point " << i;
     }
     ok::PointCloud adapted;  // the AoS adapter over PCL's own point struct gives the same cloud
-    ofmt::from_aos<pcl::PointXYZRGBA>(std::span<const pcl::PointXYZRGBA>(typed.points.data(), typed.points.size()),
-                                    adapted);
+    ofmt::from_aos<pcl::PointXYZRGBA>(
+        std::span<const pcl::PointXYZRGBA>(typed.points.data(), typed.points.size()), adapted);
     for (std::size_t i = 0; i < ref.size(); ++i) {
       ASSERT_EQ(bits(adapted.z()[i]), bits(ours->z()[i])) << "point " << i;
       ASSERT_EQ(adapted.rgb()[i], ours->rgb()[i]) << "point " << i;

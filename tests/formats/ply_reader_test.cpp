@@ -14,7 +14,8 @@ namespace {
 
 const char* ASCII_CUBE =
     "ply\nformat ascii 1.0\ncomment made by hand\nobj_info none\nelement vertex 3\n"
-    "property float x\nproperty float y\nproperty float z\nproperty uchar red\nproperty uchar green\n"
+    "property float x\nproperty float y\nproperty float z\nproperty uchar red\nproperty uchar "
+    "green\n"
     "property uchar blue\nproperty float nx\nproperty float ny\nproperty float nz\n"
     "element face 2\nproperty list uchar int vertex_indices\nend_header\n"
     "0 0 0 255 0 0 0 0 1\n1 0 0 0 255 0 0 0 1\n0 1.5 -2 0 0 255 0 1 0\n3 0 1 2\n4 0 1 2 0\n";
@@ -28,9 +29,10 @@ void put(std::string& s, T v, bool big) {
 }
 
 std::string binary_model(bool big) {
-  std::string s = std::string("ply\nformat ") + (big ? "binary_big_endian" : "binary_little_endian") +
-                  " 1.0\nelement vertex 2\nproperty double x\nproperty double y\nproperty double z\n"
-                  "property uchar alpha\nelement face 1\nproperty list uchar uint vertex_indices\nend_header\n";
+  std::string s =
+      std::string("ply\nformat ") + (big ? "binary_big_endian" : "binary_little_endian") +
+      " 1.0\nelement vertex 2\nproperty double x\nproperty double y\nproperty double z\n"
+      "property uchar alpha\nelement face 1\nproperty list uchar uint vertex_indices\nend_header\n";
   for (double v : {1.0, 2.0, 3.0}) { put(s, v, big); }
   put(s, std::uint8_t{7}, big);
   for (double v : {-1.0, 0.5, 0.25}) { put(s, v, big); }
@@ -70,10 +72,13 @@ TEST(PlyReader, ErrorsSayWhatAndWhere) {
     std::string bytes;
     Code code;
   };
-  const std::string head = "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\n";
+  const std::string head =
+      "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float "
+      "z\n";
   const Case cases[] = {
       {"PLY\n", Code::BAD_HEADER},
-      {"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nend_header\n1\n", Code::BAD_HEADER},
+      {"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nend_header\n1\n",
+       Code::BAD_HEADER},
       {"ply\nformat ascii 1.0\nend_header\n", Code::BAD_HEADER},
       {"ply\nformat utf8 1.0\nend_header\n", Code::UNSUPPORTED},
       {"ply\nformat ascii 1.0\nelement vertex 1\nproperty half x\nend_header\n", Code::UNSUPPORTED},
@@ -81,8 +86,10 @@ TEST(PlyReader, ErrorsSayWhatAndWhere) {
       {head + "end_header\n1 2 3\n4 five 6\n", Code::BAD_NUMBER},
       {head + "end_header\n1 2 3 4\n5 6 7\n", Code::SIZE_MISMATCH},
       {"ply\nformat ascii 1.0\nelement vertex 4294967296\nend_header\n", Code::TOO_LARGE},
-      {head + "element face 1\nproperty list char int i\nend_header\n1 2 3\n4 5 6\n-1 1\n", Code::CORRUPT_DATA},
-      {head + "element face 1\nproperty list uchar int i\nend_header\n1 2 3\n4 5 6\n300 1\n", Code::BAD_NUMBER},
+      {head + "element face 1\nproperty list char int i\nend_header\n1 2 3\n4 5 6\n-1 1\n",
+       Code::CORRUPT_DATA},
+      {head + "element face 1\nproperty list uchar int i\nend_header\n1 2 3\n4 5 6\n300 1\n",
+       Code::BAD_NUMBER},
       {head + "end_header\n", Code::TRUNCATED},
   };
   for (const Case& c : cases) {
@@ -94,16 +101,18 @@ TEST(PlyReader, ErrorsSayWhatAndWhere) {
 }
 
 TEST(PlyReader, HugeBinaryCountIsRefusedBeforeAllocating) {
-  std::string s = "ply\nformat binary_little_endian 1.0\nelement vertex 2000000000\nproperty float x\n"
-                  "property float y\nproperty float z\nend_header\n";
+  std::string s =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 2000000000\nproperty float x\n"
+      "property float y\nproperty float z\nend_header\n";
   s.append(24, '\0');
   auto r = ofmt::read_ply_buffer(s, "big.ply");
   ASSERT_FALSE(r);
   EXPECT_EQ(r.error().code, Code::TRUNCATED);
 }
 
-// An element without properties holds no bytes: a huge count must neither loop (fuzz_ply_reader once
-// timed out on 808,956,253 empty instances; the header caps counts at 2^31) nor be refused in binary; in ASCII each instance is a line.
+// An element without properties holds no bytes: a huge count must neither loop (fuzz_ply_reader
+// once timed out on 808,956,253 empty instances; the header caps counts at 2^31) nor be refused in
+// binary; in ASCII each instance is a line.
 TEST(PlyReader, ElementWithoutPropertiesAndHugeCountIsSkippedAtOnce) {
   std::string s = binary_model(false);
   s.insert(s.find("end_header"), "element marker 2000000000\n");

@@ -37,9 +37,9 @@ TEST(PointFields, RecordsRoundTripThroughPointCloud2Layout) {
 TEST(PointFields, DecodesIntegerAndDoubleFields) {
   // A PointCloud2-style record with a double x, int16 y, uint8 z and an ignored field.
   const std::vector<ofmt::PointField> fields = {{"x", 0, ofmt::ScalarType::FLOAT64, 1},
-                                              {"y", 8, ofmt::ScalarType::INT16, 1},
-                                              {"z", 10, ofmt::ScalarType::UINT8, 1},
-                                              {"intensity", 11, ofmt::ScalarType::UINT8, 1}};
+                                                {"y", 8, ofmt::ScalarType::INT16, 1},
+                                                {"z", 10, ofmt::ScalarType::UINT8, 1},
+                                                {"intensity", 11, ofmt::ScalarType::UINT8, 1}};
   char rec[12] = {};
   const double x = -2.5;
   const std::int16_t y = -300;

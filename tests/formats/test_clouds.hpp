@@ -19,7 +19,8 @@ inline std::uint32_t bits(float v) {
 }
 
 /// A width x height cloud with random coordinates (some NaN) and, if asked, every optional field.
-inline kernels::PointCloud make_cloud(std::uint32_t width, std::uint32_t height, bool all_fields, std::uint32_t seed) {
+inline kernels::PointCloud make_cloud(std::uint32_t width, std::uint32_t height, bool all_fields,
+                                      std::uint32_t seed) {
   kernels::PointCloud c;
   if (all_fields) {
     c.add_field(kernels::Field::RGB);
@@ -52,16 +53,19 @@ inline void expect_same_cloud(const kernels::PointCloud& a, const kernels::Point
   ASSERT_EQ(a.width(), b.width());
   ASSERT_EQ(a.height(), b.height());
   ASSERT_EQ(a.size(), b.size());
-  for (auto f : {kernels::Field::RGB, kernels::Field::LABEL, kernels::Field::NORMALS}) { ASSERT_EQ(a.has(f), b.has(f)); }
+  for (auto f : {kernels::Field::RGB, kernels::Field::LABEL, kernels::Field::NORMALS}) {
+    ASSERT_EQ(a.has(f), b.has(f));
+  }
   std::size_t mismatches = 0;
   for (std::size_t i = 0; i < a.size(); ++i) {
-    const bool same = bits(a.x()[i]) == bits(b.x()[i]) && bits(a.y()[i]) == bits(b.y()[i]) &&
-                      bits(a.z()[i]) == bits(b.z()[i]) &&
-                      (!a.has(kernels::Field::RGB) || a.rgb()[i] == b.rgb()[i]) &&
-                      (!a.has(kernels::Field::LABEL) || a.label()[i] == b.label()[i]) &&
-                      (!a.has(kernels::Field::NORMALS) || (bits(a.normal_x()[i]) == bits(b.normal_x()[i]) &&
-                                                           bits(a.normal_y()[i]) == bits(b.normal_y()[i]) &&
-                                                           bits(a.normal_z()[i]) == bits(b.normal_z()[i])));
+    const bool same =
+        bits(a.x()[i]) == bits(b.x()[i]) && bits(a.y()[i]) == bits(b.y()[i]) &&
+        bits(a.z()[i]) == bits(b.z()[i]) &&
+        (!a.has(kernels::Field::RGB) || a.rgb()[i] == b.rgb()[i]) &&
+        (!a.has(kernels::Field::LABEL) || a.label()[i] == b.label()[i]) &&
+        (!a.has(kernels::Field::NORMALS) || (bits(a.normal_x()[i]) == bits(b.normal_x()[i]) &&
+                                             bits(a.normal_y()[i]) == bits(b.normal_y()[i]) &&
+                                             bits(a.normal_z()[i]) == bits(b.normal_z()[i])));
     mismatches += same ? 0U : 1U;
   }
   EXPECT_EQ(mismatches, 0U);

@@ -1,7 +1,7 @@
-// Fuzzes parse_descriptor_cache (evaluation/descriptor_cache.hpp): no input may crash, leak or hit UB;
-// a cache is either rejected whole (no entry) or accepted whole, and an accepted one re-encodes (paths
-// sorted) and parses back with the same entries.
-// The first input byte picks the descriptor length (1..8), the rest is the cache file.
+// Fuzzes parse_descriptor_cache (evaluation/descriptor_cache.hpp): no input may crash, leak or hit
+// UB; a cache is either rejected whole (no entry) or accepted whole, and an accepted one re-encodes
+// (paths sorted) and parses back with the same entries. The first input byte picks the descriptor
+// length (1..8), the rest is the cache file.
 #include <cstdint>
 #include <span>
 #include <string>
@@ -20,7 +20,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (back.entries.size() != cache.entries.size()) { __builtin_trap(); }
   for (const auto& [path, entry] : cache.entries) {
     const auto it = back.entries.find(path);
-    if (it == back.entries.end() || !(it->second.stamp == entry.stamp) || it->second.descriptor.size() != length) { __builtin_trap(); }
+    if (it == back.entries.end() || !(it->second.stamp == entry.stamp) ||
+        it->second.descriptor.size() != length) {
+      __builtin_trap();
+    }
   }
   return 0;
 }

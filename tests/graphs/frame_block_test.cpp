@@ -40,8 +40,9 @@ TEST(FrameBlock, RegionsAreAlignedAndDisjoint) {
   EXPECT_LE(reinterpret_cast<const std::byte*>(block.raw().data() + block.raw().size()),
             reinterpret_cast<const std::byte*>(&block.state()));
   // the raw region holds a full frame of that capacity with every optional field
-  EXPECT_GE(block.raw().size(), engine::frame_payload_bytes(static_cast<std::uint32_t>(capacity), 1,
-                                                            engine::FRAME_FIELD_RGB | engine::FRAME_FIELD_LABEL));
+  EXPECT_GE(block.raw().size(),
+            engine::frame_payload_bytes(static_cast<std::uint32_t>(capacity), 1,
+                                        engine::FRAME_FIELD_RGB | engine::FRAME_FIELD_LABEL));
 }
 
 TEST(FrameBlock, TextTruncatesAndTerminates) {

@@ -1,6 +1,7 @@
-// The learning channel end to end: a second thread drives a running tabletop session only through the
-// channel (teach, ask, correct, forget, each acknowledged) and sees every effect in the objects output
-// (graphs/objects_output.hpp), with the in-memory learner and with a durable perceptual memory.
+// The learning channel end to end: a second thread drives a running tabletop session only through
+// the channel (teach, ask, correct, forget, each acknowledged) and sees every effect in the objects
+// output (graphs/objects_output.hpp), with the in-memory learner and with a durable perceptual
+// memory.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -22,11 +23,13 @@ using Outcome = LearningAck::Outcome;
 /// The person at the table: reads the objects output and talks through one learning client.
 class Teacher {
  public:
-  Teacher(LearningService& service, ObjectsHub& hub) : client_(service.connect()), objects_(hub.subscribe(64)) {}
+  Teacher(LearningService& service, ObjectsHub& hub)
+      : client_(service.connect()), objects_(hub.subscribe(64)) {}
 
-  /// Waits (at most @p lists object lists, 60 s) for a list in which @p pred holds; returns that list's frame.
-  std::optional<std::uint64_t> wait_for(const std::function<bool(const engine::ObjectListPayload&)>& pred,
-                                        int lists) {
+  /// Waits (at most @p lists object lists, 60 s) for a list in which @p pred holds; returns that
+  /// list's frame.
+  std::optional<std::uint64_t> wait_for(
+      const std::function<bool(const engine::ObjectListPayload&)>& pred, int lists) {
     const auto deadline = Clock::now() + std::chrono::seconds(60);
     for (int seen = 0; seen < lists && Clock::now() < deadline;) {
       if (!objects_->poll(list_)) {
@@ -62,7 +65,8 @@ class Teacher {
 
 const engine::ObjectEntry* entry_of(const engine::ObjectListPayload& l, std::uint64_t track) {
   for (std::uint32_t k = 0; k < l.count; ++k) {
-    if (l.objects[k].track_id == track && (l.objects[k].flags & engine::OBJECT_FRAGMENT) == 0) return &l.objects[k];
+    if (l.objects[k].track_id == track && (l.objects[k].flags & engine::OBJECT_FRAGMENT) == 0)
+      return &l.objects[k];
   }
   return nullptr;
 }
@@ -79,7 +83,8 @@ void teach_correct_forget(LearningService& learning, Outcome stored) {
   ObjectsHub hub;
   SessionLog log(nullptr);
   const auto registry = make_tabletop_registry(learning, log, &hub);
-  auto spec = test::tabletop_spec({{"source", {{"frames", "900"}}}, {"recognise", {{"instructor", "0"}}}});
+  auto spec =
+      test::tabletop_spec({{"source", {{"frames", "900"}}}, {"recognise", {{"instructor", "0"}}}});
   spec.period_ns = 15'000'000;  // paced, so that the teacher acts while the session runs
   auto graph = engine::build_graph(spec, registry);
   ASSERT_TRUE(graph) << engine::to_string(graph.error());
@@ -88,17 +93,22 @@ void teach_correct_forget(LearningService& learning, Outcome stored) {
   std::thread runner([&] { engine.run({}); });
   // A described, still object seen for a few frames: its track has a key view by then.
   std::uint64_t track = 0;
-  auto seen = teacher.wait_for([&](const engine::ObjectListPayload& l) {
-    for (std::uint32_t k = 0; k < l.count; ++k) {
-      const auto& o = l.objects[k];
-      if ((o.flags & engine::OBJECT_DESCRIBED) && !(o.flags & engine::OBJECT_MOVING) && l.frame_id >= 5) track = o.track_id;
-    }
-    return track != 0;
-  }, 200);
+  auto seen = teacher.wait_for(
+      [&](const engine::ObjectListPayload& l) {
+        for (std::uint32_t k = 0; k < l.count; ++k) {
+          const auto& o = l.objects[k];
+          if ((o.flags & engine::OBJECT_DESCRIBED) && !(o.flags & engine::OBJECT_MOVING) &&
+              l.frame_id >= 5)
+            track = o.track_id;
+        }
+        return track != 0;
+      },
+      200);
   ASSERT_TRUE(seen);
   EXPECT_TRUE(entry_of(teacher.last(), track)->unknown);  // nothing is known yet
   // teach: the key views and the current view are stored
-  auto taught = teacher.call(command(LearningCommand::Kind::TEACH, static_cast<std::uint32_t>(track), "alpha"));
+  auto taught = teacher.call(
+      command(LearningCommand::Kind::TEACH, static_cast<std::uint32_t>(track), "alpha"));
   ASSERT_TRUE(taught);
   EXPECT_EQ(taught->outcome, stored) << to_string(taught->outcome);
   EXPECT_GE(taught->views, 2U);
@@ -109,32 +119,38 @@ void teach_correct_forget(LearningService& learning, Outcome stored) {
       return o != nullptr && (label.empty() ? o->unknown == 1 : o->label.view() == label);
     };
   };
-  ASSERT_TRUE(teacher.wait_for(labelled("alpha"), 30)) << "the taught label never showed in the objects output";
+  ASSERT_TRUE(teacher.wait_for(labelled("alpha"), 30))
+      << "the taught label never showed in the objects output";
   // ask
-  auto asked = teacher.call(command(LearningCommand::Kind::ASK, static_cast<std::uint32_t>(track), ""));
+  auto asked =
+      teacher.call(command(LearningCommand::Kind::ASK, static_cast<std::uint32_t>(track), ""));
   ASSERT_TRUE(asked);
   EXPECT_EQ(asked->outcome, Outcome::ANSWERED);
   EXPECT_EQ(asked->label.view(), "alpha");
   EXPECT_FALSE(asked->unknown);
   // correct, then forget the wrong category: only the correction is left
-  auto corrected = teacher.call(command(LearningCommand::Kind::CORRECT, static_cast<std::uint32_t>(track), "beta"));
+  auto corrected = teacher.call(
+      command(LearningCommand::Kind::CORRECT, static_cast<std::uint32_t>(track), "beta"));
   ASSERT_TRUE(corrected);
   EXPECT_EQ(corrected->outcome, stored);
   EXPECT_EQ(corrected->views, 1U);
   auto forgot = teacher.call(command(LearningCommand::Kind::FORGET, 0, "alpha"));
   ASSERT_TRUE(forgot);
   EXPECT_EQ(forgot->outcome, stored);
-  ASSERT_TRUE(teacher.wait_for(labelled("beta"), 30)) << "the correction never showed in the objects output";
+  ASSERT_TRUE(teacher.wait_for(labelled("beta"), 30))
+      << "the correction never showed in the objects output";
   auto again = teacher.call(command(LearningCommand::Kind::FORGET, 0, "alpha"));
   ASSERT_TRUE(again);
   EXPECT_EQ(again->outcome, Outcome::UNKNOWN_LABEL);
   ASSERT_TRUE(teacher.call(command(LearningCommand::Kind::FORGET, 0, "beta")));
-  ASSERT_TRUE(teacher.wait_for(labelled(""), 30)) << "forgetting every category did not make the object Unknown";
+  ASSERT_TRUE(teacher.wait_for(labelled(""), 30))
+      << "forgetting every category did not make the object Unknown";
   // errors come back too
   auto missing = teacher.call(command(LearningCommand::Kind::TEACH, 99999, "gamma"));
   ASSERT_TRUE(missing);
   EXPECT_EQ(missing->outcome, Outcome::NO_SUCH_TRACK);
-  auto bad = teacher.call(command(LearningCommand::Kind::TEACH, static_cast<std::uint32_t>(track), ""));
+  auto bad =
+      teacher.call(command(LearningCommand::Kind::TEACH, static_cast<std::uint32_t>(track), ""));
   ASSERT_TRUE(bad);
   EXPECT_EQ(bad->outcome, Outcome::BAD_LABEL);
   engine.request_stop();
@@ -150,7 +166,8 @@ TEST(LearningChannel, SecondThreadTeachesCorrectsAndForgetsInMemory) {
 }
 
 TEST(LearningChannel, SecondThreadTeachesCorrectsAndForgetsDurably) {
-  const auto dir = std::filesystem::temp_directory_path() / ("orthoflow_channel_" + std::to_string(::getpid()));
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("orthoflow_channel_" + std::to_string(::getpid()));
   std::filesystem::remove_all(dir);
   LearningSettings settings;
   settings.db = dir;
@@ -176,7 +193,8 @@ TEST(LearningChannel, ClientsAreBoundedAndSlotsAreReused) {
   EXPECT_EQ(again->id(), freed);
   // a full command queue refuses and counts; nothing blocks
   std::size_t accepted = 0;
-  for (int i = 0; i < 100; ++i) accepted += again->send(command(LearningCommand::Kind::ASK, 1, "")) != 0 ? 1 : 0;
+  for (int i = 0; i < 100; ++i)
+    accepted += again->send(command(LearningCommand::Kind::ASK, 1, "")) != 0 ? 1 : 0;
   EXPECT_EQ(accepted, 64U);
   EXPECT_EQ(learning->commands_dropped(), 36U);
 }

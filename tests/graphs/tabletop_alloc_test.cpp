@@ -1,14 +1,14 @@
 // Proves that the tabletop graph, after warm-up, performs no operator new per frame: sources,
-// segmentation, tracking, GOOD, recognition (asking a learner that knows categories) and the session
-// log, the objects output with an in-process consumer that asks over the learning channel. Teaching is
-// excluded: a teach rebuilds the learner's snapshot (it allocates, once per lesson, by design;
-// docs/TABLETOP.md). oneTBB's own task allocations do not go through operator new
-// (see tests/engine/engine_alloc_test.cpp).
+// segmentation, tracking, GOOD, recognition (asking a learner that knows categories) and the
+// session log, the objects output with an in-process consumer that asks over the learning channel.
+// Teaching is excluded: a teach rebuilds the learner's snapshot (it allocates, once per lesson, by
+// design; docs/TABLETOP.md). oneTBB's own task allocations do not go through operator new (see
+// tests/engine/engine_alloc_test.cpp).
 #include <gtest/gtest.h>
 
 #include <atomic>
-#include <cstdlib>
 #include <chrono>
+#include <cstdlib>
 #include <new>
 #include <thread>
 #include <vector>
@@ -28,7 +28,8 @@ TEST(TabletopAllocations, SteadyStateAllocatesNothingPerFrame) {
   // A learner that knows categories, so every ask walks real stored views.
   std::vector<float> views(3 * 675, 0.0F);
   for (std::size_t i = 0; i < views.size(); ++i) views[i] = static_cast<float>(i % 7) / 675.0F;
-  ASSERT_TRUE(learning->teach("thing", std::span<const float>(views).first(2 * 675), 0, 0, {}).ok());
+  ASSERT_TRUE(
+      learning->teach("thing", std::span<const float>(views).first(2 * 675), 0, 0, {}).ok());
   ASSERT_TRUE(learning->teach("other", std::span<const float>(views).last(675), 0, 0, {}).ok());
   // a JSON sink too: its writer thread writes to /dev/null
   auto json = LineWriter::open("/dev/null");
@@ -39,14 +40,16 @@ TEST(TabletopAllocations, SteadyStateAllocatesNothingPerFrame) {
   auto client = learning->connect();
   const auto registry = make_tabletop_registry(*learning, log, &hub);
   // random scene with 5 objects, instructor off (teaching allocates by design)
-  auto spec = test::tabletop_spec({{"source", {{"objects", "5"}, {"frames", "60"}}}, {"recognise", {{"instructor", "0"}}}});
+  auto spec = test::tabletop_spec(
+      {{"source", {{"objects", "5"}, {"frames", "60"}}}, {"recognise", {{"instructor", "0"}}}});
   auto graph = engine::build_graph(spec, registry);
   ASSERT_TRUE(graph) << engine::to_string(graph.error());
   engine::Engine engine(**graph, {2});
   // warm-up: 20 frames, then count over the remaining 40
   std::atomic<bool> stop{false};
   std::thread arm([&] {
-    while (log.summary().frames < 20 && !stop.load()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    while (log.summary().frames < 20 && !stop.load())
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
     g_counting.store(true);
   });
   std::uint64_t lists = 0, answers = 0;

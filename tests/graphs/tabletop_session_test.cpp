@@ -24,8 +24,9 @@ struct SessionRun {
 SessionRun run_graph(const test::Overrides& overrides, int threads, LearningService& learning) {
   // One file per process and run: ctest runs these tests in parallel processes.
   static int runs = 0;
-  const auto path = std::filesystem::temp_directory_path() /
-                    ("orthoflow_session_" + std::to_string(::getpid()) + "_" + std::to_string(runs++) + ".jsonl");
+  const auto path =
+      std::filesystem::temp_directory_path() /
+      ("orthoflow_session_" + std::to_string(::getpid()) + "_" + std::to_string(runs++) + ".jsonl");
   SessionRun result;
   {
     auto json = LineWriter::open(path.string());
@@ -39,7 +40,8 @@ SessionRun run_graph(const test::Overrides& overrides, int threads, LearningServ
     result.summary = log.summary();
   }  // the writer flushes and closes here
   std::ifstream in(path);
-  for (std::string line; std::getline(in, line);) result.frames.push_back(nlohmann::json::parse(line));
+  for (std::string line; std::getline(in, line);)
+    result.frames.push_back(nlohmann::json::parse(line));
   std::filesystem::remove(path);
   return result;
 }
@@ -57,7 +59,8 @@ TEST(TabletopSession, TracksTeachesAndRecognises) {
   std::map<std::string, std::set<int>> tracks_of;  // truth category + phase -> track ids
   for (const auto& f : r.frames) {
     for (const auto& o : f["objects"]) {
-      const std::string phase = f["frame"].get<int>() < 36 ? "1" : "2";  // phase 1 ends at 40% of 90
+      const std::string phase =
+          f["frame"].get<int>() < 36 ? "1" : "2";  // phase 1 ends at 40% of 90
       const std::string truth = o["truth"];
       tracks_of[truth == "bowl" ? truth : truth + phase].insert(o["track"].get<int>());
     }
@@ -108,7 +111,8 @@ TEST(TabletopSession, OutsideTeachEventTeachesTheTrackedObject) {
   teach.label.assign("my-thing");
   const std::uint64_t sequence = client->send(teach);
   ASSERT_NE(sequence, 0U);
-  const auto r = run_graph({{"source", {{"frames", "10"}}}, {"recognise", {{"instructor", "0"}}}}, 2, *learning);
+  const auto r = run_graph({{"source", {{"frames", "10"}}}, {"recognise", {{"instructor", "0"}}}},
+                           2, *learning);
   EXPECT_EQ(r.summary.taught, (std::vector<std::string>{"my-thing"}));
   EXPECT_EQ(learning->teaches(), 1U);
   LearningAck ack;
@@ -119,7 +123,8 @@ TEST(TabletopSession, OutsideTeachEventTeachesTheTrackedObject) {
   EXPECT_EQ(ack.label.view(), "my-thing");
   int recognised = 0;
   for (const auto& f : r.frames) {
-    for (const auto& o : f["objects"]) recognised += o["track"] == 1 && o["label"] == "my-thing" ? 1 : 0;
+    for (const auto& o : f["objects"])
+      recognised += o["track"] == 1 && o["label"] == "my-thing" ? 1 : 0;
   }
   EXPECT_GE(recognised, 8);  // from the frame after the lesson on
 }

@@ -24,7 +24,8 @@ struct Blob {
     in.points = {x, y, z};
     in.box_min = {x.front(), y.front(), z.front()};
     in.box_max = {x.back(), y.back(), z.back()};
-    in.centroid = {(x.front() + x.back()) / 2, (y.front() + y.back()) / 2, (z.front() + z.back()) / 2};
+    in.centroid = {(x.front() + x.back()) / 2, (y.front() + y.back()) / 2,
+                   (z.front() + z.back()) / 2};
     return in;
   }
 };
@@ -35,7 +36,8 @@ TEST(Tracker, KeepsIdsOfStillAndSlowlyMovingObjects) {
   Tracker tracker({});
   std::vector<TrackOutput> out(2);
   for (int f = 0; f < 60; ++f) {
-    const Blob still(0.0F, 0.0F, 1.0F), mover(0.3F + 0.002F * static_cast<float>(f), 0.0F, 1.0F);  // 6 cm/s
+    const Blob still(0.0F, 0.0F, 1.0F),
+        mover(0.3F + 0.002F * static_cast<float>(f), 0.0F, 1.0F);    // 6 cm/s
     const std::vector<TrackInput> in{mover.input(), still.input()};  // order must not matter
     tracker.update(f * FRAME_NS, in, out);
     EXPECT_EQ(out[0].track_id, 1U) << f;

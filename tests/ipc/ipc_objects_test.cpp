@@ -17,15 +17,19 @@ TEST(IpcObjects, RunPublishesEveryFramesObjectsToAnotherProcess) {
       [](Sandbox& box) {
         if (box.start_roudi() < 0) return;
         const pid_t echo = box.spawn_orthoflow(
-            "echo", {"ipc", "echo", "orthoflow/tabletop/objects", "--type", "objects", "--count", "20", "--depth",
-                     "64", "--timeout-ms", "8000"});
-        const pid_t run = box.spawn_orthoflow("run", {"run", "--frames", "60", "--rate", "30", "--publish-objects"});
+            "echo", {"ipc", "echo", "orthoflow/tabletop/objects", "--type", "objects", "--count",
+                     "20", "--depth", "64", "--timeout-ms", "8000"});
+        const pid_t run = box.spawn_orthoflow(
+            "run", {"run", "--frames", "60", "--rate", "30", "--publish-objects"});
         const ProcResult r = box.wait(run, 30s), e = box.wait(echo, 30s);
         box.check(r.exit_code == 0, "run --publish-objects exits 0", r);
         box.check(e.exit_code == 0, "echo exits 0", e);
-        box.check(e.out.find("type objects frame ") != std::string::npos, "echo reads object lists", e);
-        box.check(e.out.find("  track 1 label ") != std::string::npos, "the lists carry tracked objects", e);
-        box.check(e.out.find("rejected 0") != std::string::npos, "no list is rejected (type and version match)", e);
+        box.check(e.out.find("type objects frame ") != std::string::npos, "echo reads object lists",
+                  e);
+        box.check(e.out.find("  track 1 label ") != std::string::npos,
+                  "the lists carry tracked objects", e);
+        box.check(e.out.find("rejected 0") != std::string::npos,
+                  "no list is rejected (type and version match)", e);
       },
       40s);
   if (outcome.skipped) GTEST_SKIP() << outcome.reason;

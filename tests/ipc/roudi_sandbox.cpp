@@ -5,8 +5,8 @@
 #include <sched.h>
 #include <signal.h>
 #include <sys/mount.h>
-#include <sys/stat.h>
 #include <sys/prctl.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -45,11 +45,12 @@ void write_all(int fd, const std::string& text) {
 // "why" for a failed system call: "SKIP ..." when it lacks privileges, else "FAIL ...".
 std::string setup_error(const char* what) {
   const int error = errno;
-  return std::string(error == EPERM || error == EACCES ? "SKIP " : "FAIL ") + what + ": " + std::strerror(error) +
-         " (needs root or CAP_SYS_ADMIN for a private mount namespace)";
+  return std::string(error == EPERM || error == EACCES ? "SKIP " : "FAIL ") + what + ": " +
+         std::strerror(error) + " (needs root or CAP_SYS_ADMIN for a private mount namespace)";
 }
 
-// Where the host's /tmp stays reachable after a fresh tmpfs covers /tmp (inside the private /dev/shm).
+// Where the host's /tmp stays reachable after a fresh tmpfs covers /tmp (inside the private
+// /dev/shm).
 constexpr const char* HOST_TMP = "/dev/shm/.host_tmp";
 
 // mkdir -p (0755); false on the first failure other than EEXIST.
@@ -66,18 +67,22 @@ bool make_dirs(const std::string& path) {
 bool keep_visible(const std::string& dir) {
   if (dir.rfind("/tmp/", 0) != 0) return true;
   const std::string host = std::string(HOST_TMP) + dir.substr(4);
-  return make_dirs(dir) && ::mount(host.c_str(), dir.c_str(), nullptr, MS_BIND | MS_REC, nullptr) == 0;
+  return make_dirs(dir) &&
+         ::mount(host.c_str(), dir.c_str(), nullptr, MS_BIND | MS_REC, nullptr) == 0;
 }
 
 // Returns an empty string on success, else why the namespace could not be set up.
 std::string enter_private_mounts() {
   if (::unshare(CLONE_NEWNS) != 0) return setup_error("unshare(CLONE_NEWNS)");
-  if (::mount(nullptr, "/", nullptr, MS_REC | MS_PRIVATE, nullptr) != 0) return setup_error("mount rprivate /");
-  if (::mount("tmpfs", "/dev/shm", "tmpfs", 0, "mode=1777") != 0) return setup_error("mount tmpfs /dev/shm");
+  if (::mount(nullptr, "/", nullptr, MS_REC | MS_PRIVATE, nullptr) != 0)
+    return setup_error("mount rprivate /");
+  if (::mount("tmpfs", "/dev/shm", "tmpfs", 0, "mode=1777") != 0)
+    return setup_error("mount tmpfs /dev/shm");
   if (!make_dirs(HOST_TMP) || ::mount("/tmp", HOST_TMP, nullptr, MS_BIND | MS_REC, nullptr) != 0) {
     return setup_error("bind the host /tmp");
   }
-  if (::mount("tmpfs", "/tmp", "tmpfs", 0, "mode=1777") != 0) return setup_error("mount tmpfs /tmp");
+  if (::mount("tmpfs", "/tmp", "tmpfs", 0, "mode=1777") != 0)
+    return setup_error("mount tmpfs /tmp");
   if (!keep_visible(ORTHOFLOW_SOURCE_DIR) || !keep_visible(ORTHOFLOW_BINARY_DIR)) {
     return setup_error("bind the source and build directories back under /tmp");
   }
@@ -86,7 +91,8 @@ std::string enter_private_mounts() {
 
 }  // namespace
 
-pid_t Sandbox::spawn(const std::string& name, const std::vector<std::string>& argv, bool new_session) {
+pid_t Sandbox::spawn(const std::string& name, const std::vector<std::string>& argv,
+                     bool new_session) {
   const std::string out = "/tmp/" + name + ".out", err = "/tmp/" + name + ".err";
   const pid_t pid = ::fork();
   if (pid == 0) {
@@ -119,13 +125,15 @@ pid_t Sandbox::spawn_orthoflow(const std::string& name, const std::vector<std::s
 }
 
 pid_t Sandbox::start_roudi() {
-  const pid_t pid = spawn("roudi", {"/usr/bin/iox-roudi", "-c", ORTHOFLOW_SOURCE_DIR "/config/roudi_test.toml"}, true);
+  const pid_t pid = spawn(
+      "roudi", {"/usr/bin/iox-roudi", "-c", ORTHOFLOW_SOURCE_DIR "/config/roudi_test.toml"}, true);
   const auto until = Clock::now() + std::chrono::seconds(5);
   while (Clock::now() < until) {
     if (engine::probe_roudi()) return pid;
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
-  check(false, "RouDi not reachable within 5 s: " + slurp("/tmp/roudi.out") + slurp("/tmp/roudi.err"));
+  check(false,
+        "RouDi not reachable within 5 s: " + slurp("/tmp/roudi.out") + slurp("/tmp/roudi.err"));
   return -1;
 }
 
@@ -160,7 +168,8 @@ ProcResult Sandbox::wait(pid_t pid, std::chrono::milliseconds timeout) {
   return result;
 }
 
-bool Sandbox::wait_for_output(pid_t pid, const std::string& needle, std::chrono::milliseconds timeout) {
+bool Sandbox::wait_for_output(pid_t pid, const std::string& needle,
+                              std::chrono::milliseconds timeout) {
   const Child* child = find(pid);
   if (child == nullptr) return false;
   const auto until = Clock::now() + timeout;
@@ -178,8 +187,10 @@ void Sandbox::check(bool ok, const std::string& what) {
 void Sandbox::check(bool ok, const std::string& what, const ProcResult& proc) {
   if (ok) return;
   std::ostringstream text;
-  text << what << " [exit " << proc.exit_code << ", signal " << proc.signal << (proc.hung ? ", HUNG" : "") << ", "
-       << proc.seconds << " s]\n--- stdout:\n" << proc.out.substr(0, 3000) << "--- stderr:\n" << proc.err.substr(0, 3000);
+  text << what << " [exit " << proc.exit_code << ", signal " << proc.signal
+       << (proc.hung ? ", HUNG" : "") << ", " << proc.seconds << " s]\n--- stdout:\n"
+       << proc.out.substr(0, 3000) << "--- stderr:\n"
+       << proc.err.substr(0, 3000);
   failures_ += text.str() + "\n";
 }
 
@@ -226,7 +237,9 @@ Outcome run_isolated(const std::function<void(Sandbox&)>& scenario, std::chrono:
   ::close(fds[0]);
   if (hung) ::kill(pid, SIGKILL);
   ::waitpid(pid, nullptr, 0);
-  if (hung) return Outcome{false, {}, "scenario hung for " + std::to_string(timeout.count()) + " s: " + text};
+  if (hung)
+    return Outcome{
+        false, {}, "scenario hung for " + std::to_string(timeout.count()) + " s: " + text};
   if (text.rfind("SKIP ", 0) == 0) return Outcome{true, text.substr(5), {}};
   if (text.rfind("DONE ", 0) == 0) return Outcome{false, {}, text.substr(5)};
   return Outcome{false, {}, text.empty() ? "scenario child died without a report" : text};

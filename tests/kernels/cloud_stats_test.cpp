@@ -23,7 +23,8 @@ Cloud random_cloud(std::size_t n, std::uint32_t seed, float nan_share) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<float> coord(-1e6F, 1e6F);
   std::uniform_real_distribution<float> unit(0.0F, 1.0F);
-  const float specials[] = {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity(),
+  const float specials[] = {std::numeric_limits<float>::quiet_NaN(),
+                            std::numeric_limits<float>::infinity(),
                             -std::numeric_limits<float>::infinity()};
   Cloud c;
   for (std::size_t i = 0; i < n; ++i) {
@@ -57,7 +58,8 @@ TEST_P(CloudStatsSizes, EveryArchEqualsScalar) {
 
 // 0, 1, around every lane count in use (4, 8, 16), and large.
 INSTANTIATE_TEST_SUITE_P(Sizes, CloudStatsSizes,
-                         ::testing::Values(0, 1, 3, 4, 5, 7, 8, 9, 15, 16, 17, 31, 33, 1000, 100003));
+                         ::testing::Values(0, 1, 3, 4, 5, 7, 8, 9, 15, 16, 17, 31, 33, 1000,
+                                           100003));
 
 TEST(CloudStats, EmptyGivesEmptyBox) {
   const Cloud c;

@@ -1,5 +1,5 @@
-// The descriptor specification (kernels/descriptor_spec.hpp): length, equality, validation, description,
-// and that Describer gives what compute_good gives for the same parameters.
+// The descriptor specification (kernels/descriptor_spec.hpp): length, equality, validation,
+// description, and that Describer gives what compute_good gives for the same parameters.
 #include "kernels/descriptor_spec.hpp"
 
 #include <gtest/gtest.h>
@@ -30,7 +30,8 @@ TEST(DescriptorSpec, EqualityUsesTheEffectiveThreshold) {
 }
 
 TEST(DescriptorSpec, DescribeNamesKindAndParameters) {
-  EXPECT_EQ(DescriptorSpec::make_good(5, GoodMode::REFERENCE).describe(), "good bins=5 mode=reference threshold=0.0015");
+  EXPECT_EQ(DescriptorSpec::make_good(5, GoodMode::REFERENCE).describe(),
+            "good bins=5 mode=reference threshold=0.0015");
   EXPECT_EQ(DescriptorSpec{}.describe(), "good bins=15 mode=invariant threshold=0.015");
 }
 

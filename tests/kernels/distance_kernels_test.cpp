@@ -16,7 +16,8 @@ namespace ok = orthoflow::kernels;
 
 namespace {
 
-constexpr ok::Metric ALL[] = {ok::Metric::L1, ok::Metric::L2, ok::Metric::L2_SQUARED, ok::Metric::CHI_SQUARED,
+constexpr ok::Metric ALL[] = {ok::Metric::L1,           ok::Metric::L2,
+                              ok::Metric::L2_SQUARED,   ok::Metric::CHI_SQUARED,
                               ok::Metric::SYMMETRIC_KL, ok::Metric::JENSEN_SHANNON};
 
 struct Store {
@@ -39,7 +40,9 @@ Store random_store(std::size_t dims, std::size_t count, std::uint32_t seed) {
     }
     for (std::size_t d = 0; d < dims && sum > 0.0F; ++d) { s.data[d * s.stride + j] /= sum; }
     if (j % 5 == 4) {
-      for (std::size_t d = 0; d < dims; ++d) { s.data[d * s.stride + j] = s.data[d * s.stride + j - 1]; }
+      for (std::size_t d = 0; d < dims; ++d) {
+        s.data[d * s.stride + j] = s.data[d * s.stride + j - 1];
+      }
     }
   }
   return s;
@@ -53,10 +56,13 @@ std::vector<float> column(const Store& s, std::size_t j) {
 
 double tolerance(ok::Metric m, float ref) {
   switch (m) {
-    case ok::Metric::L1: return 0.0;
+    case ok::Metric::L1:
+      return 0.0;
     case ok::Metric::SYMMETRIC_KL:
-    case ok::Metric::JENSEN_SHANNON: return 1e-4 * std::abs(ref) + 1e-6;
-    default: return 1e-5 * std::abs(ref);
+    case ok::Metric::JENSEN_SHANNON:
+      return 1e-4 * std::abs(ref) + 1e-6;
+    default:
+      return 1e-5 * std::abs(ref);
   }
 }
 
@@ -71,12 +77,15 @@ TEST_P(DistanceSizes, EveryArchWithinToleranceOfScalar) {
     std::vector<float> ref(count), got(count);
     EXPECT_EQ(ok::distances_scalar(q, s.view(), m, ref), count);
     EXPECT_EQ(ok::distances(q, s.view(), m, got), count);
-    for (std::size_t j = 0; j < count; ++j) { EXPECT_NEAR(got[j], ref[j], tolerance(m, ref[j])) << ok::to_string(m); }
+    for (std::size_t j = 0; j < count; ++j) {
+      EXPECT_NEAR(got[j], ref[j], tolerance(m, ref[j])) << ok::to_string(m);
+    }
     ok::for_each_available_arch([&](auto arch) {
       std::vector<float> a(count, -1.0F);
       ok::detail::DistanceKernel{}(arch, q, s.view(), m, a);
       for (std::size_t j = 0; j < count; ++j) {
-        ASSERT_NEAR(a[j], ref[j], tolerance(m, ref[j])) << ok::to_string(m) << " " << decltype(arch)::name() << " j " << j;
+        ASSERT_NEAR(a[j], ref[j], tolerance(m, ref[j]))
+            << ok::to_string(m) << " " << decltype(arch)::name() << " j " << j;
       }
     });
   }
@@ -84,7 +93,8 @@ TEST_P(DistanceSizes, EveryArchWithinToleranceOfScalar) {
 
 // 0, 1, around 4/8/16 lanes and the 4-register blocks (16/32/64 columns), and larger.
 INSTANTIATE_TEST_SUITE_P(Sizes, DistanceSizes,
-                         ::testing::Values(0, 1, 3, 4, 5, 7, 8, 9, 15, 16, 17, 31, 32, 33, 63, 64, 65, 1000));
+                         ::testing::Values(0, 1, 3, 4, 5, 7, 8, 9, 15, 16, 17, 31, 32, 33, 63, 64,
+                                           65, 1000));
 
 TEST(Distance, HandComputedValues) {
   // Two descriptors as columns: q = (0.5, 0.5, 0), b0 = q, b1 = (0, 0.5, 0.5).
@@ -100,7 +110,8 @@ TEST(Distance, HandComputedValues) {
   EXPECT_FLOAT_EQ(get(ok::Metric::L2_SQUARED), 0.5F);
   EXPECT_FLOAT_EQ(get(ok::Metric::L2), std::sqrt(0.5F));
   EXPECT_FLOAT_EQ(get(ok::Metric::CHI_SQUARED), 1.0F);  // 0.25/0.5 + 0 + 0.25/0.5
-  EXPECT_NEAR(get(ok::Metric::JENSEN_SHANNON), std::log(2.0) / 2.0, 1e-6);  // half the mass disjoint
+  EXPECT_NEAR(get(ok::Metric::JENSEN_SHANNON), std::log(2.0) / 2.0,
+              1e-6);  // half the mass disjoint
   const double e = ok::DISTANCE_KL_EPSILON;
   EXPECT_NEAR(get(ok::Metric::SYMMETRIC_KL), 2 * 0.5 * (std::log(0.5 + e) - std::log(e)), 1e-3);
 }
@@ -115,9 +126,12 @@ TEST(Distance, NearestKMatchesScalarAndIsSortedWithStableTies) {
     ASSERT_EQ(ok::nearest_k_scalar(q, s.view(), m, scratch, b), 10U);
     EXPECT_EQ(a[0].index, 17U) << ok::to_string(m);
     for (std::size_t i = 1; i < a.size(); ++i) { EXPECT_LE(a[i - 1].distance, a[i].distance); }
-    for (std::size_t i = 0; i < a.size(); ++i) { EXPECT_EQ(a[i].index, b[i].index) << ok::to_string(m) << " rank " << i; }
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      EXPECT_EQ(a[i].index, b[i].index) << ok::to_string(m) << " rank " << i;
+    }
   }
-  // Column 19 duplicates 18 (every fifth column repeats its left neighbour): equal distances, lower index first.
+  // Column 19 duplicates 18 (every fifth column repeats its left neighbour): equal distances, lower
+  // index first.
   const std::vector<float> q18 = column(s, 18);
   std::vector<float> scratch(s.count);
   std::vector<ok::Neighbor> two(2);
@@ -143,7 +157,8 @@ TEST(DistanceDeathTest, WrongShapesAreBugs) {
   const Store s = random_store(4, 3, 1U);
   std::vector<float> out(3);
   const std::vector<float> bad_query(5, 0.0F);
-  EXPECT_DEATH(static_cast<void>(ok::distances(bad_query, s.view(), ok::Metric::L1, out)), "query length");
+  EXPECT_DEATH(static_cast<void>(ok::distances(bad_query, s.view(), ok::Metric::L1, out)),
+               "query length");
 }
 
 }  // namespace

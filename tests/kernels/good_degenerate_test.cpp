@@ -1,6 +1,6 @@
 // GOOD on bad and degenerate input: every GoodError enumerator, finite deterministic output with an
-// "unreliable" flag for 1-2 points, identical, collinear, coplanar and sphere-like clouds, NaN skipping,
-// huge coordinates, and the invariant tie rule.
+// "unreliable" flag for 1-2 points, identical, collinear, coplanar and sphere-like clouds, NaN
+// skipping, huge coordinates, and the invariant tie rule.
 #include <limits>
 
 #include "tests/kernels/good_test_util.hpp"
@@ -9,7 +9,8 @@ namespace {
 
 using namespace good_test;
 
-orthoflow::Result<ok::GoodResult, ok::GoodError> run(const Cloud& c, const ok::GoodConfig& cfg, std::vector<float>& d) {
+orthoflow::Result<ok::GoodResult, ok::GoodError> run(const Cloud& c, const ok::GoodConfig& cfg,
+                                                     std::vector<float>& d) {
   ok::GoodScratch scratch(cfg.bins);
   d.assign(3 * cfg.bins * cfg.bins, -1.0F);
   return ok::compute_good(c.view(), cfg, scratch, d);
@@ -40,7 +41,8 @@ TEST(GoodErrors, EveryEnumeratorIsReachable) {
   const float nan = std::numeric_limits<float>::quiet_NaN();
   expect_error(Cloud{{nan, 1.0F}, {0.0F, nan}, {0.0F, 0.0F}}, {}, ok::GoodError::NO_FINITE_POINTS);
   expect_error(mug, {0, ok::GoodMode::INVARIANT, std::nullopt}, ok::GoodError::BAD_BINS);
-  expect_error(mug, {ok::GOOD_MAX_BINS + 1, ok::GoodMode::INVARIANT, std::nullopt}, ok::GoodError::BAD_BINS);
+  expect_error(mug, {ok::GOOD_MAX_BINS + 1, ok::GoodMode::INVARIANT, std::nullopt},
+               ok::GoodError::BAD_BINS);
   expect_error(mug, {5, ok::GoodMode::INVARIANT, -0.1F}, ok::GoodError::BAD_THRESHOLD);
   expect_error(mug, {5, ok::GoodMode::REFERENCE, nan}, ok::GoodError::BAD_THRESHOLD);
   ok::GoodScratch small(5);
@@ -49,14 +51,17 @@ TEST(GoodErrors, EveryEnumeratorIsReachable) {
   ASSERT_FALSE(r.has_value());
   EXPECT_EQ(r.error(), ok::GoodError::SCRATCH_TOO_SMALL);
   ok::GoodScratch big(15);
-  r = ok::compute_good(mug.view(), {15, ok::GoodMode::INVARIANT, std::nullopt}, big, std::span<float>(out).first(674));
+  r = ok::compute_good(mug.view(), {15, ok::GoodMode::INVARIANT, std::nullopt}, big,
+                       std::span<float>(out).first(674));
   ASSERT_FALSE(r.has_value());
   EXPECT_EQ(r.error(), ok::GoodError::OUTPUT_TOO_SMALL);
 }
 
 TEST(GoodConfig, ModeDefaultThresholds) {
-  EXPECT_EQ((ok::GoodConfig{5, ok::GoodMode::INVARIANT, std::nullopt}.effective_threshold()), 0.015F);
-  EXPECT_EQ((ok::GoodConfig{5, ok::GoodMode::REFERENCE, std::nullopt}.effective_threshold()), 0.0015F);
+  EXPECT_EQ((ok::GoodConfig{5, ok::GoodMode::INVARIANT, std::nullopt}.effective_threshold()),
+            0.015F);
+  EXPECT_EQ((ok::GoodConfig{5, ok::GoodMode::REFERENCE, std::nullopt}.effective_threshold()),
+            0.0015F);
   EXPECT_EQ((ok::GoodConfig{5, ok::GoodMode::REFERENCE, 0.01F}.effective_threshold()), 0.01F);
 }
 
@@ -79,14 +84,16 @@ TEST_P(GoodDegenerate, FiniteDeterministicAndFlagged) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Shared, GoodDegenerate,
-                         ::testing::Values("single_point", "two_points", "all_identical_50", "collinear_axis",
-                                           "collinear_diag", "plate_disk", "plate_disk_axis_aligned", "sphere",
-                                           "bowl_hemisphere", "trunc_band"));
+                         ::testing::Values("single_point", "two_points", "all_identical_50",
+                                           "collinear_axis", "collinear_diag", "plate_disk",
+                                           "plate_disk_axis_aligned", "sphere", "bowl_hemisphere",
+                                           "trunc_band"));
 
 // Ten well-spread points: a usable frame (no flag) and a valid descriptor.
 TEST(GoodDegenerate, TenPointsGiveAValidDescriptor) {
   ok::GoodResult r;
-  const auto d = describe(load(good_dir() / "tiny10.pcd"), {5, ok::GoodMode::INVARIANT, std::nullopt}, &r);
+  const auto d =
+      describe(load(good_dir() / "tiny10.pcd"), {5, ok::GoodMode::INVARIANT, std::nullopt}, &r);
   expect_valid(d, 5);
   EXPECT_EQ(r.points_used, 10U);
 }
@@ -116,7 +123,8 @@ TEST(GoodDegenerate, HugeCoordinatesStayFinite) {
   const auto r = run(c, {5, ok::GoodMode::INVARIANT, std::nullopt}, d);
   ASSERT_TRUE(r.has_value());
   for (const float v : d) { EXPECT_TRUE(std::isfinite(v)); }
-  const auto far = run(Cloud{{1e7F, 1e7F + 1.0F, 1e7F}, {0.0F, 0.0F, 1.0F}, {2.0F, 2.0F, 2.0F}}, {5, ok::GoodMode::INVARIANT, std::nullopt}, d);
+  const auto far = run(Cloud{{1e7F, 1e7F + 1.0F, 1e7F}, {0.0F, 0.0F, 1.0F}, {2.0F, 2.0F, 2.0F}},
+                       {5, ok::GoodMode::INVARIANT, std::nullopt}, d);
   ASSERT_TRUE(far.has_value());
   expect_valid(d, 5);
 }
@@ -138,16 +146,19 @@ TEST(GoodTieRule, SkewnessDecidesWhenCountsTie) {
     const Cloud moved = trial == 0 ? c : random_motion(c, rng);
     ok::GoodResult r;
     describe(moved, {5, ok::GoodMode::INVARIANT, std::nullopt}, &r);
-    // X (frame row 0) must point to where the world +x went: the image of the far-reaching point 0.3.
+    // X (frame row 0) must point to where the world +x went: the image of the far-reaching point
+    // 0.3.
     const std::size_t far_idx = 3, near_idx = 0;
-    const float proj_far = r.frame[0] * moved.x[far_idx] + r.frame[1] * moved.y[far_idx] + r.frame[2] * moved.z[far_idx];
-    const float proj_near = r.frame[0] * moved.x[near_idx] + r.frame[1] * moved.y[near_idx] + r.frame[2] * moved.z[near_idx];
+    const float proj_far = r.frame[0] * moved.x[far_idx] + r.frame[1] * moved.y[far_idx] +
+                           r.frame[2] * moved.z[far_idx];
+    const float proj_near = r.frame[0] * moved.x[near_idx] + r.frame[1] * moved.y[near_idx] +
+                            r.frame[2] * moved.z[near_idx];
     EXPECT_GT(proj_far, proj_near) << "trial " << trial;
   }
 }
 
-// A cloud symmetric under x -> -x and y -> -y (box corners with distinct edges): no rule can choose,
-// so SIGN_AMBIGUOUS is set and the output is still finite and the same for every call.
+// A cloud symmetric under x -> -x and y -> -y (box corners with distinct edges): no rule can
+// choose, so SIGN_AMBIGUOUS is set and the output is still finite and the same for every call.
 TEST(GoodTieRule, SymmetricShapeIsFlaggedAmbiguous) {
   Cloud c;
   for (const float sx : {-1.0F, 1.0F}) {

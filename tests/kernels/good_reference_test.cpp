@@ -1,5 +1,5 @@
-// The shared GOOD vectors (testdata/good): reference mode equals one of the 4 reference variants and
-// invariant mode one of the 4 frame binnings, at 5 and 15 bins, for every cloud (L1 <= 0.01).
+// The shared GOOD vectors (testdata/good): reference mode equals one of the 4 reference variants
+// and invariant mode one of the 4 frame binnings, at 5 and 15 bins, for every cloud (L1 <= 0.01).
 #include <algorithm>
 
 #include "tests/kernels/good_test_util.hpp"
@@ -22,7 +22,9 @@ std::vector<Case> all_cases() {
       for (const std::size_t bins : {5U, 15U}) { cases.push_back({stem, bins}); }
     }
   }
-  std::sort(cases.begin(), cases.end(), [](const Case& a, const Case& b) { return a.name + std::to_string(a.bins) < b.name + std::to_string(b.bins); });
+  std::sort(cases.begin(), cases.end(), [](const Case& a, const Case& b) {
+    return a.name + std::to_string(a.bins) < b.name + std::to_string(b.bins);
+  });
   return cases;
 }
 
@@ -40,7 +42,9 @@ class GoodVectors : public ::testing::TestWithParam<Case> {
 };
 
 TEST_P(GoodVectors, ReferenceModeMatchesAVariant) {
-  if (!fs::exists(file(".variants"))) { GTEST_SKIP() << "no .variants file for " << GetParam().name; }
+  if (!fs::exists(file(".variants"))) {
+    GTEST_SKIP() << "no .variants file for " << GetParam().name;
+  }
   const Cloud c = load(good_dir() / (GetParam().name + ".pcd"));
   ok::GoodConfig cfg{GetParam().bins, ok::GoodMode::REFERENCE, std::nullopt};
   const auto d = describe(c, cfg);
@@ -53,7 +57,8 @@ TEST_P(GoodVectors, InvariantModeMatchesAFrame) {
   const Cloud c = load(good_dir() / (GetParam().name + ".pcd"));
   const auto frames = load_variants(file(".frames"));
   ASSERT_EQ(frames.size(), 4U);
-  const auto d = describe(c, ok::GoodConfig{GetParam().bins, ok::GoodMode::INVARIANT, std::nullopt});
+  const auto d =
+      describe(c, ok::GoodConfig{GetParam().bins, ok::GoodMode::INVARIANT, std::nullopt});
   EXPECT_LE(best_l1(d, frames), 0.01);
 }
 

@@ -1,5 +1,5 @@
-// GOOD's SIMD passes against their scalar twins, on every architecture the CPU has: random clouds with
-// NaN/Inf, sizes around 4/8/16 lanes, duplicates and huge coordinates; then whole descriptors.
+// GOOD's SIMD passes against their scalar twins, on every architecture the CPU has: random clouds
+// with NaN/Inf, sizes around 4/8/16 lanes, duplicates and huge coordinates; then whole descriptors.
 #include <limits>
 
 #include "kernels/detail/good_kernel.hpp"
@@ -15,13 +15,16 @@ Cloud random_cloud(std::size_t n, std::uint32_t seed, float scale, float bad_sha
   std::mt19937 rng(seed);
   std::uniform_real_distribution<float> coord(-scale, scale);
   std::uniform_real_distribution<float> unit(0.0F, 1.0F);
-  const float specials[] = {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity(),
+  const float specials[] = {std::numeric_limits<float>::quiet_NaN(),
+                            std::numeric_limits<float>::infinity(),
                             -std::numeric_limits<float>::infinity()};
   Cloud c;
   for (std::size_t i = 0; i < n; ++i) {
     float p[3] = {coord(rng), 0.5F * coord(rng), 0.25F * coord(rng)};
     if (unit(rng) < bad_share) { p[rng() % 3] = specials[rng() % 3]; }
-    if (i % 7 == 3 && i > 0) { p[0] = c.x.back(), p[1] = c.y.back(), p[2] = c.z.back(); }  // duplicates
+    if (i % 7 == 3 && i > 0) {
+      p[0] = c.x.back(), p[1] = c.y.back(), p[2] = c.z.back();
+    }  // duplicates
     c.x.push_back(p[0]);
     c.y.push_back(p[1]);
     c.z.push_back(p[2]);
@@ -44,7 +47,8 @@ struct SimdCase {
 class GoodSimd : public ::testing::TestWithParam<SimdCase> {};
 
 TEST_P(GoodSimd, StatsAndBinsEqualScalarOnEveryArch) {
-  const Cloud c = random_cloud(GetParam().n, static_cast<std::uint32_t>(GetParam().n) + 11U, GetParam().scale, 0.1F);
+  const Cloud c = random_cloud(GetParam().n, static_cast<std::uint32_t>(GetParam().n) + 11U,
+                               GetParam().scale, 0.1F);
   const od::GoodTransform t = some_transform();
   const float inf = std::numeric_limits<float>::infinity();
   od::GoodStats ref{{inf, inf, inf}, {-inf, -inf, -inf}, {0, 0}, {0, 0}};
@@ -59,7 +63,9 @@ TEST_P(GoodSimd, StatsAndBinsEqualScalarOnEveryArch) {
     // moves by ~1e-7 relative and a point sitting on the threshold or a bin edge may change side.
     const double tol = 1e-5 * GetParam().scale;
     for (std::size_t a = 0; a < 3; ++a) {
-      if (s.min[a] != ref.min[a]) { EXPECT_NEAR(s.min[a], ref.min[a], tol) << name; }  // equal covers +-inf
+      if (s.min[a] != ref.min[a]) {
+        EXPECT_NEAR(s.min[a], ref.min[a], tol) << name;
+      }  // equal covers +-inf
       if (s.max[a] != ref.max[a]) { EXPECT_NEAR(s.max[a], ref.max[a], tol) << name; }
     }
     for (std::size_t a = 0; a < 2; ++a) {
@@ -69,7 +75,9 @@ TEST_P(GoodSimd, StatsAndBinsEqualScalarOnEveryArch) {
     std::vector<std::uint32_t> counts(303, 0U);
     od::GoodBinKernel{}(arch, c.view(), p, counts);
     long moved = 0;  // over the cells and the three drop slots
-    for (std::size_t i = 0; i < counts.size(); ++i) { moved += std::abs(static_cast<long>(counts[i]) - static_cast<long>(ref_counts[i])); }
+    for (std::size_t i = 0; i < counts.size(); ++i) {
+      moved += std::abs(static_cast<long>(counts[i]) - static_cast<long>(ref_counts[i]));
+    }
     EXPECT_LE(moved, 6) << name;
     if (!name.starts_with("avx") && !name.starts_with("fma")) {  // no FMA in the SSE2 unit: exact
       EXPECT_EQ(counts, ref_counts) << name;
@@ -79,10 +87,12 @@ TEST_P(GoodSimd, StatsAndBinsEqualScalarOnEveryArch) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Sizes, GoodSimd,
-                         ::testing::Values(SimdCase{0, 1.0F}, SimdCase{1, 1.0F}, SimdCase{3, 1.0F}, SimdCase{4, 1.0F},
-                                           SimdCase{5, 1.0F}, SimdCase{7, 1.0F}, SimdCase{8, 1.0F}, SimdCase{9, 1.0F},
-                                           SimdCase{15, 1.0F}, SimdCase{16, 1.0F}, SimdCase{17, 1.0F},
-                                           SimdCase{33, 1.0F}, SimdCase{1000, 0.1F}, SimdCase{5003, 1e30F}));
+                         ::testing::Values(SimdCase{0, 1.0F}, SimdCase{1, 1.0F}, SimdCase{3, 1.0F},
+                                           SimdCase{4, 1.0F}, SimdCase{5, 1.0F}, SimdCase{7, 1.0F},
+                                           SimdCase{8, 1.0F}, SimdCase{9, 1.0F}, SimdCase{15, 1.0F},
+                                           SimdCase{16, 1.0F}, SimdCase{17, 1.0F},
+                                           SimdCase{33, 1.0F}, SimdCase{1000, 0.1F},
+                                           SimdCase{5003, 1e30F}));
 
 TEST(PcaMoments, EveryArchWithinToleranceOfScalar) {
   for (const std::size_t n : {1U, 3U, 4U, 5U, 8U, 9U, 17U, 1000U}) {
@@ -95,15 +105,20 @@ TEST(PcaMoments, EveryArchWithinToleranceOfScalar) {
       m.origin = ref.origin;
       m = od::PcaMomentsKernel{}(arch, c.view(), m);
       EXPECT_EQ(m.count, ref.count);
-      for (std::size_t a = 0; a < 3; ++a) { EXPECT_NEAR(m.sum[a], ref.sum[a], 1e-12 * (1.0 + std::abs(ref.sum[a]))); }
-      for (std::size_t a = 0; a < 6; ++a) { EXPECT_NEAR(m.sq[a], ref.sq[a], 1e-12 * (1.0 + std::abs(ref.sq[a]))); }
+      for (std::size_t a = 0; a < 3; ++a) {
+        EXPECT_NEAR(m.sum[a], ref.sum[a], 1e-12 * (1.0 + std::abs(ref.sum[a])));
+      }
+      for (std::size_t a = 0; a < 6; ++a) {
+        EXPECT_NEAR(m.sq[a], ref.sq[a], 1e-12 * (1.0 + std::abs(ref.sq[a])));
+      }
     });
   }
 }
 
 TEST(GoodSimd, AllNaNCountsNothing) {
   const float nan = std::numeric_limits<float>::quiet_NaN();
-  const Cloud c{std::vector<float>(37, nan), std::vector<float>(37, 0.0F), std::vector<float>(37, 1.0F)};
+  const Cloud c{std::vector<float>(37, nan), std::vector<float>(37, 0.0F),
+                std::vector<float>(37, 1.0F)};
   ok::for_each_available_arch([&](auto arch) {
     const od::GoodStats s = od::GoodStatsKernel{}(arch, c.view(), some_transform(), 0.0F);
     EXPECT_EQ(s.pos[0] + s.neg[0] + s.pos[1] + s.neg[1], 0U);
@@ -114,7 +129,8 @@ TEST(GoodSimd, AllNaNCountsNothing) {
 }
 
 TEST(GoodSimd, DispatchedDescriptorEqualsScalarTwin) {
-  for (const char* name : {"mug_handle", "box", "cone", "sphere", "duplicates", "mug_handle_far", "two_points"}) {
+  for (const char* name :
+       {"mug_handle", "box", "cone", "sphere", "duplicates", "mug_handle_far", "two_points"}) {
     const Cloud c = load(good_dir() / (std::string(name) + ".pcd"));
     for (const auto mode : {ok::GoodMode::INVARIANT, ok::GoodMode::REFERENCE}) {
       for (const std::size_t bins : {5U, 15U}) {
@@ -125,7 +141,9 @@ TEST(GoodSimd, DispatchedDescriptorEqualsScalarTwin) {
         const auto rb = ok::compute_good_scalar(c.view(), cfg, scratch, b);
         ASSERT_TRUE(ra.has_value() && rb.has_value());
         EXPECT_LE(l1(a, b), 1e-3) << name;  // a point may move across a bin edge (good.hpp @note)
-        for (std::size_t k = 0; k < 16; ++k) { EXPECT_NEAR(ra->frame[k], rb->frame[k], 1e-5) << name; }
+        for (std::size_t k = 0; k < 16; ++k) {
+          EXPECT_NEAR(ra->frame[k], rb->frame[k], 1e-5) << name;
+        }
         EXPECT_EQ(ra->order, rb->order) << name;
         EXPECT_EQ(ra->kept, rb->kept) << name;
       }

@@ -32,7 +32,9 @@ inline Cloud load(const fs::path& path) {
     return {};
   }
   const ok::PointCloud& pc = cloud_result.value();
-  return {{pc.x().begin(), pc.x().end()}, {pc.y().begin(), pc.y().end()}, {pc.z().begin(), pc.z().end()}};
+  return {{pc.x().begin(), pc.x().end()},
+          {pc.y().begin(), pc.y().end()},
+          {pc.z().begin(), pc.z().end()}};
 }
 
 /// The descriptors after '|' on each "variant ..." line of a .variants or .frames file.
@@ -83,7 +85,9 @@ inline Cloud random_motion(const Cloud& c, std::mt19937& rng) {
   for (std::size_t i = 0; i < c.x.size(); ++i) {
     const double p[3] = {c.x[i], c.y[i], c.z[i]};
     float o[3];
-    for (int a = 0; a < 3; ++a) { o[a] = static_cast<float>(r[a][0] * p[0] + r[a][1] * p[1] + r[a][2] * p[2] + tr[a]); }
+    for (int a = 0; a < 3; ++a) {
+      o[a] = static_cast<float>(r[a][0] * p[0] + r[a][1] * p[1] + r[a][2] * p[2] + tr[a]);
+    }
     out.x.push_back(o[0]);
     out.y.push_back(o[1]);
     out.z.push_back(o[2]);
@@ -92,7 +96,8 @@ inline Cloud random_motion(const Cloud& c, std::mt19937& rng) {
 }
 
 /// compute_good() into a fresh vector; fails the test on error.
-inline std::vector<float> describe(const Cloud& c, const ok::GoodConfig& cfg, ok::GoodResult* result = nullptr) {
+inline std::vector<float> describe(const Cloud& c, const ok::GoodConfig& cfg,
+                                   ok::GoodResult* result = nullptr) {
   ok::GoodScratch scratch(cfg.bins);
   std::vector<float> d(3 * cfg.bins * cfg.bins);
   auto good_result = ok::compute_good(c.view(), cfg, scratch, d);

@@ -1,5 +1,5 @@
-// kernels/pca_frame.hpp: the SIMD moments equal the scalar twin within the header's tolerance, the frame
-// recovers known axes and eigenvalues, and every PcaError is triggered.
+// kernels/pca_frame.hpp: the SIMD moments equal the scalar twin within the header's tolerance, the
+// frame recovers known axes and eigenvalues, and every PcaError is triggered.
 #include "kernels/pca_frame.hpp"
 
 #include <gtest/gtest.h>
@@ -26,20 +26,24 @@ double normal(orthoflow::core::Rng& rng) {
   return sum - 6.0;
 }
 
-/// An anisotropic blob: standard deviations 0.3, 0.1, 0.02 along x, y, z, centred at @p c, some NaN.
+/// An anisotropic blob: standard deviations 0.3, 0.1, 0.02 along x, y, z, centred at @p c, some
+/// NaN.
 Cloud blob(std::size_t n, double c, std::uint64_t seed) {
   orthoflow::core::Rng rng(seed);
   Cloud out;
   for (std::size_t i = 0; i < n; ++i) {
     const bool nan = i % 11 == 5;
-    out.x.push_back(nan ? std::numeric_limits<float>::quiet_NaN() : static_cast<float>(c + 0.3 * normal(rng)));
+    out.x.push_back(nan ? std::numeric_limits<float>::quiet_NaN()
+                        : static_cast<float>(c + 0.3 * normal(rng)));
     out.y.push_back(static_cast<float>(c + 0.1 * normal(rng)));
     out.z.push_back(static_cast<float>(c + 0.02 * normal(rng)));
   }
   return out;
 }
 
-double rel(double a, double b) { return std::fabs(a - b) / std::max({std::fabs(a), std::fabs(b), 1e-300}); }
+double rel(double a, double b) {
+  return std::fabs(a - b) / std::max({std::fabs(a), std::fabs(b), 1e-300});
+}
 
 class PcaMomentsSizes : public ::testing::TestWithParam<std::size_t> {};
 
@@ -55,10 +59,12 @@ TEST_P(PcaMomentsSizes, SimdEqualsScalarWithinTolerance) {
   for (std::size_t k = 0; k < 6; ++k) { EXPECT_LE(rel(a.sq[k], b.sq[k]), 1e-12) << k; }
 }
 
-INSTANTIATE_TEST_SUITE_P(Sizes, PcaMomentsSizes, ::testing::Values(0, 1, 2, 3, 4, 5, 7, 8, 9, 15, 16, 17, 33, 10007));
+INSTANTIATE_TEST_SUITE_P(Sizes, PcaMomentsSizes,
+                         ::testing::Values(0, 1, 2, 3, 4, 5, 7, 8, 9, 15, 16, 17, 33, 10007));
 
 TEST(PcaFrame, RecoversKnownAxesFarFromTheOrigin) {
-  const Cloud c = blob(20000, 1000.0, 3);  // 1 km away: moments about the first point keep precision
+  const Cloud c =
+      blob(20000, 1000.0, 3);  // 1 km away: moments about the first point keep precision
   auto f = ok::compute_pca_frame(c.view());
   ASSERT_TRUE(f);
   EXPECT_NEAR(std::sqrt(f->eigenvalues[0]), 0.3, 0.01);
@@ -72,7 +78,9 @@ TEST(PcaFrame, RecoversKnownAxesFarFromTheOrigin) {
   EXPECT_EQ(f->flags & ok::FRAME_UNRELIABLE, 0U);
   auto s = ok::compute_pca_frame_scalar(c.view());
   ASSERT_TRUE(s);
-  for (std::size_t k = 0; k < 3; ++k) { EXPECT_LE(rel(f->eigenvalues[k], s->eigenvalues[k]), 1e-9); }
+  for (std::size_t k = 0; k < 3; ++k) {
+    EXPECT_LE(rel(f->eigenvalues[k], s->eigenvalues[k]), 1e-9);
+  }
 }
 
 TEST(PcaFrame, ErrorsAreReported) {
@@ -85,7 +93,8 @@ TEST(PcaFrame, ErrorsAreReported) {
   auto n = ok::compute_pca_frame(all_nan.view());
   ASSERT_FALSE(n);
   EXPECT_EQ(n.error(), ok::PcaError::NO_FINITE_POINTS);
-  EXPECT_STRNE(ok::to_string(ok::PcaError::EMPTY_CLOUD), ok::to_string(ok::PcaError::NO_FINITE_POINTS));
+  EXPECT_STRNE(ok::to_string(ok::PcaError::EMPTY_CLOUD),
+               ok::to_string(ok::PcaError::NO_FINITE_POINTS));
 }
 
 }  // namespace

@@ -24,7 +24,8 @@ namespace {
 class PclAgreement : public ::testing::TestWithParam<const char*> {
  protected:
   void SetUp() override {
-    auto r = orthoflow::formats::read_pcd(std::string(ORTHOFLOW_SHARED_DIR) + "/data/scenes/" + GetParam());
+    auto r = orthoflow::formats::read_pcd(std::string(ORTHOFLOW_SHARED_DIR) + "/data/scenes/" +
+                                          GetParam());
     ASSERT_TRUE(r) << r.error().to_string();
     cloud_ = std::move(*r);
     pcl_ = ob::run_pcl_chain(ob::to_pcl(cloud_));
@@ -33,11 +34,13 @@ class PclAgreement : public ::testing::TestWithParam<const char*> {
     std::vector<std::uint8_t> mask(n);
     kept_ = {std::vector<float>(n), std::vector<float>(n), std::vector<float>(n)};
     ok::crop_box_mask(cloud_.points(), ok::SegmentationParams{}.roi, mask);
-    const std::size_t kept = ok::compact_masked(cloud_.points(), mask, {kept_[0], kept_[1], kept_[2]}, {});
+    const std::size_t kept =
+        ok::compact_masked(cloud_.points(), mask, {kept_[0], kept_[1], kept_[2]}, {});
     for (auto& v : kept_) { v.resize(kept); }
     ok::VoxelGridScratch scratch(kept);
     vox_ = {std::vector<float>(kept), std::vector<float>(kept), std::vector<float>(kept)};
-    auto vr = ok::voxel_grid({kept_[0], kept_[1], kept_[2]}, 0.005F, scratch, {vox_[0], vox_[1], vox_[2]});
+    auto vr = ok::voxel_grid({kept_[0], kept_[1], kept_[2]}, 0.005F, scratch,
+                             {vox_[0], vox_[1], vox_[2]});
     ASSERT_TRUE(vr) << vr.error().to_string();
     for (auto& v : vox_) { v.resize(*vr); }
   }
@@ -49,7 +52,8 @@ class PclAgreement : public ::testing::TestWithParam<const char*> {
 TEST_P(PclAgreement, SameVoxelSetAndCentroids) {
   // Both order voxels by the same key (x fastest, z slowest, relative to the lowest voxel), so the
   // outputs correspond index by index. (Keys recomputed from PCL's float-summed centroids can cross
-  // a voxel face when the points lie on it, as Kinect-quantised depths often do, so they are not used.)
+  // a voxel face when the points lie on it, as Kinect-quantised depths often do, so they are not
+  // used.)
   EXPECT_EQ(kept_[0].size(), pcl_.cropped);
   ASSERT_EQ(vox_[0].size(), pcl_.voxels->size());
   const float inv = 1.0F / 0.005F;
@@ -74,15 +78,18 @@ TEST_P(PclAgreement, PlaneWithinOneDegreeAndFiveMillimetres) {
   const auto& c = pcl_.plane.values;
   ASSERT_EQ(c.size(), 4U);
   const double len = std::sqrt(double(c[0]) * c[0] + double(c[1]) * c[1] + double(c[2]) * c[2]);
-  double dot = (ours->plane.normal[0] * c[0] + ours->plane.normal[1] * c[1] + ours->plane.normal[2] * c[2]) / len;
+  double dot =
+      (ours->plane.normal[0] * c[0] + ours->plane.normal[1] * c[1] + ours->plane.normal[2] * c[2]) /
+      len;
   const double sign = dot < 0 ? -1.0 : 1.0;
   dot *= sign;
   EXPECT_LT(std::acos(std::min(1.0, dot)) * 180.0 / 3.14159265358979, 1.0);
   EXPECT_NEAR(double(ours->plane.d), sign * c[3] / len, 0.005);
-  std::printf("%s: ours n=(%.4f %.4f %.4f) d=%.4f inliers %zu | PCL (%.4f %.4f %.4f) d=%.4f inliers %zu\n", GetParam(),
-              double(ours->plane.normal[0]), double(ours->plane.normal[1]), double(ours->plane.normal[2]),
-              double(ours->plane.d), ours->inliers, sign * c[0] / len, sign * c[1] / len, sign * c[2] / len,
-              sign * c[3] / len, pcl_.inliers);
+  std::printf(
+      "%s: ours n=(%.4f %.4f %.4f) d=%.4f inliers %zu | PCL (%.4f %.4f %.4f) d=%.4f inliers %zu\n",
+      GetParam(), double(ours->plane.normal[0]), double(ours->plane.normal[1]),
+      double(ours->plane.normal[2]), double(ours->plane.d), ours->inliers, sign * c[0] / len,
+      sign * c[1] / len, sign * c[2] / len, sign * c[3] / len, pcl_.inliers);
 }
 
 TEST_P(PclAgreement, IdenticalClusterPartitionOnTheSamePoints) {
@@ -110,8 +117,9 @@ TEST_P(PclAgreement, IdenticalClusterPartitionOnTheSamePoints) {
 }
 
 TEST_P(PclAgreement, OrganizedChainPlaneWithinOneDegreeAndFiveMillimetres) {
-  // The organized chain fits the plane on a strided pixel sample (SegmentationParams::organized_stride)
-  // instead of the voxels: the plane tolerance still holds against PCL's voxel RANSAC.
+  // The organized chain fits the plane on a strided pixel sample
+  // (SegmentationParams::organized_stride) instead of the voxels: the plane tolerance still
+  // holds against PCL's voxel RANSAC.
   ok::SegmentationChain chain(cloud_.size(), ok::SegmentationParams{});
   auto seg = chain.run(cloud_.view());
   ASSERT_TRUE(seg) << seg.error().to_string();
@@ -126,7 +134,8 @@ TEST_P(PclAgreement, OrganizedChainPlaneWithinOneDegreeAndFiveMillimetres) {
   EXPECT_NEAR(double(seg->plane.plane.d), sign * c[3] / len, 0.005);
 }
 
-INSTANTIATE_TEST_SUITE_P(Mosd, PclAgreement, ::testing::Values("test31.pcd", "test44.pcd", "test55.pcd"),
+INSTANTIATE_TEST_SUITE_P(Mosd, PclAgreement,
+                         ::testing::Values("test31.pcd", "test44.pcd", "test55.pcd"),
                          [](const auto& p) { return std::string(p.param).substr(0, 6); });
 
 }  // namespace

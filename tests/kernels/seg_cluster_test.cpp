@@ -27,8 +27,13 @@ std::vector<std::int32_t> reference(const Cloud& c, const ok::ClusterParams& p) 
   const std::size_t n = c.x.size();
   std::vector<std::size_t> parent(n);
   std::iota(parent.begin(), parent.end(), 0U);
-  auto find = [&](std::size_t i) { while (parent[i] != i) { i = parent[i]; } return i; };
-  auto ok_pt = [&](std::size_t i) { return std::isfinite(c.x[i]) && std::isfinite(c.y[i]) && std::isfinite(c.z[i]); };
+  auto find = [&](std::size_t i) {
+    while (parent[i] != i) { i = parent[i]; }
+    return i;
+  };
+  auto ok_pt = [&](std::size_t i) {
+    return std::isfinite(c.x[i]) && std::isfinite(c.y[i]) && std::isfinite(c.z[i]);
+  };
   for (std::size_t i = 0; i < n; ++i) {
     for (std::size_t j = i + 1; j < n && ok_pt(i); ++j) {
       const float dx = c.x[i] - c.x[j], dy = c.y[i] - c.y[j], dz = c.z[i] - c.z[j];
@@ -61,7 +66,8 @@ Cloud blobs(std::size_t per_blob, std::size_t blobs_n, float spread, std::uint32
     for (std::size_t i = 0; i < per_blob; ++i) { c.add(cx + g(rng), cy + g(rng), cz + g(rng)); }
   }
   // Interleave blobs so that ids do not follow blob order trivially.
-  std::shuffle(c.x.begin(), c.x.end(), std::mt19937(seed)), std::shuffle(c.y.begin(), c.y.end(), std::mt19937(seed)),
+  std::shuffle(c.x.begin(), c.x.end(), std::mt19937(seed)),
+      std::shuffle(c.y.begin(), c.y.end(), std::mt19937(seed)),
       std::shuffle(c.z.begin(), c.z.end(), std::mt19937(seed));
   return c;
 }
@@ -81,7 +87,9 @@ void expect_reference(const Cloud& c, const ok::ClusterParams& p) {
 TEST(SegCluster, GridMatchesBruteForce) {
   ok::ClusterParams p;
   p.min_size = 5;
-  for (const std::size_t n : {1U, 7U, 40U, 300U}) { expect_reference(blobs(n, 6, 0.03F, std::uint32_t(n)), p); }
+  for (const std::size_t n : {1U, 7U, 40U, 300U}) {
+    expect_reference(blobs(n, 6, 0.03F, std::uint32_t(n)), p);
+  }
   p.tolerance = 0.005F;
   p.min_size = 1;
   p.max_size = 50;
@@ -99,7 +107,9 @@ TEST(SegCluster, AdversarialInputs) {
   for (int i = 0; i < 33; ++i) { dup.add(0.5F, 0.5F, 0.5F); }
   expect_reference(dup, p);
   Cloud huge;
-  for (int i = 0; i < 17; ++i) { huge.add(1e6F + 0.01F * float(i), -1e6F, 3e5F); }  // a chain 1 cm apart
+  for (int i = 0; i < 17; ++i) {
+    huge.add(1e6F + 0.01F * float(i), -1e6F, 3e5F);
+  }  // a chain 1 cm apart
   expect_reference(huge, p);
 }
 
@@ -114,7 +124,9 @@ TEST(SegCluster, OrganizedSeparatesByDepthAndMask) {
     }
   }
   std::vector<std::uint8_t> mask(c.x.size(), 1);
-  for (std::uint32_t v = 0; v < h; ++v) { mask[v * w + 30] = 0; }  // one pixel gap: bridged by radius 2
+  for (std::uint32_t v = 0; v < h; ++v) {
+    mask[v * w + 30] = 0;
+  }  // one pixel gap: bridged by radius 2
   ok::ClusterScratch scratch(c.x.size());
   std::vector<std::int32_t> labels(c.x.size());
   ok::ClusterParams p;
@@ -143,9 +155,11 @@ TEST(SegCluster, EveryErrorCode) {
   EXPECT_EQ(ok::euclidean_cluster(c.view(), {}, p, scratch, labels).error().code, Code::BAD_PARAMS);
   p = {};
   p.pixel_radius = 0;
-  EXPECT_EQ(ok::euclidean_cluster_organized({c.view(), 5, 2}, {}, p, scratch, labels).error().code, Code::BAD_PARAMS);
+  EXPECT_EQ(ok::euclidean_cluster_organized({c.view(), 5, 2}, {}, p, scratch, labels).error().code,
+            Code::BAD_PARAMS);
   ok::ClusterScratch small(3);
-  EXPECT_EQ(ok::euclidean_cluster(c.view(), {}, {}, small, labels).error().code, Code::SCRATCH_TOO_SMALL);
+  EXPECT_EQ(ok::euclidean_cluster(c.view(), {}, {}, small, labels).error().code,
+            Code::SCRATCH_TOO_SMALL);
   Cloud far;
   far.add(-3e38F, -3e38F, -3e38F), far.add(3e38F, 3e38F, 3e38F);
   ok::ClusterScratch s2(2);
@@ -162,7 +176,8 @@ TEST(SegClusterStats, BoxAlongAxesAndRotated) {
   for (int i = 0; i <= 20; ++i) {
     for (int j = 0; j <= 10; ++j) {
       for (int k = 0; k <= 5; ++k) {
-        const float a = -0.2F + 0.02F * float(i), b = -0.1F + 0.02F * float(j), e = -0.05F + 0.02F * float(k);
+        const float a = -0.2F + 0.02F * float(i), b = -0.1F + 0.02F * float(j),
+                    e = -0.05F + 0.02F * float(k);
         c.add(1.0F + ca * a - sa * b, 2.0F + sa * a + ca * b, 3.0F + e);
       }
     }
@@ -183,7 +198,8 @@ TEST(SegClusterStats, BoxAlongAxesAndRotated) {
   EXPECT_GT(stats[0].covariance[0], 0.0F);
 }
 
-void expect_same_stats(const std::vector<ok::ClusterStats>& a, const std::vector<ok::ClusterStats>& b) {
+void expect_same_stats(const std::vector<ok::ClusterStats>& a,
+                       const std::vector<ok::ClusterStats>& b) {
   ASSERT_EQ(a.size(), b.size());
   for (std::size_t c = 0; c < a.size(); ++c) {
     EXPECT_EQ(a[c].points, b[c].points) << c;
@@ -198,8 +214,9 @@ void expect_same_stats(const std::vector<ok::ClusterStats>& a, const std::vector
 }
 
 TEST(SegClusterStats, ListedEqualsFullScanAndDirectCounts) {
-  // Runs of equal labels (length 1..12, ids interleaved), unlabelled gaps; the member list holds every
-  // index (label -1 entries are skipped) or only the labelled ones: bit-identical to the full scan.
+  // Runs of equal labels (length 1..12, ids interleaved), unlabelled gaps; the member list holds
+  // every index (label -1 entries are skipped) or only the labelled ones: bit-identical to the full
+  // scan.
   std::mt19937 rng(5);
   std::uniform_real_distribution<float> coord(-1.0F, 1.0F);
   Cloud c;

@@ -1,7 +1,7 @@
-// The fast paths of the organized tabletop chain against their references, on random and adversarial
-// inputs: the SIMD polygon prefilter of polygonal_prism (every compiled arch) against the scalar twin,
-// pixel_subsample against a plain strided loop, organized clustering against a brute-force window
-// graph, cluster_stats with unlabelled gaps against a direct recomputation.
+// The fast paths of the organized tabletop chain against their references, on random and
+// adversarial inputs: the SIMD polygon prefilter of polygonal_prism (every compiled arch) against
+// the scalar twin, pixel_subsample against a plain strided loop, organized clustering against a
+// brute-force window graph, cluster_stats with unlabelled gaps against a direct recomputation.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -27,13 +27,15 @@ struct Cloud {
   std::vector<float> x, y, z;
   ok::PointsView view() const { return {x, y, z}; }
   void add(double a, double b, double c) {
-    x.push_back(static_cast<float>(a)), y.push_back(static_cast<float>(b)), z.push_back(static_cast<float>(c));
+    x.push_back(static_cast<float>(a)), y.push_back(static_cast<float>(b)),
+        z.push_back(static_cast<float>(c));
   }
 };
 
-/// A tilted table plane (the mOSD one), a random convex hull of @p corners points in it, and a cloud of
-/// n points around it: random ones, hull vertices and edge points exactly (then rounded to float),
-/// heights exactly at h_min / h_max, NaNs, duplicates; @p scale multiplies every coordinate.
+/// A tilted table plane (the mOSD one), a random convex hull of @p corners points in it, and a
+/// cloud of n points around it: random ones, hull vertices and edge points exactly (then rounded to
+/// float), heights exactly at h_min / h_max, NaNs, duplicates; @p scale multiplies every
+/// coordinate.
 struct PrismCase {
   ok::Plane plane{{0.0F, -0.8F, -0.6F}, 0.6F};
   std::vector<double> hu, hv;
@@ -55,19 +57,39 @@ PrismCase make_prism_case(std::size_t n, std::size_t corners, double scale, std:
   const ok::PlaneBasis b = ok::make_plane_basis(c.plane);
   auto emit = [&](double pu, double pv, double height) {
     double p[3];
-    for (std::size_t a = 0; a < 3; ++a) { p[a] = b.origin[a] + pu * b.u[a] + pv * b.v[a] + height * b.n[a]; }
+    for (std::size_t a = 0; a < 3; ++a) {
+      p[a] = b.origin[a] + pu * b.u[a] + pv * b.v[a] + height * b.n[a];
+    }
     c.cloud.add(p[0], p[1], p[2]);
   };
   for (std::size_t i = 0; i < n; ++i) {
     const std::size_t k = h == 0 ? 0 : i % h, next = h == 0 ? 0 : (k + 1) % h;
     const double height = (i % 5 == 0) ? 0.005 : (i % 5 == 1) ? 0.5 : 0.3 * unit(rng) + 0.2;
     switch (i % 4) {
-      case 0: emit(0.7 * scale * unit(rng), 0.6 * scale * unit(rng), height); break;
-      case 1: if (h > 0) { emit(c.hu[k], c.hv[k], height); } else { emit(0, 0, height); } break;
-      case 2: if (h > 0) { emit(0.5 * (c.hu[k] + c.hu[next]), 0.5 * (c.hv[k] + c.hv[next]), height); } else { emit(0, 0, height); } break;
-      default: c.cloud.add(NAN_F, 0.0, 0.0);
+      case 0:
+        emit(0.7 * scale * unit(rng), 0.6 * scale * unit(rng), height);
+        break;
+      case 1:
+        if (h > 0) {
+          emit(c.hu[k], c.hv[k], height);
+        } else {
+          emit(0, 0, height);
+        }
+        break;
+      case 2:
+        if (h > 0) {
+          emit(0.5 * (c.hu[k] + c.hu[next]), 0.5 * (c.hv[k] + c.hv[next]), height);
+        } else {
+          emit(0, 0, height);
+        }
+        break;
+      default:
+        c.cloud.add(NAN_F, 0.0, 0.0);
     }
-    if (i % 11 == 3 && i > 0) { c.cloud.x.back() = c.cloud.x[0], c.cloud.y.back() = c.cloud.y[0], c.cloud.z.back() = c.cloud.z[0]; }
+    if (i % 11 == 3 && i > 0) {
+      c.cloud.x.back() = c.cloud.x[0], c.cloud.y.back() = c.cloud.y[0],
+      c.cloud.z.back() = c.cloud.z[0];
+    }
   }
   return c;
 }
@@ -79,21 +101,28 @@ void expect_prism_equal(const PrismCase& c, const ok::AxisBox& box) {
   std::vector<float> heights(n);
   ok::plane_signed_distance_scalar(c.cloud.view(), c.plane, heights);
   std::vector<std::uint8_t> ref(n), got(n);
-  const std::size_t kept = ok::detail::prism_mask_range(c.cloud.view(), prism, heights, ref.data(), 0, n);
+  const std::size_t kept =
+      ok::detail::prism_mask_range(c.cloud.view(), prism, heights, ref.data(), 0, n);
   ok::detail::PrismEdges edges;
-  if (!ok::detail::make_prism_edges(prism, edges)) { return; }  // the dispatcher then runs the scalar rule
+  if (!ok::detail::make_prism_edges(prism, edges)) {
+    return;
+  }  // the dispatcher then runs the scalar rule
   ok::for_each_available_arch([&](auto arch) {
-    // The arch computes its own heights (FMA may move them within the plane_distance.hpp tolerance); for
-    // those heights its mask must equal the scalar rule's exactly.
+    // The arch computes its own heights (FMA may move them within the plane_distance.hpp
+    // tolerance); for those heights its mask must equal the scalar rule's exactly.
     std::fill(got.begin(), got.end(), std::uint8_t{7});
     std::vector<float> own(n, -1.0F);
     std::vector<std::uint8_t> own_ref(n);
-    const std::size_t got_kept = ok::detail::PrismPolygonKernel{}(arch, c.cloud.view(), prism, edges, own, got);
-    EXPECT_EQ(got_kept, ok::detail::prism_mask_range(c.cloud.view(), prism, own, own_ref.data(), 0, n));
+    const std::size_t got_kept =
+        ok::detail::PrismPolygonKernel{}(arch, c.cloud.view(), prism, edges, own, got);
+    EXPECT_EQ(got_kept,
+              ok::detail::prism_mask_range(c.cloud.view(), prism, own, own_ref.data(), 0, n));
     EXPECT_EQ(got, own_ref) << decltype(arch)::name() << " n " << n;
     for (std::size_t i = 0; i < n; ++i) {
-      const float tol = 1e-6F * (std::fabs(c.cloud.x[i]) + std::fabs(c.cloud.y[i]) + std::fabs(c.cloud.z[i]) + 1.0F);
-      EXPECT_TRUE((std::isnan(heights[i]) && std::isnan(own[i])) || std::fabs(own[i] - heights[i]) <= tol)
+      const float tol = 1e-6F * (std::fabs(c.cloud.x[i]) + std::fabs(c.cloud.y[i]) +
+                                 std::fabs(c.cloud.z[i]) + 1.0F);
+      EXPECT_TRUE((std::isnan(heights[i]) && std::isnan(own[i])) ||
+                  std::fabs(own[i] - heights[i]) <= tol)
           << decltype(arch)::name() << " height " << i;
     }
   });
@@ -107,14 +136,15 @@ class SegPrismFast : public ::testing::TestWithParam<std::size_t> {};
 TEST_P(SegPrismFast, EveryArchEqualsScalar) {
   const std::size_t n = GetParam();
   expect_prism_equal(make_prism_case(n, 24, 1.0, 3), {});
-  expect_prism_equal(make_prism_case(n, 7, 1e6, 4), {});      // huge coordinates
-  expect_prism_equal(make_prism_case(n, 3, 1e-3, 5), {});     // tiny triangle
-  ok::AxisBox half;  // the box cuts the hull: x <= 0 only
+  expect_prism_equal(make_prism_case(n, 7, 1e6, 4), {});   // huge coordinates
+  expect_prism_equal(make_prism_case(n, 3, 1e-3, 5), {});  // tiny triangle
+  ok::AxisBox half;                                        // the box cuts the hull: x <= 0 only
   half.max[0] = 0.0F;
   expect_prism_equal(make_prism_case(n, 24, 1.0, 6), half);
 }
 
-INSTANTIATE_TEST_SUITE_P(Sizes, SegPrismFast, ::testing::Values(0, 1, 3, 4, 5, 7, 8, 9, 15, 16, 17, 31, 33, 1000));
+INSTANTIATE_TEST_SUITE_P(Sizes, SegPrismFast,
+                         ::testing::Values(0, 1, 3, 4, 5, 7, 8, 9, 15, 16, 17, 31, 33, 1000));
 
 TEST(SegPrismFast, LargeAndDegenerateHullsTakeTheExactPath) {
   const PrismCase big = make_prism_case(500, 300, 1.0, 8);  // more than MAX_EDGES vertices
@@ -152,7 +182,8 @@ TEST(SegPixelSubsample, StridedRoiKeptPixelsInRowMajorOrder) {
     for (std::uint32_t v = stride / 2; v < hgt; v += stride) {
       for (std::uint32_t u = stride / 2; u < w; u += stride) {
         const std::size_t i = std::size_t{v} * w + u;
-        const bool in = c.x[i] >= -1.0F && c.x[i] <= 1.0F && c.y[i] >= -1.5F && c.y[i] <= 1.5F && std::isfinite(c.z[i]);
+        const bool in = c.x[i] >= -1.0F && c.x[i] <= 1.0F && c.y[i] >= -1.5F && c.y[i] <= 1.5F &&
+                        std::isfinite(c.z[i]);
         if (in) { expected.push_back(i); }
       }
     }
@@ -167,16 +198,21 @@ TEST(SegPixelSubsample, StridedRoiKeptPixelsInRowMajorOrder) {
   EXPECT_EQ(ok::pixel_subsample({ok::PointsView{}, 0, 0}, 3, roi, {none, none, none}), 0U);
 }
 
-/// Brute force over the window graph: pixels within r (Chebyshev) and tolerance, sizes filtered, ids by
-/// lowest index (the organized clustering's contract).
+/// Brute force over the window graph: pixels within r (Chebyshev) and tolerance, sizes filtered,
+/// ids by lowest index (the organized clustering's contract).
 std::vector<std::int32_t> window_reference(const Cloud& c, std::uint32_t w, std::uint32_t h,
-                                           const std::vector<std::uint8_t>& mask, const ok::ClusterParams& p) {
+                                           const std::vector<std::uint8_t>& mask,
+                                           const ok::ClusterParams& p) {
   const std::size_t n = std::size_t{w} * h;
   std::vector<std::size_t> parent(n);
   std::iota(parent.begin(), parent.end(), 0U);
-  auto find = [&](std::size_t i) { while (parent[i] != i) { i = parent[i]; } return i; };
+  auto find = [&](std::size_t i) {
+    while (parent[i] != i) { i = parent[i]; }
+    return i;
+  };
   auto inc = [&](std::size_t i) {
-    return (mask.empty() || mask[i] != 0) && std::isfinite(c.x[i]) && std::isfinite(c.y[i]) && std::isfinite(c.z[i]);
+    return (mask.empty() || mask[i] != 0) && std::isfinite(c.x[i]) && std::isfinite(c.y[i]) &&
+           std::isfinite(c.z[i]);
   };
   const auto r = static_cast<long>(p.pixel_radius);
   for (std::size_t i = 0; i < n; ++i) {
@@ -197,7 +233,9 @@ std::vector<std::int32_t> window_reference(const Cloud& c, std::uint32_t w, std:
   for (std::size_t i = 0; i < n; ++i) {
     if (!inc(i)) { continue; }
     const std::size_t root = find(i);
-    if (id[root] == -2) { id[root] = (size[root] >= p.min_size && size[root] <= p.max_size) ? next++ : -1; }
+    if (id[root] == -2) {
+      id[root] = (size[root] >= p.min_size && size[root] <= p.max_size) ? next++ : -1;
+    }
     label[i] = id[root];
   }
   return label;
@@ -215,7 +253,8 @@ TEST(SegClusterFast, OrganizedEqualsWindowGraphReference) {
         // Three surfaces at different depths, isolated spikes, holes, random mask.
         float z = u < 14 ? 1.0F : (v < 15 ? 1.03F : 1.015F);
         z += unit(rng) < 0.05F ? 0.1F : 0.004F * unit(rng);
-        c.add((float(u) - 20.0F) * 0.003F * z, (float(v) - 15.0F) * 0.003F * z, unit(rng) < 0.05F ? NAN_F : z);
+        c.add((float(u) - 20.0F) * 0.003F * z, (float(v) - 15.0F) * 0.003F * z,
+              unit(rng) < 0.05F ? NAN_F : z);
         mask[c.x.size() - 1] = unit(rng) < 0.85F ? 1 : 0;
       }
     }
@@ -225,7 +264,8 @@ TEST(SegClusterFast, OrganizedEqualsWindowGraphReference) {
         p.pixel_radius = radius, p.min_size = min_size, p.max_size = seed % 2 == 0 ? 400U : 100000U;
         ok::ClusterScratch scratch(c.x.size());
         std::vector<std::int32_t> labels(c.x.size(), 99);
-        const std::vector<std::uint8_t> m = seed == 5 ? std::vector<std::uint8_t>{} : mask;  // empty mask: all
+        const std::vector<std::uint8_t> m =
+            seed == 5 ? std::vector<std::uint8_t>{} : mask;  // empty mask: all
         auto r = ok::euclidean_cluster_organized({c.view(), w, h}, m, p, scratch, labels);
         ASSERT_TRUE(r) << r.error().to_string();
         const auto ref = window_reference(c, w, h, m, p);
@@ -237,15 +277,17 @@ TEST(SegClusterFast, OrganizedEqualsWindowGraphReference) {
 }
 
 TEST(SegClusterFast, StatsSkipUnlabelledGapsExactly) {
-  // Labelled points separated by unlabelled gaps of 0..20 (around the 8-label skip) give exactly the
-  // statistics of the same labelled points without gaps.
+  // Labelled points separated by unlabelled gaps of 0..20 (around the 8-label skip) give exactly
+  // the statistics of the same labelled points without gaps.
   std::mt19937 rng(21);
   std::uniform_real_distribution<float> coord(-1.0F, 1.0F);
   Cloud full, dense;
   std::vector<std::int32_t> full_labels, dense_labels;
   for (int k = 0; k < 300; ++k) {
     const auto gap = static_cast<int>(rng() % 21);
-    for (int g = 0; g < gap; ++g) { full.add(NAN_F, NAN_F, NAN_F), full_labels.push_back(g % 2 == 0 ? -1 : -7); }
+    for (int g = 0; g < gap; ++g) {
+      full.add(NAN_F, NAN_F, NAN_F), full_labels.push_back(g % 2 == 0 ? -1 : -7);
+    }
     const float p[3] = {coord(rng), coord(rng) + 2.0F, coord(rng)};
     const auto label = static_cast<std::int32_t>(rng() % 3);
     full.add(p[0], p[1], p[2]), dense.add(p[0], p[1], p[2]);

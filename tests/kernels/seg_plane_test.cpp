@@ -6,9 +6,9 @@
 #include <random>
 #include <vector>
 
+#include "core/rng.hpp"
 #include "kernels/polygonal_prism.hpp"
 #include "kernels/ransac_plane.hpp"
-#include "core/rng.hpp"
 
 namespace ok = orthoflow::kernels;
 
@@ -21,7 +21,8 @@ struct Cloud {
 };
 
 TEST(SegRng, GoldenSequenceIsPortable) {
-  // xoshiro256** seeded by splitmix64(0): first outputs computed independently (Python big integers).
+  // xoshiro256** seeded by splitmix64(0): first outputs computed independently (Python big
+  // integers).
   orthoflow::core::Rng rng(0);
   EXPECT_EQ(rng.next(), 0x99EC5F36CB75F2B4ULL);
   EXPECT_EQ(rng.next(), 0xBF6E1F784956452AULL);
@@ -43,7 +44,8 @@ Cloud table_scene(std::size_t table, std::size_t clutter, std::uint32_t seed) {
   Cloud c;
   for (std::size_t i = 0; i < table + clutter; ++i) {
     const float a = uv(rng), b = uv(rng), h = i < table ? noise(rng) : up(rng);
-    c.add(o[0] + a * u[0] + b * v[0] + h * n[0], o[1] + a * u[1] + b * v[1] + h * n[1], o[2] + a * u[2] + b * v[2] + h * n[2]);
+    c.add(o[0] + a * u[0] + b * v[0] + h * n[0], o[1] + a * u[1] + b * v[1] + h * n[1],
+          o[2] + a * u[2] + b * v[2] + h * n[2]);
   }
   return c;
 }
@@ -139,7 +141,9 @@ TEST(SegHull, RandomDiscContainsAllPoints) {
   std::vector<double> hu, hv;
   for (auto i : h) { hu.push_back(u[i]), hv.push_back(v[i]); }
   ASSERT_GE(h.size(), 8U);
-  for (std::size_t i = 0; i < u.size(); ++i) { EXPECT_TRUE(ok::inside_convex_polygon(hu, hv, u[i], v[i])) << i; }
+  for (std::size_t i = 0; i < u.size(); ++i) {
+    EXPECT_TRUE(ok::inside_convex_polygon(hu, hv, u[i], v[i])) << i;
+  }
   EXPECT_FALSE(ok::inside_convex_polygon(hu, hv, 1.5, 0.0));
 }
 

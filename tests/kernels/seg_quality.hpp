@@ -12,12 +12,18 @@ namespace orthoflow::testing {
 
 struct Quality {
   std::size_t gt_objects = 0, clusters = 0, matched = 0, over = 0, under = 0;
-  [[nodiscard]] double precision() const { return clusters == 0 ? 0.0 : double(matched) / double(clusters); }
-  [[nodiscard]] double recall() const { return gt_objects == 0 ? 1.0 : double(matched) / double(gt_objects); }
+  [[nodiscard]] double precision() const {
+    return clusters == 0 ? 0.0 : double(matched) / double(clusters);
+  }
+  [[nodiscard]] double recall() const {
+    return gt_objects == 0 ? 1.0 : double(matched) / double(gt_objects);
+  }
 };
 
-/// @p gt_label: mOSD labels (object k = label / 10 for label >= 20); @p cluster: id or -1, same pixels.
-inline Quality evaluate(std::span<const std::uint32_t> gt_label, std::span<const std::int32_t> cluster) {
+/// @p gt_label: mOSD labels (object k = label / 10 for label >= 20); @p cluster: id or -1, same
+/// pixels.
+inline Quality evaluate(std::span<const std::uint32_t> gt_label,
+                        std::span<const std::int32_t> cluster) {
   std::map<std::uint32_t, std::size_t> obj_size;
   std::map<std::int32_t, std::size_t> cl_size;
   std::map<std::pair<std::uint32_t, std::int32_t>, std::size_t> both;

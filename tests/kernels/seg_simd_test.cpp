@@ -1,6 +1,7 @@
 // Every compiled SIMD variant of the segmentation kernels against its scalar twin, on random and
 // adversarial inputs: empty, all-NaN, one point, sizes around the lane counts 4/8/16, huge
-// coordinates, duplicates. Exact kernels must be equal; FMA-sensitive ones within the header tolerance.
+// coordinates, duplicates. Exact kernels must be equal; FMA-sensitive ones within the header
+// tolerance.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -34,9 +35,13 @@ Cloud make_cloud(std::size_t n, Kind kind, std::uint32_t seed) {
   Cloud c;
   for (std::size_t i = 0; i < n; ++i) {
     float p[3] = {coord(rng), coord(rng), coord(rng)};
-    if (kind == Kind::HUGE) { for (float& v : p) { v *= 1e30F; } }
+    if (kind == Kind::HUGE) {
+      for (float& v : p) { v *= 1e30F; }
+    }
     if (kind == Kind::DUPLICATES && i > 0) { p[0] = c.x[0], p[1] = c.y[0], p[2] = c.z[0]; }
-    if (kind == Kind::ALL_NAN || (kind == Kind::RANDOM && unit(rng) < 0.2F)) { p[rng() % 3] = NAN_F; }
+    if (kind == Kind::ALL_NAN || (kind == Kind::RANDOM && unit(rng) < 0.2F)) {
+      p[rng() % 3] = NAN_F;
+    }
     c.x.push_back(p[0]);
     c.y.push_back(p[1]);
     c.z.push_back(p[2]);
@@ -127,14 +132,15 @@ TEST_P(SegSimd, PlaneInliersAndDistancesWithinTolerance) {
             ambiguous);
 }
 
-INSTANTIATE_TEST_SUITE_P(Inputs, SegSimd,
-                         ::testing::Values(Case{0, Kind::RANDOM}, Case{1, Kind::RANDOM}, Case{3, Kind::RANDOM},
-                                           Case{4, Kind::RANDOM}, Case{5, Kind::RANDOM}, Case{7, Kind::RANDOM},
-                                           Case{8, Kind::RANDOM}, Case{9, Kind::RANDOM}, Case{15, Kind::RANDOM},
-                                           Case{16, Kind::RANDOM}, Case{17, Kind::RANDOM}, Case{33, Kind::RANDOM},
-                                           Case{10007, Kind::RANDOM}, Case{37, Kind::ALL_NAN}, Case{1, Kind::ALL_NAN},
-                                           Case{41, Kind::HUGE}, Case{29, Kind::DUPLICATES}),
-                         case_name);
+INSTANTIATE_TEST_SUITE_P(
+    Inputs, SegSimd,
+    ::testing::Values(Case{0, Kind::RANDOM}, Case{1, Kind::RANDOM}, Case{3, Kind::RANDOM},
+                      Case{4, Kind::RANDOM}, Case{5, Kind::RANDOM}, Case{7, Kind::RANDOM},
+                      Case{8, Kind::RANDOM}, Case{9, Kind::RANDOM}, Case{15, Kind::RANDOM},
+                      Case{16, Kind::RANDOM}, Case{17, Kind::RANDOM}, Case{33, Kind::RANDOM},
+                      Case{10007, Kind::RANDOM}, Case{37, Kind::ALL_NAN}, Case{1, Kind::ALL_NAN},
+                      Case{41, Kind::HUGE}, Case{29, Kind::DUPLICATES}),
+    case_name);
 
 TEST(SegSimdDepth, ProjectionEqualsScalarBitForBit) {
   std::array<float, ok::DISPARITY_TABLE_SIZE> table{};
@@ -145,15 +151,21 @@ TEST(SegSimdDepth, ProjectionEqualsScalarBitForBit) {
     const std::uint32_t height = 5;
     std::mt19937 rng(width);
     std::vector<std::uint16_t> raw(std::size_t{width} * height);
-    for (auto& r : raw) { r = static_cast<std::uint16_t>(rng() % 5 == 0 ? 2047 : 400 + rng() % 800); }
+    for (auto& r : raw) {
+      r = static_cast<std::uint16_t>(rng() % 5 == 0 ? 2047 : 400 + rng() % 800);
+    }
     std::vector<float> rx(raw.size()), ry(raw.size()), rz(raw.size());
     const ok::DepthCamera cam{};
-    const std::size_t valid = ok::depth_to_points_scalar(raw, width, height, table, cam, {rx, ry, rz});
+    const std::size_t valid =
+        ok::depth_to_points_scalar(raw, width, height, table, cam, {rx, ry, rz});
     ok::for_each_available_arch([&](auto arch) {
       std::vector<float> x(raw.size()), y(raw.size()), z(raw.size());
-      EXPECT_EQ(ok::detail::DepthProjectionKernel{}(arch, raw, width, height, table, cam, {x, y, z}), valid);
+      EXPECT_EQ(
+          ok::detail::DepthProjectionKernel{}(arch, raw, width, height, table, cam, {x, y, z}),
+          valid);
       for (std::size_t i = 0; i < raw.size(); ++i) {
-        EXPECT_TRUE((std::isnan(rz[i]) && std::isnan(z[i])) || (x[i] == rx[i] && y[i] == ry[i] && z[i] == rz[i]))
+        EXPECT_TRUE((std::isnan(rz[i]) && std::isnan(z[i])) ||
+                    (x[i] == rx[i] && y[i] == ry[i] && z[i] == rz[i]))
             << decltype(arch)::name() << " width " << width << " pixel " << i;
       }
     });
@@ -162,7 +174,9 @@ TEST(SegSimdDepth, ProjectionEqualsScalarBitForBit) {
     // No-reading pixels become NaN; a valid pixel is on its ray: x / z = (u - cx) / fx.
     for (std::size_t i = 0; i < raw.size(); ++i) {
       EXPECT_EQ(std::isnan(z[i]), raw[i] == 2047 || raw[i] >= 1080);
-      if (!std::isnan(z[i])) { EXPECT_NEAR(x[i] / z[i], (float(i % width) - cam.cx) / cam.fx, 1e-5F); }
+      if (!std::isnan(z[i])) {
+        EXPECT_NEAR(x[i] / z[i], (float(i % width) - cam.cx) / cam.fx, 1e-5F);
+      }
     }
   }
 }
@@ -182,7 +196,10 @@ TEST(SegSimdPrism, DispatchedPrismMatchesScalar) {
     const float height = c.z[i] + 0.5F;
     // For this plane the basis is u = x, v = y, so the hull is the square |x|, |y| <= 1.
     const bool inside_xy = std::fabs(c.x[i]) <= 1.0F && std::fabs(c.y[i]) <= 1.0F;
-    expected += (height >= 0.1F && height <= 1.0F && inside_xy && !std::isnan(c.x[i]) && !std::isnan(c.y[i])) ? 1U : 0U;
+    expected += (height >= 0.1F && height <= 1.0F && inside_xy && !std::isnan(c.x[i]) &&
+                 !std::isnan(c.y[i]))
+                    ? 1U
+                    : 0U;
   }
   EXPECT_GT(kept, 0U);
   EXPECT_EQ(kept, expected);

@@ -1,5 +1,5 @@
-// voxel_grid(): against a brute-force std::map reference (PCL's voxel rule), at any extent and leaf,
-// every error code, determinism and ordering.
+// voxel_grid(): against a brute-force std::map reference (PCL's voxel rule), at any extent and
+// leaf, every error code, determinism and ordering.
 #include <gtest/gtest.h>
 
 #include <array>
@@ -34,7 +34,8 @@ std::map<std::array<std::int64_t, 3>, std::array<double, 4>> reference(const Clo
   std::map<std::array<std::int64_t, 3>, std::array<double, 4>> m;
   for (std::size_t i = 0; i < c.x.size(); ++i) {
     if (!std::isfinite(c.x[i]) || !std::isfinite(c.y[i]) || !std::isfinite(c.z[i])) { continue; }
-    auto& acc = m[{static_cast<std::int64_t>(std::floor(c.z[i] * inv)), static_cast<std::int64_t>(std::floor(c.y[i] * inv)),
+    auto& acc = m[{static_cast<std::int64_t>(std::floor(c.z[i] * inv)),
+                   static_cast<std::int64_t>(std::floor(c.y[i] * inv)),
                    static_cast<std::int64_t>(std::floor(c.x[i] * inv))}];
     acc[0] += c.x[i], acc[1] += c.y[i], acc[2] += c.z[i], acc[3] += 1.0;
   }
@@ -63,14 +64,17 @@ Cloud random_cloud(std::size_t n, float extent, std::uint32_t seed, float nan_sh
   std::uniform_real_distribution<float> unit(0.0F, 1.0F);
   Cloud c;
   for (std::size_t i = 0; i < n; ++i) {
-    c.add(coord(rng), coord(rng), unit(rng) < nan_share ? std::numeric_limits<float>::quiet_NaN() : coord(rng));
+    c.add(coord(rng), coord(rng),
+          unit(rng) < nan_share ? std::numeric_limits<float>::quiet_NaN() : coord(rng));
   }
   return c;
 }
 
 TEST(SegVoxel, MatchesReferenceAcrossSizesAndLeaves) {
   for (const std::size_t n : {1U, 2U, 5U, 16U, 17U, 1000U, 20000U}) {
-    for (const float leaf : {0.005F, 0.05F, 0.3F, 5.0F}) { expect_matches_reference(random_cloud(n, 1.0F, std::uint32_t(n)), leaf); }
+    for (const float leaf : {0.005F, 0.05F, 0.3F, 5.0F}) {
+      expect_matches_reference(random_cloud(n, 1.0F, std::uint32_t(n)), leaf);
+    }
   }
 }
 
@@ -111,14 +115,17 @@ TEST(SegVoxel, DeterministicAndSortedByVoxel) {
   const std::size_t nb = *ok::voxel_grid(c.view(), 0.02F, scratch, b.span());
   ASSERT_EQ(na, nb);
   EXPECT_EQ(a.x, b.x);
-  for (std::size_t k = 1; k < na; ++k) { EXPECT_LE(std::floor(a.z[k - 1] / 0.02F), std::floor(a.z[k] / 0.02F) + 1); }
+  for (std::size_t k = 1; k < na; ++k) {
+    EXPECT_LE(std::floor(a.z[k - 1] / 0.02F), std::floor(a.z[k] / 0.02F) + 1);
+  }
 }
 
 TEST(SegVoxel, EveryErrorCode) {
   const Cloud c = random_cloud(100, 1.0F, 7);
   ok::VoxelGridScratch scratch(100);
   Out out(100);
-  for (const float bad : {0.0F, -0.01F, std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity(), 1e-45F}) {
+  for (const float bad : {0.0F, -0.01F, std::numeric_limits<float>::quiet_NaN(),
+                          std::numeric_limits<float>::infinity(), 1e-45F}) {
     auto r = ok::voxel_grid(c.view(), bad, scratch, out.span());
     ASSERT_FALSE(r) << bad;
     EXPECT_EQ(r.error().code, Code::INVALID_LEAF);

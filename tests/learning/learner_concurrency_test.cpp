@@ -1,5 +1,6 @@
-// One thread teaches while several ask: every answer must come from one consistent snapshot (its label
-// names a category that existed, its label and id agree, generations and counts never go backwards).
+// One thread teaches while several ask: every answer must come from one consistent snapshot (its
+// label names a category that existed, its label and id agree, generations and counts never go
+// backwards).
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -32,8 +33,9 @@ std::vector<float> view(std::size_t k, int r) {
 
 std::string label_of(std::size_t k) { return "c" + std::to_string(k); }
 
-void ask_until_done(const Learner& learner, const std::atomic<std::size_t>& published, const std::atomic<bool>& done,
-                    bool exact, std::atomic<int>& failures, std::atomic<long>& asks) {
+void ask_until_done(const Learner& learner, const std::atomic<std::size_t>& published,
+                    const std::atomic<bool>& done, bool exact, std::atomic<int>& failures,
+                    std::atomic<long>& asks) {
   AskScratch scratch(4);  // small chunks: several kernel calls per category
   std::uint64_t last_generation = 0;
   std::size_t last_categories = 0;
@@ -49,9 +51,10 @@ void ask_until_done(const Learner& learner, const std::atomic<std::size_t>& publ
       ok = ok && (!exact || p.category == k);
     }
     if (!ok && failures.fetch_add(1) == 0) {
-      ADD_FAILURE() << "asked c" << k << " (published " << before << ".." << after << "): got " << p.label.view()
-                    << " id " << p.category << " unknown " << p.unknown << " generation " << p.generation << " (last "
-                    << last_generation << "), categories " << categories << " (last " << last_categories << ")";
+      ADD_FAILURE() << "asked c" << k << " (published " << before << ".." << after << "): got "
+                    << p.label.view() << " id " << p.category << " unknown " << p.unknown
+                    << " generation " << p.generation << " (last " << last_generation
+                    << "), categories " << categories << " (last " << last_categories << ")";
     }
     last_generation = p.generation;
     last_categories = categories;
@@ -71,10 +74,14 @@ void run(Learner& learner, bool exact) {
   for (int r = 0; r < ROUNDS; ++r) {
     for (std::size_t k = 0; k < CATEGORIES; ++k) {
       // Interleave for sure: a few asks between consecutive teaches.
-      for (const long seen = asks.load(); asks.load() < seen + 2;) { std::this_thread::sleep_for(std::chrono::microseconds(50)); }
+      for (const long seen = asks.load(); asks.load() < seen + 2;) {
+        std::this_thread::sleep_for(std::chrono::microseconds(50));
+      }
       const std::vector<float> v = view(k, r);
       ASSERT_EQ(*learner.teach(label_of(k), DescriptorBatch{v, LENGTH}), k);
-      if (r == 0) { published.store(k + 1, std::memory_order_release); }  // teach returned: visible to the next ask
+      if (r == 0) {
+        published.store(k + 1, std::memory_order_release);
+      }  // teach returned: visible to the next ask
     }
   }
   done.store(true, std::memory_order_release);

@@ -13,7 +13,9 @@
 namespace orthoflow::learning {
 namespace {
 
-DescriptorBatch batch(const std::vector<float>& values, std::size_t length) { return {values, length}; }
+DescriptorBatch batch(const std::vector<float>& values, std::size_t length) {
+  return {values, length};
+}
 
 // A = {(0,0), (2,0)}: ICD 2.  B = {(10,0), (10,4)}: ICD 4.  Query T = (5,0).
 // D(T, A) = {5, 3}; D(T, B) = {5, sqrt(41)}.
@@ -166,7 +168,8 @@ TEST(Learners, NothingLearnedIsUnknownAndWrongLengthIsUnknown) {
   InstanceLearner instance(InstanceConfig{4});
   BayesLearner bayes(BayesConfig{4});
   AskScratch scratch;
-  for (const Learner* l : {static_cast<const Learner*>(&instance), static_cast<const Learner*>(&bayes)}) {
+  for (const Learner* l :
+       {static_cast<const Learner*>(&instance), static_cast<const Learner*>(&bayes)}) {
     const Prediction p = l->ask(std::vector<float>{0, 0, 0, 1}, scratch);
     EXPECT_TRUE(p.unknown);
     EXPECT_EQ(p.category, NO_CATEGORY);
@@ -182,7 +185,9 @@ TEST(Learners, OpenEndedCategoriesArriveAfterThousandsOfAsks) {
   for (Learner* l : {static_cast<Learner*>(&instance), static_cast<Learner*>(&bayes)}) {
     ASSERT_TRUE(l->teach("x", batch({1, 0, 0, 0, 0.9F, 0.1F, 0, 0}, 4)));
     ASSERT_TRUE(l->teach("y", batch({0, 1, 0, 0, 0.1F, 0.9F, 0, 0}, 4)));
-    for (int i = 0; i < 3000; ++i) { ASSERT_EQ(l->ask(std::vector<float>{0, 0, 1, 0}, scratch).category != 2U, true); }
+    for (int i = 0; i < 3000; ++i) {
+      ASSERT_EQ(l->ask(std::vector<float>{0, 0, 1, 0}, scratch).category != 2U, true);
+    }
     ASSERT_EQ(*l->teach("z", batch({0, 0, 1, 0, 0, 0, 0.9F, 0.1F}, 4)), 2U);
     const Prediction p = l->ask(std::vector<float>{0, 0, 1, 0}, scratch);
     EXPECT_EQ(p.label.view(), "z") << l->kind();
@@ -213,7 +218,8 @@ TEST(Learners, RestoreGivesTheSameAnswersAsTeaching) {
   const std::vector<float> b{10, 0, 10, 4};
   auto taught = make_ab(InstanceConfig{});
   InstanceLearner restored(InstanceConfig{2});
-  const std::vector<RestoredCategory> cats{{7, "B", batch(b, 2), {}, 2}, {3, "A", batch(a, 2), {}, 2}};
+  const std::vector<RestoredCategory> cats{{7, "B", batch(b, 2), {}, 2},
+                                           {3, "A", batch(a, 2), {}, 2}};
   ASSERT_TRUE(restored.restore(cats, 20));
   AskScratch scratch;
   const Prediction p = restored.ask(QUERY, scratch);
@@ -236,7 +242,8 @@ TEST(Learners, EveryLearnErrorIsReported) {
   const float nan = std::nanf("");
   EXPECT_EQ(instance.teach("", batch({1, 0}, 2)).error(), LearnError::EMPTY_LABEL);
   EXPECT_TRUE(instance.teach(std::string(63, 'a'), batch({1, 0}, 2)));
-  EXPECT_EQ(instance.teach(std::string(64, 'a'), batch({1, 0}, 2)).error(), LearnError::LABEL_TOO_LONG);
+  EXPECT_EQ(instance.teach(std::string(64, 'a'), batch({1, 0}, 2)).error(),
+            LearnError::LABEL_TOO_LONG);
   EXPECT_EQ(instance.teach("a", batch({}, 2)).error(), LearnError::NO_VIEWS);
   EXPECT_EQ(instance.teach("a", batch({1, 0, 1}, 3)).error(), LearnError::WRONG_LENGTH);
   EXPECT_EQ(instance.teach("a", batch({1, 0, 1}, 2)).error(), LearnError::WRONG_LENGTH);
@@ -245,13 +252,16 @@ TEST(Learners, EveryLearnErrorIsReported) {
   EXPECT_EQ(bayes.teach("neg", batch({-1, 0}, 2)).error(), LearnError::NEGATIVE_VALUE);
   EXPECT_EQ(bayes.forget("none").error(), LearnError::UNKNOWN_LABEL);
   const std::vector<float> v{1, 0};
-  const std::vector<RestoredCategory> twice{{1, "a", batch(v, 2), {}, 1}, {1, "b", batch(v, 2), {}, 1}};
+  const std::vector<RestoredCategory> twice{{1, "a", batch(v, 2), {}, 1},
+                                            {1, "b", batch(v, 2), {}, 1}};
   EXPECT_EQ(instance.restore(twice, 0).error(), LearnError::DUPLICATE_ID);
-  const std::vector<RestoredCategory> same_label{{1, "a", batch(v, 2), {}, 1}, {2, "a", batch(v, 2), {}, 1}};
+  const std::vector<RestoredCategory> same_label{{1, "a", batch(v, 2), {}, 1},
+                                                 {2, "a", batch(v, 2), {}, 1}};
   EXPECT_EQ(bayes.restore(same_label, 0).error(), LearnError::DUPLICATE_ID);
   const std::vector<double> acc{1.0, 0.0};
   const std::vector<RestoredCategory> model_only{{1, "a", {}, acc, 1}};
-  EXPECT_EQ(instance.restore(model_only, 0).error(), LearnError::NO_VIEWS);  // instance needs the views
+  EXPECT_EQ(instance.restore(model_only, 0).error(),
+            LearnError::NO_VIEWS);  // instance needs the views
   EXPECT_TRUE(bayes.restore(model_only, 0));
   EXPECT_EQ(instance.stats().categories, 2U);  // refused restores changed nothing
   EXPECT_STRNE(to_string(LearnError::DUPLICATE_ID), "unknown learn error");

@@ -1,5 +1,6 @@
-// Helper of memory_crash_test: opens the store given as argv[1], then teaches one view at a time and
-// prints the stamp of every acknowledged teach on its own line, until it is killed (or argv[2] teaches).
+// Helper of memory_crash_test: opens the store given as argv[1], then teaches one view at a time
+// and prints the stamp of every acknowledged teach on its own line, until it is killed (or argv[2]
+// teaches).
 #include <cstdio>
 #include <cstdlib>
 #include <string>

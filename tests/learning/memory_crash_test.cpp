@@ -1,7 +1,7 @@
-// Crash consistency of the perceptual memory: a child process (memory_crash_child) teaches in a loop and
-// prints every acknowledged teach; the parent SIGKILLs it at seeded random moments, 50 times, and after
-// every kill checks that the store opens, that every acknowledged teach is there, and that at most the
-// one teach in flight was stored without being acknowledged.
+// Crash consistency of the perceptual memory: a child process (memory_crash_child) teaches in a
+// loop and prints every acknowledged teach; the parent SIGKILLs it at seeded random moments, 50
+// times, and after every kill checks that the store opens, that every acknowledged teach is there,
+// and that at most the one teach in flight was stored without being acknowledged.
 #include <gtest/gtest.h>
 #include <poll.h>
 #include <sys/wait.h>
@@ -32,7 +32,8 @@ void take_lines(std::string& text, std::set<std::int64_t>& out) {
   }
 }
 
-// Runs the child on @p dir and kills it after @p delay; lines already in the pipe were acknowledged.
+// Runs the child on @p dir and kills it after @p delay; lines already in the pipe were
+// acknowledged.
 ChildRun run_and_kill(const std::filesystem::path& dir, std::chrono::milliseconds delay) {
   int fds[2];
   EXPECT_EQ(pipe(fds), 0);
@@ -57,7 +58,8 @@ ChildRun run_and_kill(const std::filesystem::path& dir, std::chrono::millisecond
       started = true;
       deadline = std::chrono::steady_clock::now() + delay;
     }
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+        deadline - std::chrono::steady_clock::now());
     if (left.count() <= 0) { break; }
     pollfd p{fds[0], POLLIN, 0};
     if (poll(&p, 1, static_cast<int>(left.count())) > 0) {
@@ -67,7 +69,9 @@ ChildRun run_and_kill(const std::filesystem::path& dir, std::chrono::millisecond
     }
   }
   kill(pid, SIGKILL);
-  for (ssize_t n = 0; (n = read(fds[0], buf, sizeof buf)) > 0;) { text.append(buf, static_cast<std::size_t>(n)); }
+  for (ssize_t n = 0; (n = read(fds[0], buf, sizeof buf)) > 0;) {
+    text.append(buf, static_cast<std::size_t>(n));
+  }
   close(fds[0]);
   waitpid(pid, &run.status, 0);
   take_lines(text, run.acknowledged);
@@ -82,7 +86,8 @@ TEST(PerceptualMemoryCrash, EveryAcknowledgedTeachSurvivesSigkill) {
   std::size_t unacknowledged_but_stored = 0;
   for (int round = 0; round < 50; ++round) {
     const ChildRun run = run_and_kill(dir, std::chrono::milliseconds(delay_ms(rng)));
-    ASSERT_TRUE(WIFSIGNALED(run.status) && WTERMSIG(run.status) == SIGKILL) << "round " << round << " child exited early";
+    ASSERT_TRUE(WIFSIGNALED(run.status) && WTERMSIG(run.status) == SIGKILL)
+        << "round " << round << " child exited early";
     acknowledged.insert(run.acknowledged.begin(), run.acknowledged.end());
     auto memory_result = PerceptualMemory::open(dir, test::small_config());
     ASSERT_TRUE(memory_result) << "round " << round << ": " << memory_result.error().to_string();
@@ -93,12 +98,16 @@ TEST(PerceptualMemoryCrash, EveryAcknowledgedTeachSurvivesSigkill) {
       ASSERT_EQ(views->size(), c.views);
       for (const ViewRecord& v : *views) {
         EXPECT_EQ(v.descriptor, test::make_view(75, static_cast<std::size_t>(v.stamp_ns) % 5 * 7,
-                                                static_cast<std::uint64_t>(v.stamp_ns)).descriptor);
+                                                static_cast<std::uint64_t>(v.stamp_ns))
+                                    .descriptor);
         stored.insert(v.stamp_ns);
       }
     }
-    for (const std::int64_t a : acknowledged) { ASSERT_TRUE(stored.count(a)) << "round " << round << ": lost " << a; }
-    // Stored but never acknowledged: only the teach in flight at the kill (then acknowledged == stored - 1).
+    for (const std::int64_t a : acknowledged) {
+      ASSERT_TRUE(stored.count(a)) << "round " << round << ": lost " << a;
+    }
+    // Stored but never acknowledged: only the teach in flight at the kill (then acknowledged ==
+    // stored - 1).
     std::size_t extra = 0;
     for (const std::int64_t s : stored) { extra += acknowledged.count(s) == 0 ? 1U : 0U; }
     ASSERT_LE(extra, 1U) << "round " << round;

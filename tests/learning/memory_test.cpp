@@ -1,5 +1,5 @@
-// The LevelDB perceptual memory: persistence across reopen, parameter checks, forget, export/import,
-// and every MemoryError code.
+// The LevelDB perceptual memory: persistence across reopen, parameter checks, forget,
+// export/import, and every MemoryError code.
 #include <gtest/gtest.h>
 #include <leveldb/db.h>
 #include <sys/resource.h>
@@ -60,13 +60,17 @@ TEST(PerceptualMemory, ReopenRestoresCategoriesViewsAndAnswers) {
     EXPECT_EQ((*views)[1].track_id, 4U);
     EXPECT_EQ((*views)[1].descriptor, make_view(LENGTH, 9, 4).descriptor);
     EXPECT_EQ((*views)[1].frame, make_view(LENGTH, 9, 4).frame);
-    EXPECT_EQ(*m.teach("cup", std::vector{make_view(LENGTH, 4, 6)}), 3U);  // ids continue after reopen
+    EXPECT_EQ(*m.teach("cup", std::vector{make_view(LENGTH, 4, 6)}),
+              3U);  // ids continue after reopen
   }
 }
 
 TEST(PerceptualMemory, EitherLearnerOpensTheSameStore) {
   const auto dir = fresh_dir();
-  { auto m = must_open(dir, small_config(LearnerKind::INSTANCE)); teach_three(m); }
+  {
+    auto m = must_open(dir, small_config(LearnerKind::INSTANCE));
+    teach_three(m);
+  }
   auto m = must_open(dir, small_config(LearnerKind::BAYES));
   EXPECT_STREQ(m.learner().kind(), "bayes");
   AskScratch scratch;
@@ -75,13 +79,17 @@ TEST(PerceptualMemory, EitherLearnerOpensTheSameStore) {
 
 TEST(PerceptualMemory, OtherDescriptorParametersAreRejected) {
   const auto dir = fresh_dir();
-  { auto m = must_open(dir, small_config()); teach_three(m); }
+  {
+    auto m = must_open(dir, small_config());
+    teach_three(m);
+  }
   MemoryConfig other = small_config();
   other.descriptor.good.bins = 6;
   auto bins_result = PerceptualMemory::open(dir, other);
   ASSERT_FALSE(bins_result);
   EXPECT_EQ(bins_result.error().code, Code::PARAMS_MISMATCH);
-  EXPECT_NE(bins_result.error().message.find("bins=5"), std::string::npos) << bins_result.error().message;
+  EXPECT_NE(bins_result.error().message.find("bins=5"), std::string::npos)
+      << bins_result.error().message;
   EXPECT_NE(bins_result.error().message.find("bins=6"), std::string::npos);
   other = small_config();
   other.descriptor.good.mode = kernels::GoodMode::REFERENCE;
@@ -118,7 +126,8 @@ TEST(PerceptualMemory, RejectedTeachWritesNothing) {
     ASSERT_FALSE(r);
     EXPECT_EQ(r.error().code, Code::REJECTED);
     EXPECT_NE(r.error().message.find("view 1"), std::string::npos) << r.error().message;
-    EXPECT_EQ(m.teach(std::string(64, 'x'), std::vector{make_view(LENGTH, 1, 1)}).error().code, Code::REJECTED);
+    EXPECT_EQ(m.teach(std::string(64, 'x'), std::vector{make_view(LENGTH, 1, 1)}).error().code,
+              Code::REJECTED);
     EXPECT_EQ(m.teach("empty", std::vector<ViewRecord>{}).error().code, Code::REJECTED);
     ViewRecord negative = make_view(LENGTH, 1, 1);
     negative.descriptor[0] = -0.5F;
@@ -161,9 +170,13 @@ TEST(PerceptualMemory, BadImportsAndFilesAreReported) {
     return path;
   };
   const std::string header = R"({"schema":1,"bins":5,"mode":"invariant","threshold":0.015})";
-  EXPECT_EQ(m.import_from(write(R"({"schema":1,"bins":7,"mode":"invariant","threshold":0.015})")).error().code,
+  EXPECT_EQ(m.import_from(write(R"({"schema":1,"bins":7,"mode":"invariant","threshold":0.015})"))
+                .error()
+                .code,
             Code::BAD_IMPORT);
-  EXPECT_EQ(m.import_from(write(R"({"schema":9,"bins":5,"mode":"invariant","threshold":0.015})")).error().code,
+  EXPECT_EQ(m.import_from(write(R"({"schema":9,"bins":5,"mode":"invariant","threshold":0.015})"))
+                .error()
+                .code,
             Code::BAD_IMPORT);
   const auto bad_line = m.import_from(write(header + "\n{\"label\":\"a\",\"descriptor\":[1,2]}\n"));
   ASSERT_FALSE(bad_line);
@@ -177,7 +190,8 @@ TEST(PerceptualMemory, OpenFailuresAndCorruptRecords) {
   const auto dir = fresh_dir();
   auto first = must_open(dir, small_config());
   teach_three(first);
-  auto locked = PerceptualMemory::open(dir, small_config());  // LevelDB's LOCK file: one opener at a time
+  auto locked =
+      PerceptualMemory::open(dir, small_config());  // LevelDB's LOCK file: one opener at a time
   ASSERT_FALSE(locked);
   EXPECT_EQ(locked.error().code, Code::OPEN_FAILED);
   EXPECT_NE(locked.error().message.find(dir.string()), std::string::npos);
@@ -192,7 +206,8 @@ TEST(PerceptualMemory, OpenFailuresAndCorruptRecords) {
   auto corrupt = PerceptualMemory::open(dir, small_config());
   ASSERT_FALSE(corrupt);
   EXPECT_EQ(corrupt.error().code, Code::CORRUPT);
-  EXPECT_NE(corrupt.error().message.find("category 1 view 0"), std::string::npos) << corrupt.error().message;
+  EXPECT_NE(corrupt.error().message.find("category 1 view 0"), std::string::npos)
+      << corrupt.error().message;
 }
 
 TEST(PerceptualMemory, FailedSyncedWriteIsNotAcknowledged) {

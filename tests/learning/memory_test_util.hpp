@@ -1,5 +1,6 @@
 #pragma once
-// Helpers for the perceptual-memory tests: a fresh store directory and deterministic GOOD-like views.
+// Helpers for the perceptual-memory tests: a fresh store directory and deterministic GOOD-like
+// views.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -13,8 +14,9 @@ namespace orthoflow::learning::test {
 /// A fresh, empty directory under the build tree, named after the running test.
 inline std::filesystem::path fresh_dir(const std::string& tag = "") {
   const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  const std::filesystem::path dir = std::filesystem::path(ORTHOFLOW_BINARY_DIR) / "test_stores" /
-                                    (std::string(info->test_suite_name()) + "." + info->name() + tag);
+  const std::filesystem::path dir =
+      std::filesystem::path(ORTHOFLOW_BINARY_DIR) / "test_stores" /
+      (std::string(info->test_suite_name()) + "." + info->name() + tag);
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir.parent_path());
   return dir;
@@ -28,14 +30,15 @@ inline MemoryConfig small_config(LearnerKind kind = LearnerKind::INSTANCE) {
   return cfg;
 }
 
-/// A histogram view of @p length values: three blocks summing to 1, peaked at bin @p peak of each block,
-/// with a small seeded wobble so that views of one category differ.
+/// A histogram view of @p length values: three blocks summing to 1, peaked at bin @p peak of each
+/// block, with a small seeded wobble so that views of one category differ.
 inline ViewRecord make_view(std::size_t length, std::size_t peak, std::uint64_t seed) {
   ViewRecord v;
   v.descriptor.assign(length, 0.0F);
   const std::size_t block = length / 3;
   for (std::size_t b = 0; b < 3; ++b) {
-    const float wobble = 0.05F * static_cast<float>((seed * 2654435761ULL + b * 97ULL) % 7ULL) / 7.0F;
+    const float wobble =
+        0.05F * static_cast<float>((seed * 2654435761ULL + b * 97ULL) % 7ULL) / 7.0F;
     v.descriptor[b * block + peak % block] = 0.8F - wobble;
     v.descriptor[b * block + (peak + 1) % block] = 0.2F + wobble;
   }

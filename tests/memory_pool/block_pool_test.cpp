@@ -17,8 +17,9 @@ namespace {
 
 struct ExternalMemory {
   explicit ExternalMemory(std::size_t n)
-      : data(static_cast<std::byte*>(::operator new(n, std::align_val_t{CACHE_LINE_BYTES}))), size(n) {}
-  ~ExternalMemory() { ::operator delete(data, std::align_val_t{CACHE_LINE_BYTES}); }
+      : data(static_cast<std::byte*>(::operator new (n, std::align_val_t{CACHE_LINE_BYTES}))),
+        size(n) {}
+  ~ExternalMemory() { ::operator delete (data, std::align_val_t{CACHE_LINE_BYTES}); }
   ExternalMemory(const ExternalMemory&) = delete;
   ExternalMemory& operator=(const ExternalMemory&) = delete;
   std::span<std::byte> span() { return {data, size}; }
@@ -52,7 +53,8 @@ TEST(BlockPool, SitsOnExternalMemoryAndBlocksLieInside) {
     std::memset(bytes.data(), i, bytes.size());
     handles.push_back(std::move(*block_result));
   }
-  for (int i = 0; i < 4; ++i) EXPECT_EQ(static_cast<int>(handles[static_cast<std::size_t>(i)].bytes()[99]), i);
+  for (int i = 0; i < 4; ++i)
+    EXPECT_EQ(static_cast<int>(handles[static_cast<std::size_t>(i)].bytes()[99]), i);
 }
 
 TEST(BlockPool, ExhaustionNamesRequesterAndSize) {

@@ -11,10 +11,10 @@
 #include <string>
 #include <vector>
 
+#include "kernels/good.hpp"
 #include "simulation/object_catalog.hpp"
 #include "simulation/object_dataset.hpp"
 #include "simulation/synthetic_scene.hpp"
-#include "kernels/good.hpp"
 
 namespace orthoflow::simulation {
 namespace {
@@ -27,7 +27,9 @@ struct Fnv {
     for (std::size_t i = 0; i < n; ++i) { h = (h ^ b[i]) * 0x100000001B3ULL; }
   }
   template <class T>
-  void span(std::span<const T> s) { bytes(s.data(), s.size_bytes()); }
+  void span(std::span<const T> s) {
+    bytes(s.data(), s.size_bytes());
+  }
   void value(double v) { bytes(&v, sizeof v); }
 };
 
@@ -52,11 +54,11 @@ std::uint64_t layout_hash(const Scene& s) {
 }
 
 TEST(ObjectCatalogScenes, DefaultScenesAreByteIdenticalToThoseBeforeTheCatalogGrew) {
-  // Pinned on the 12-category catalog (commit cd46acf), before any category was added: default scenes
-  // must keep drawing from the original set with the same random draws, so the golden files, the
-  // tabletop sessions and `orthoflow synth` keep their bytes.
-  const std::uint64_t layouts[] = {0x45FD6E6F5F68A1EBULL, 0xDE50CFA10FFE9D70ULL, 0xEC8139A49BCBF31BULL,
-                                   0x99DFBE5670DFACBFULL};
+  // Pinned on the 12-category catalog (commit cd46acf), before any category was added: default
+  // scenes must keep drawing from the original set with the same random draws, so the golden files,
+  // the tabletop sessions and `orthoflow synth` keep their bytes.
+  const std::uint64_t layouts[] = {0x45FD6E6F5F68A1EBULL, 0xDE50CFA10FFE9D70ULL,
+                                   0xEC8139A49BCBF31BULL, 0x99DFBE5670DFACBFULL};
   const std::uint64_t seeds[] = {1, 7, 42, 1234};
   for (std::size_t i = 0; i < 4; ++i) {
     SceneConfig touching;
@@ -86,15 +88,18 @@ Category cat(std::size_t i) { return static_cast<Category>(i); }
 TEST(ObjectCatalog, TwentyTwoOrMoreCategoriesWithTheOriginalTwelveFirst) {
   static_assert(CATEGORY_COUNT >= 22);
   static_assert(SCENE_CATEGORY_COUNT == 12);
-  const char* original[] = {"bottle", "bowl", "flask", "fork", "knife", "mug",
-                            "plate",  "spoon", "teapot", "vase", "box", "can"};
-  for (std::size_t i = 0; i < SCENE_CATEGORY_COUNT; ++i) { EXPECT_STREQ(category_name(cat(i)), original[i]); }
+  const char* original[] = {"bottle", "bowl",  "flask",  "fork", "knife", "mug",
+                            "plate",  "spoon", "teapot", "vase", "box",   "can"};
+  for (std::size_t i = 0; i < SCENE_CATEGORY_COUNT; ++i) {
+    EXPECT_STREQ(category_name(cat(i)), original[i]);
+  }
   std::set<std::string> names;
   for (std::size_t i = 0; i < CATEGORY_COUNT; ++i) {
     const std::string name = category_name(cat(i));
     EXPECT_TRUE(names.insert(name).second) << name << " twice";
-    EXPECT_TRUE(std::all_of(name.begin(), name.end(), [](char ch) { return (ch >= 'a' && ch <= 'z') || ch == '_'; }))
-        << name;
+    EXPECT_TRUE(std::all_of(name.begin(), name.end(), [](char ch) {
+      return (ch >= 'a' && ch <= 'z') || ch == '_';
+    })) << name;
   }
   EXPECT_EQ(category_from_name("wine_glass"), Category::WINE_GLASS);
   EXPECT_EQ(category_from_name("candle"), Category::CANDLE);
@@ -110,8 +115,10 @@ Vec3 extent(const ObjectModel& m) {
     const Primitive& p = m.parts[k];
     const bool frustum = p.kind == PrimitiveKind::FRUSTUM;
     const double rxy = frustum ? std::max(p.size[0], p.size[1]) : 0.0;
-    const Vec3 a = frustum ? Vec3{p.center[0] - rxy, p.center[1] - rxy, p.center[2]} : p.center - p.size;
-    const Vec3 b = frustum ? Vec3{p.center[0] + rxy, p.center[1] + rxy, p.center[2] + p.size[2]} : p.center + p.size;
+    const Vec3 a =
+        frustum ? Vec3{p.center[0] - rxy, p.center[1] - rxy, p.center[2]} : p.center - p.size;
+    const Vec3 b = frustum ? Vec3{p.center[0] + rxy, p.center[1] + rxy, p.center[2] + p.size[2]}
+                           : p.center + p.size;
     for (std::size_t d = 0; d < 3; ++d) {
       lo[d] = std::min(lo[d], a[d]);
       hi[d] = std::max(hi[d], std::min(b[d], d == 2 ? m.height : 1e9));
@@ -122,7 +129,8 @@ Vec3 extent(const ObjectModel& m) {
 
 TEST(ObjectCatalog, EveryInstancePassesTheTabletopSizeRule) {
   // Tabletop C_size (thesis Table 3.1, graphs/objects_node.cpp): the largest extent between 2 and
-  // 50 cm; here at least 3 cm, and the top at least 1 cm above the table (the segmentation keeps 5 mm+).
+  // 50 cm; here at least 3 cm, and the top at least 1 cm above the table (the segmentation keeps 5
+  // mm+).
   for (std::size_t c = 0; c < CATEGORY_COUNT; ++c) {
     for (std::uint64_t seed : {1ULL, 2ULL}) {
       for (std::uint32_t i = 0; i < 8; ++i) {
@@ -150,7 +158,8 @@ TEST(ObjectCatalog, NewCategoryInstancesDifferAndRepeat) {
         shape.insert(shape.end(), m.parts[k].center.begin(), m.parts[k].center.end());
       }
       shape.push_back(m.rgb);
-      EXPECT_TRUE(shapes.insert(shape).second) << category_name(cat(c)) << " #" << i << " repeats another instance";
+      EXPECT_TRUE(shapes.insert(shape).second)
+          << category_name(cat(c)) << " #" << i << " repeats another instance";
       const ObjectModel again = make_object_model(cat(c), i, 3);
       EXPECT_EQ(again.height, m.height);
       EXPECT_EQ(again.rgb, m.rgb);
@@ -172,7 +181,8 @@ TEST(ObjectCatalog, EveryCategoryRendersAndDescribesFromSeveralViewpoints) {
     const double reach = std::hypot(2 * m.footprint_radius, m.height) + 0.02;
     for (std::uint32_t v = 0; v < 3; ++v) {
       core::Rng noise(v);
-      const std::size_t n = render_object_view(m, dataset_view(config, cat(c), 1, v), config.render, noise, frame, view);
+      const std::size_t n = render_object_view(m, dataset_view(config, cat(c), 1, v), config.render,
+                                               noise, frame, view);
       const std::string what = std::string(category_name(cat(c))) + " view " + std::to_string(v);
       ASSERT_GE(n, 100U) << what;
       // The points lie within the object's size of each other (no table or background kept).

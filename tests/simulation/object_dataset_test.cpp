@@ -5,8 +5,8 @@
 #include <filesystem>
 #include <fstream>
 
-#include "simulation/object_dataset.hpp"
 #include "formats/pcd_io.hpp"
+#include "simulation/object_dataset.hpp"
 
 namespace orthoflow::simulation {
 namespace {
@@ -38,11 +38,14 @@ TEST(ObjectDataset, WritesTheExpectedTreeAndEveryViewHasObjectPoints) {
   EXPECT_EQ(summary_result.value().categories, 3U);
   EXPECT_GE(summary_result.value().min_points, 20U);
   std::size_t files = 0;
-  for (const auto& entry : fs::recursive_directory_iterator(dir)) { files += entry.is_regular_file(); }
+  for (const auto& entry : fs::recursive_directory_iterator(dir)) {
+    files += entry.is_regular_file();
+  }
   EXPECT_EQ(files, 12U);
   EXPECT_TRUE(fs::exists(dir / "mug" / "mug_00" / "view_000.pcd"));
   EXPECT_TRUE(fs::exists(dir / "knife" / "knife_01" / "view_001.pcd"));
-  for (const char* rel : {"mug/mug_01/view_001.pcd", "plate/plate_00/view_000.pcd", "knife/knife_00/view_001.pcd"}) {
+  for (const char* rel :
+       {"mug/mug_01/view_001.pcd", "plate/plate_00/view_000.pcd", "knife/knife_00/view_001.pcd"}) {
     const auto cloud_result = formats::read_pcd(dir / rel);
     ASSERT_TRUE(cloud_result) << cloud_result.error().to_string();
     const kernels::PointCloud& c = cloud_result.value();
@@ -78,7 +81,8 @@ TEST(ObjectDataset, ViewsAreSeededAndSpanTheConfiguredRanges) {
   EXPECT_GT(max_az - min_az, 5.0);
   DatasetConfig other = c;
   other.seed = 4;
-  EXPECT_NE(dataset_view(c, Category::MUG, 0, 0).azimuth_rad, dataset_view(other, Category::MUG, 0, 0).azimuth_rad);
+  EXPECT_NE(dataset_view(c, Category::MUG, 0, 0).azimuth_rad,
+            dataset_view(other, Category::MUG, 0, 0).azimuth_rad);
 }
 
 TEST(ObjectDataset, SameSeedSameBytes) {
@@ -88,9 +92,11 @@ TEST(ObjectDataset, SameSeedSameBytes) {
   core::Rng ra(5), rb(5), rc(6);
   ASSERT_GT(render_object_view(mug, view, small_config().render, ra, frame, a), 150U);
   render_object_view(mug, view, small_config().render, rb, frame, b);
-  EXPECT_EQ(formats::encode_pcd(a, formats::PcdEncoding::BINARY), formats::encode_pcd(b, formats::PcdEncoding::BINARY));
+  EXPECT_EQ(formats::encode_pcd(a, formats::PcdEncoding::BINARY),
+            formats::encode_pcd(b, formats::PcdEncoding::BINARY));
   render_object_view(mug, view, small_config().render, rc, frame, b);
-  EXPECT_NE(formats::encode_pcd(a, formats::PcdEncoding::BINARY), formats::encode_pcd(b, formats::PcdEncoding::BINARY));
+  EXPECT_NE(formats::encode_pcd(a, formats::PcdEncoding::BINARY),
+            formats::encode_pcd(b, formats::PcdEncoding::BINARY));
 }
 
 TEST(ObjectDataset, WindowedViewHasExactlyTheObjectPointsOfTheFullFrame) {
@@ -116,7 +122,8 @@ TEST(ObjectDataset, WindowedViewHasExactlyTheObjectPointsOfTheFullFrame) {
       }
       EXPECT_EQ(k, n) << category_name(cat);
       EXPECT_GT(n, 50U);
-      EXPECT_LT(frame.size(), view.distance_m > 1.0 ? full.size() / 4 : full.size());  // a part of the image
+      EXPECT_LT(frame.size(),
+                view.distance_m > 1.0 ? full.size() / 4 : full.size());  // a part of the image
     }
   }
 }

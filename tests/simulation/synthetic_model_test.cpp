@@ -8,10 +8,10 @@
 #include <cstdint>
 #include <string>
 
+#include "core/rng.hpp"
 #include "simulation/kinect_depth_model.hpp"
 #include "simulation/object_catalog.hpp"
 #include "simulation/shape_primitives.hpp"
-#include "core/rng.hpp"
 #include "simulation/synthetic_scene.hpp"
 
 namespace orthoflow::simulation {
@@ -62,11 +62,13 @@ TEST(KinectDepthModel, TableIsZeroForNoReadingAndIncreasingUpToThePole) {
   for (std::size_t raw = 1090; raw < t.size(); ++raw) { ASSERT_EQ(t[raw], 0.0F) << "raw " << raw; }
 }
 
-// ---- Portable random generator --------------------------------------------------------------------
+// ---- Portable random generator
+// --------------------------------------------------------------------
 
 TEST(SyntheticRandom, ReproducesThePublishedXoshiroAndSplitMixSequences) {
-  // Reference values from an independent implementation of Vigna's xoshiro256** seeded by SplitMix64
-  // (SplitMix64's first output for seed 0 is the well-known 0xE220A8397B1DCDAF, state_[0] here).
+  // Reference values from an independent implementation of Vigna's xoshiro256** seeded by
+  // SplitMix64 (SplitMix64's first output for seed 0 is the well-known 0xE220A8397B1DCDAF,
+  // state_[0] here).
   core::Rng zero(0);
   EXPECT_EQ(zero.next(), 0x99EC5F36CB75F2B4ULL);
   EXPECT_EQ(zero.next(), 0xBF6E1F784956452AULL);
@@ -116,9 +118,10 @@ TEST(SyntheticRandom, SceneTablesFollowTheDrawOrderOnEveryCompiler) {
   // width from two draws, depth, floor drop; left to right). Two draws in one function call would
   // be unsequenced and GCC would take them in the other order (seed 7: width 1.1523).
   const std::uint64_t seeds[] = {7, 42};
-  const double expected[2][5] = {
-      {1.0502882410898446, 0.6695525780472927, 1.1300514565510897, 0.7981720557666137, 0.7634606120368672},
-      {0.741931485529941, 0.7220323708212084, 0.9924692945325387, 0.7983607828564205, 0.7500661298564515}};
+  const double expected[2][5] = {{1.0502882410898446, 0.6695525780472927, 1.1300514565510897,
+                                  0.7981720557666137, 0.7634606120368672},
+                                 {0.741931485529941, 0.7220323708212084, 0.9924692945325387,
+                                  0.7983607828564205, 0.7500661298564515}};
   for (std::size_t i = 0; i < 2; ++i) {
     const TableSpec t = make_scene(SceneConfig{}, seeds[i]).table;
     EXPECT_EQ(t.distance_m, expected[i][0]) << "seed " << seeds[i];
@@ -129,7 +132,8 @@ TEST(SyntheticRandom, SceneTablesFollowTheDrawOrderOnEveryCompiler) {
   }
 }
 
-// ---- Ray-primitive intersections --------------------------------------------------------------------
+// ---- Ray-primitive intersections
+// --------------------------------------------------------------------
 
 Hit cast(const Primitive& p, const Vec3& o, const Vec3& d) {
   Hit h;
@@ -143,7 +147,9 @@ void expect_hit(const Hit& h, double t, const Vec3& normal, const std::string& w
   ASSERT_TRUE(h.found()) << what;
   EXPECT_NEAR(h.t, t, 1e-12) << what;
   const Vec3 n = unit(h.normal);
-  for (std::size_t k = 0; k < 3; ++k) { EXPECT_NEAR(n[k], normal[k], 1e-9) << what << " normal[" << k << "]"; }
+  for (std::size_t k = 0; k < 3; ++k) {
+    EXPECT_NEAR(n[k], normal[k], 1e-9) << what << " normal[" << k << "]";
+  }
 }
 
 TEST(ShapePrimitives, CylinderConeAndOpenTopHitsWhereExpected) {
@@ -179,7 +185,8 @@ TEST(ShapePrimitives, BoxFacesAndNearestHitKeeping) {
   const Primitive box{PrimitiveKind::BOX, {0, 0, 0.05}, {0.1, 0.05, 0.05}};
   expect_hit(cast(box, {0, -1, 0.05}, {0, 1, 0}), 0.95, {0, -1, 0}, "-y face");
   expect_hit(cast(box, {2, 0, 0.02}, {-1, 0, 0}), 1.9, {1, 0, 0}, "+x face");
-  expect_hit(cast(box, {0.05, 0.01, 1}, {0, 0, -2}), 0.45, {0, 0, 1}, "top, unnormalised direction");
+  expect_hit(cast(box, {0.05, 0.01, 1}, {0, 0, -2}), 0.45, {0, 0, 1},
+             "top, unnormalised direction");
   EXPECT_FALSE(cast(box, {0, -1, 0.2}, {0, 1, 0}).found());
   // A hit farther than the one already kept leaves it alone.
   Hit best;
@@ -192,7 +199,8 @@ TEST(ShapePrimitives, BoxFacesAndNearestHitKeeping) {
   EXPECT_FALSE(intersect(box, {0, -1, 0.05}, {0, 1, 0}, 1.0, behind));
 }
 
-// ---- Object catalog -----------------------------------------------------------------------------------
+// ---- Object catalog
+// -----------------------------------------------------------------------------------
 
 TEST(ObjectCatalog, NamesRoundTripAndUnknownNamesAreRejected) {
   for (std::size_t i = 0; i < CATEGORY_COUNT; ++i) {
@@ -207,17 +215,21 @@ TEST(ObjectCatalog, NamesRoundTripAndUnknownNamesAreRejected) {
   EXPECT_FALSE(category_from_name("mugs").has_value());
 }
 
-/// Casts rays at @p m from all around and checks every hit against its declared footprint and height.
+/// Casts rays at @p m from all around and checks every hit against its declared footprint and
+/// height.
 void expect_inside_bounds(const ObjectModel& m, std::uint64_t seed) {
   core::Rng r(seed);
   std::size_t hits = 0;
   for (int i = 0; i < 400; ++i) {
     const double az = r.uniform(0.0, 6.283185307179586), el = r.uniform(-0.3, 1.5);
-    const Vec3 o{std::cos(az) * std::cos(el), std::sin(az) * std::cos(el), m.height / 2 + std::sin(el)};
-    // Aim near a random part (its centre, jittered by up to half its size) so thin parts get hit too.
+    const Vec3 o{std::cos(az) * std::cos(el), std::sin(az) * std::cos(el),
+                 m.height / 2 + std::sin(el)};
+    // Aim near a random part (its centre, jittered by up to half its size) so thin parts get hit
+    // too.
     const Primitive& p = m.parts[r.below(m.part_count)];
     const double lift = p.kind == PrimitiveKind::FRUSTUM ? p.size[2] / 2 : 0.0;
-    const Vec3 target{p.center[0] + r.uniform(-0.5, 0.5) * p.size[0], p.center[1] + r.uniform(-0.5, 0.5) * p.size[0],
+    const Vec3 target{p.center[0] + r.uniform(-0.5, 0.5) * p.size[0],
+                      p.center[1] + r.uniform(-0.5, 0.5) * p.size[0],
                       p.center[2] + lift + r.uniform(-0.5, 0.5) * p.size[2]};
     const Vec3 d = target - o;
     Hit h;
@@ -225,7 +237,8 @@ void expect_inside_bounds(const ObjectModel& m, std::uint64_t seed) {
     if (!h.found()) { continue; }
     ++hits;
     const Vec3 q = o + h.t * d;
-    const std::string what = std::string(category_name(m.category)) + " #" + std::to_string(m.instance);
+    const std::string what =
+        std::string(category_name(m.category)) + " #" + std::to_string(m.instance);
     ASSERT_LE(std::hypot(q[0], q[1]), m.footprint_radius + 1e-9) << what;
     ASSERT_LE(q[2], m.height + 1e-9) << what;
     ASSERT_GE(q[2], -1e-9) << what << ": below the table plane";

@@ -44,9 +44,12 @@ TEST(SyntheticScene, OrganizedLayoutWithNanExactlyWhereNoReading) {
   std::size_t table = 0, objects = 0, none = 0;
   for (std::size_t i = 0; i < r.cloud.size(); ++i) {
     const std::uint32_t l = r.cloud.label()[i];
-    const bool nan = std::isnan(r.cloud.x()[i]) || std::isnan(r.cloud.y()[i]) || std::isnan(r.cloud.z()[i]);
+    const bool nan =
+        std::isnan(r.cloud.x()[i]) || std::isnan(r.cloud.y()[i]) || std::isnan(r.cloud.z()[i]);
     ASSERT_EQ(nan, l == LABEL_NONE) << "pixel " << i;
-    if (!nan) { ASSERT_TRUE(std::isnan(r.cloud.x()[i]) == false && std::isnan(r.cloud.z()[i]) == false); }
+    if (!nan) {
+      ASSERT_TRUE(std::isnan(r.cloud.x()[i]) == false && std::isnan(r.cloud.z()[i]) == false);
+    }
     table += l == LABEL_TABLE;
     objects += l >= OBJECT_LABEL_BASE;
     none += l == LABEL_NONE;
@@ -68,7 +71,8 @@ TEST(SyntheticScene, TablePointsLieOnThePlaneWithinTheNoiseModel) {
       if (r.cloud.label()[i] != LABEL_TABLE) { continue; }
       const Vec3 p = point(r.cloud, i);
       const double dist = dot(f.normal, p) + f.d;
-      ASSERT_LE(std::fabs(dist), depth_error_bound_m(p[2], options.depth)) << "seed " << seed << " pixel " << i;
+      ASSERT_LE(std::fabs(dist), depth_error_bound_m(p[2], options.depth))
+          << "seed " << seed << " pixel " << i;
       // Inside the table rectangle (up to the noise, which moves points along their ray).
       const Vec3 q = p - f.center;
       ASSERT_LE(std::fabs(dot(q, f.right)), r.scene.table.width_m / 2 + 0.05);
@@ -78,7 +82,8 @@ TEST(SyntheticScene, TablePointsLieOnThePlaneWithinTheNoiseModel) {
       ++n;
     }
     ASSERT_GT(n, 2500U);
-    // Along the ray the error is about sqrt(sigma_raw^2 + 1/12) steps; the plane distance is smaller.
+    // Along the ray the error is about sqrt(sigma_raw^2 + 1/12) steps; the plane distance is
+    // smaller.
     EXPECT_LT(std::sqrt(sum_sq / static_cast<double>(n)), 0.6);
   }
 }
@@ -152,7 +157,9 @@ TEST(SyntheticScene, DepthIsQuantisedToTheDisparitySteps) {
   // The noise spreads one pixel's depth over a few levels, one step (> 1 mm at >= 0.7 m) apart.
   ASSERT_GE(at_centre.size(), 2U);
   EXPECT_LE(at_centre.size(), 7U);
-  for (auto it = std::next(at_centre.begin()); it != at_centre.end(); ++it) { EXPECT_GT(*it - *std::prev(it), 1e-3F); }
+  for (auto it = std::next(at_centre.begin()); it != at_centre.end(); ++it) {
+    EXPECT_GT(*it - *std::prev(it), 1e-3F);
+  }
 }
 
 TEST(SyntheticScene, ProjectorBaselineCastsShadowsBesideObjects) {
@@ -205,9 +212,11 @@ TEST(SyntheticScene, PlacementKeepsObjectsApartOrTouchingAndOnTheTable) {
 }
 
 TEST(SyntheticScene, TenObjectFrameReusesTheCloud) {
-  const Scene scene = make_scene(SceneConfig{10, false, {}, 5, true}, 6);  // a seed where all ten fit
+  const Scene scene =
+      make_scene(SceneConfig{10, false, {}, 5, true}, 6);  // a seed where all ten fit
 #if defined(__SANITIZE_ADDRESS__)
-  const RenderOptions options = half_resolution();  // the timing means nothing under ASan: keep it short
+  const RenderOptions options =
+      half_resolution();  // the timing means nothing under ASan: keep it short
 #else
   const RenderOptions options;
 #endif
@@ -217,11 +226,12 @@ TEST(SyntheticScene, TenObjectFrameReusesTheCloud) {
   const float* before = cloud.x().data();
   const auto start = std::chrono::steady_clock::now();
   render_scene(scene, options, rng, cloud);
-  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  const double ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   EXPECT_EQ(before, cloud.x().data());  // same buffers: the warm cloud is refilled in place
   EXPECT_EQ(scene.objects.size(), 10U);
-  std::printf("[ info ] %ux%u frame with %zu objects rendered in %.1f ms\n", cloud.width(), cloud.height(),
-              scene.objects.size(), ms);
+  std::printf("[ info ] %ux%u frame with %zu objects rendered in %.1f ms\n", cloud.width(),
+              cloud.height(), scene.objects.size(), ms);
   // Speed is measured in bench/drivers/synthetic_bench.cpp, never asserted here.
 }
 

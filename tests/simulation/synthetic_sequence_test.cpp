@@ -11,14 +11,15 @@
 #include "simulation/synthetic_sequence.hpp"
 
 #if defined(__GNUC__) && !defined(__clang__)
-// GCC's -Wmismatched-new-delete sees malloc'ed memory freed by free() through the inlined replacement
-// operators below and warns; they are a matched pair by construction.
+// GCC's -Wmismatched-new-delete sees malloc'ed memory freed by free() through the inlined
+// replacement operators below and warns; they are a matched pair by construction.
 #pragma GCC diagnostic ignored "-Wmismatched-new-delete"
 #endif
 
 namespace {
-// Counts heap allocations while `counting` is set (replaces the global operator new of this test binary).
-// Not under AddressSanitizer, whose own operator new variants must pair with its operator delete.
+// Counts heap allocations while `counting` is set (replaces the global operator new of this test
+// binary). Not under AddressSanitizer, whose own operator new variants must pair with its operator
+// delete.
 std::atomic<bool> counting{false};
 std::atomic<std::size_t> allocations{0};
 }  // namespace
@@ -29,12 +30,16 @@ std::atomic<std::size_t> allocations{0};
 #define ORTHOFLOW_COUNT_ALLOCATIONS 1
 
 void* operator new(std::size_t n) {
-  if (counting.load(std::memory_order_relaxed)) { allocations.fetch_add(1, std::memory_order_relaxed); }
+  if (counting.load(std::memory_order_relaxed)) {
+    allocations.fetch_add(1, std::memory_order_relaxed);
+  }
   if (void* p = std::malloc(n == 0 ? 1 : n)) { return p; }
   throw std::bad_alloc();
 }
 void* operator new(std::size_t n, std::align_val_t al) {
-  if (counting.load(std::memory_order_relaxed)) { allocations.fetch_add(1, std::memory_order_relaxed); }
+  if (counting.load(std::memory_order_relaxed)) {
+    allocations.fetch_add(1, std::memory_order_relaxed);
+  }
   const auto a = static_cast<std::size_t>(al);
   if (void* p = std::aligned_alloc(a, (n + a - 1) / a * a + (n == 0 ? a : 0))) { return p; }
   throw std::bad_alloc();
@@ -64,7 +69,8 @@ std::size_t pixels_of(const kernels::PointCloud& c, std::uint32_t id) {
 }
 
 /// Centroid of an object's points projected on the table axes (table coordinates).
-std::array<double, 2> table_centroid(const kernels::PointCloud& c, std::uint32_t id, const TableFrame& f) {
+std::array<double, 2> table_centroid(const kernels::PointCloud& c, std::uint32_t id,
+                                     const TableFrame& f) {
   double x = 0, y = 0;
   std::size_t n = 0;
   for (std::size_t i = 0; i < c.size(); ++i) {
@@ -101,7 +107,8 @@ TEST(SyntheticSequence, ObjectsAppearMoveAndDisappearAsScripted) {
     if (frame + 1 == FRAMES) { last = table_centroid(cloud, 0, f); }
   }
   EXPECT_FALSE(seq.next(cloud));
-  // The mover's points travelled by velocity * elapsed time (the visible side shifts a little with view).
+  // The mover's points travelled by velocity * elapsed time (the visible side shifts a little with
+  // view).
   const double t = static_cast<double>(FRAMES - 1) / 30.0;
   EXPECT_NEAR(last[0] - first[0], mover.velocity_x * t, 0.01);
   EXPECT_NEAR(last[1] - first[1], mover.velocity_y * t, 0.01);
@@ -114,12 +121,15 @@ TEST(SyntheticSequence, SameSeedSameFrames) {
   while (a.next(ca)) {
     ASSERT_TRUE(b.next(cb));
     ASSERT_EQ(0, std::memcmp(ca.z().data(), cb.z().data(), ca.size() * sizeof(float)));
-    ASSERT_EQ(0, std::memcmp(ca.label().data(), cb.label().data(), ca.size() * sizeof(std::uint32_t)));
+    ASSERT_EQ(0,
+              std::memcmp(ca.label().data(), cb.label().data(), ca.size() * sizeof(std::uint32_t)));
   }
 }
 
 TEST(SyntheticSequence, NoHeapAllocationAfterTheFirstFrame) {
-  if (!ORTHOFLOW_COUNT_ALLOCATIONS) { GTEST_SKIP() << "allocation counting is off under AddressSanitizer"; }
+  if (!ORTHOFLOW_COUNT_ALLOCATIONS) {
+    GTEST_SKIP() << "allocation counting is off under AddressSanitizer";
+  }
   SyntheticSequence seq(make_sequence_script(6, 4, 3), 2);
   kernels::PointCloud cloud;
   allocations = 0;

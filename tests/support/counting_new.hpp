@@ -1,10 +1,10 @@
 #pragma once
 /// @file
-/// @brief Allocation counting for the "no heap allocation after warm-up" tests. Include this header in
-/// exactly ONE source file of a test binary: it replaces every global operator new and delete (plain,
-/// array, aligned and nothrow) with versions that count while `g_counting` is set. All forms are
-/// replaced so that ASan never sees memory from one allocator freed by another.
-/// What it does not see: allocations that bypass operator new (malloc, oneTBB's own allocator).
+/// @brief Allocation counting for the "no heap allocation after warm-up" tests. Include this header
+/// in exactly ONE source file of a test binary: it replaces every global operator new and delete
+/// (plain, array, aligned and nothrow) with versions that count while `g_counting` is set. All
+/// forms are replaced so that ASan never sees memory from one allocator freed by another. What it
+/// does not see: allocations that bypass operator new (malloc, oneTBB's own allocator).
 #include <atomic>
 #include <cstdint>
 #include <cstdlib>
@@ -15,10 +15,12 @@ inline std::atomic<bool> g_counting{false};
 inline std::atomic<std::uint64_t> g_allocations{0};
 
 inline void* counted_alloc(std::size_t size, std::size_t align) noexcept {
-  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1, std::memory_order_relaxed);
+  if (g_counting.load(std::memory_order_relaxed))
+    g_allocations.fetch_add(1, std::memory_order_relaxed);
   if (size == 0) size = 1;
-  return align > alignof(std::max_align_t) ? std::aligned_alloc(align, (size + align - 1) / align * align)
-                                           : std::malloc(size);
+  return align > alignof(std::max_align_t)
+             ? std::aligned_alloc(align, (size + align - 1) / align * align)
+             : std::malloc(size);
 }
 
 inline void* counted_alloc_or_throw(std::size_t size, std::size_t align) {
@@ -36,8 +38,12 @@ void* operator new(std::size_t n, std::align_val_t a) {
 void* operator new[](std::size_t n, std::align_val_t a) {
   return orthoflow::test::counted_alloc_or_throw(n, static_cast<std::size_t>(a));
 }
-void* operator new(std::size_t n, const std::nothrow_t&) noexcept { return orthoflow::test::counted_alloc(n, 0); }
-void* operator new[](std::size_t n, const std::nothrow_t&) noexcept { return orthoflow::test::counted_alloc(n, 0); }
+void* operator new(std::size_t n, const std::nothrow_t&) noexcept {
+  return orthoflow::test::counted_alloc(n, 0);
+}
+void* operator new[](std::size_t n, const std::nothrow_t&) noexcept {
+  return orthoflow::test::counted_alloc(n, 0);
+}
 void* operator new(std::size_t n, std::align_val_t a, const std::nothrow_t&) noexcept {
   return orthoflow::test::counted_alloc(n, static_cast<std::size_t>(a));
 }
