@@ -1,8 +1,8 @@
 // `orthoflow memory --db DIR [--learner instance|bayes] [--bins N] [--mode M] [--ct X] <action>`:
 // the perceptual memory (learning/perceptual_memory.hpp, docs/LEARNING.md) from the command line.
 // Actions: teach LABEL FILE.pcd..., ask FILE.pcd [--json], correct LABEL FILE.pcd, list, stats,
-// forget LABEL, export FILE, import FILE, calibrate. Descriptors are GOOD (kernels::compute_good)
-// of each PCD.
+// forget LABEL, export FILE, import FILE, calibrate. Descriptors are the store's specification
+// (kernels::Describer; GOOD) of each PCD.
 #include <cmath>
 #include <iostream>
 #include <memory>
@@ -47,8 +47,10 @@ learning::MemoryConfig config_of(const MemoryOptions& o) {
   return cfg;
 }
 
-learning::PerceptualMemory open_memory(const MemoryOptions& o) {
-  auto memory_result = learning::PerceptualMemory::open(o.db, config_of(o));
+// Only commands that write may create a store (teach, correct, import); the read-only ones (ask,
+// list, stats, export, calibrate) never change it and work on a read-only store.
+learning::PerceptualMemory open_memory(const MemoryOptions& o, learning::OpenMode mode) {
+  auto memory_result = learning::PerceptualMemory::open(o.db, config_of(o), mode);
   if (!memory_result) {
     const bool bad_input =
         memory_result.error().code == learning::MemoryError::Code::PARAMS_MISMATCH ||
@@ -82,7 +84,7 @@ void check_write(const learning::MemoryError& e) {
 }
 
 void run_teach(const MemoryOptions& o, bool correct) {
-  auto memory = open_memory(o);
+  auto memory = open_memory(o, learning::OpenMode::CREATE);
   std::vector<learning::ViewRecord> views;
   for (const std::string& f : o.files) { views.push_back(view_of(f, memory.config().descriptor)); }
   auto id_result = correct ? memory.correct(o.label, views.front()) : memory.teach(o.label, views);
@@ -96,7 +98,7 @@ nlohmann::json number_or_null(float v) {
 }
 
 void run_ask(const MemoryOptions& o) {
-  const auto memory = open_memory(o);
+  const auto memory = open_memory(o, learning::OpenMode::READ_ONLY);
   const learning::ViewRecord v = view_of(o.file, memory.config().descriptor);
   learning::AskScratch scratch;
   const learning::Prediction p = memory.learner().ask(v.descriptor, scratch);
@@ -117,14 +119,14 @@ void run_ask(const MemoryOptions& o) {
 }
 
 void run_list(const MemoryOptions& o) {
-  const auto memory = open_memory(o);
+  const auto memory = open_memory(o, learning::OpenMode::READ_ONLY);
   for (const learning::CategoryEntry& c : memory.list()) {
     std::cout << c.id << '\t' << c.label << '\t' << c.views << '\n';
   }
 }
 
 void run_stats(const MemoryOptions& o) {
-  const auto memory = open_memory(o);
+  const auto memory = open_memory(o, learning::OpenMode::READ_ONLY);
   const learning::MemoryStats s = memory.stats();
   const nlohmann::json j{{"categories", s.categories},
                          {"views", s.views},
@@ -135,7 +137,7 @@ void run_stats(const MemoryOptions& o) {
 }
 
 void run_forget(const MemoryOptions& o) {
-  auto memory = open_memory(o);
+  auto memory = open_memory(o, learning::OpenMode::READ_WRITE);
   if (auto r = memory.forget(o.label); !r) {
     fail(r.error().to_string(), r.error().code == learning::MemoryError::Code::UNKNOWN_LABEL
                                     ? EXIT_BAD_INPUT
@@ -145,14 +147,15 @@ void run_forget(const MemoryOptions& o) {
 }
 
 void run_transfer(const MemoryOptions& o, bool do_export) {
-  auto memory = open_memory(o);
+  auto memory =
+      open_memory(o, do_export ? learning::OpenMode::READ_ONLY : learning::OpenMode::CREATE);
   auto count_result = do_export ? memory.export_to(o.file) : memory.import_from(o.file);
   if (!count_result) { check_write(count_result.error()); }
   std::cout << (do_export ? "exported " : "imported ") << *count_result << " views\n";
 }
 
 void run_calibrate(const MemoryOptions& o) {
-  const auto memory = open_memory(o);
+  const auto memory = open_memory(o, learning::OpenMode::READ_ONLY);
   std::vector<std::vector<learning::ViewRecord>> views;
   std::vector<std::vector<float>> flat;
   std::vector<learning::RestoredCategory> cats;

@@ -135,7 +135,7 @@ void print_summary(const graphs::SessionSummary& s, const engine::GraphStats& st
             << s.frames_with_error << " with an error\n";
   std::cout << "objects:     " << s.object_views << " object views, " << s.tracks_started
             << " tracks, " << s.key_views << " key views\n";
-  std::cout << "recognition: " << s.recognitions << " answers; " << l.teaches() << " views taught";
+  std::cout << "recognition: " << s.recognitions << " answers; " << l.teaches() << " lessons";
   if (!s.taught.empty()) {
     std::cout << " (";
     for (std::size_t i = 0; i < s.taught.size(); ++i) std::cout << (i ? ", " : "") << s.taught[i];

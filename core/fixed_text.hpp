@@ -32,6 +32,17 @@ struct FixedText {
     std::memcpy(chars.data(), s.data(), n);
     std::fill(chars.begin() + static_cast<std::ptrdiff_t>(n), chars.end(), '\0');
   }
+  /// @brief Stores @p s only if it fits whole (at most CAPACITY bytes, no embedded zero); otherwise
+  /// leaves the text empty. @return whether it was stored: what a caller checks before it sends a
+  /// label that must not be cut short.
+  [[nodiscard]] bool try_assign(std::string_view s) noexcept {
+    if (s.size() > CAPACITY || s.find('\0') != std::string_view::npos) {
+      assign({});
+      return false;
+    }
+    assign(s);
+    return true;
+  }
   /// @brief A text holding @p s (truncated as assign()).
   [[nodiscard]] static FixedText from(std::string_view s) noexcept {
     FixedText t;

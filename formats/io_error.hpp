@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// @brief The error every file reader and writer in drivers/ returns.
+/// @brief The error every file reader and writer in formats/ returns.
 #include <cstdint>
 #include <string>
 

@@ -1,5 +1,5 @@
 #pragma once
-// PLY header model shared by the PLY reader's header and body parts (internal to drivers/).
+// PLY header model shared by the PLY reader's header and body parts (internal to formats/).
 #include <cstdint>
 #include <span>
 #include <string>

@@ -32,9 +32,10 @@ struct LearningCommand {
   std::uint32_t track_id = 0;       ///< TEACH (when not by_position), CORRECT, ASK
   bool by_position = false;         ///< TEACH: the object whose centroid is nearest to position
   std::array<float, 3> position{};  ///< sensor frame, metres
-  core::Text label;                 ///< TEACH, CORRECT, FORGET
-  std::uint32_t sender = 0;         ///< set by LearningClient::send
-  std::uint64_t sequence = 0;       ///< set by LearningClient::send (1, 2, ... per client)
+  core::Text
+      label;  ///< TEACH, CORRECT, FORGET: fill with label.try_assign() (refuses what would be cut)
+  std::uint32_t sender = 0;    ///< set by LearningClient::send
+  std::uint64_t sequence = 0;  ///< set by LearningClient::send (1, 2, ... per client)
 };
 
 /// @brief "teach", "correct", "forget" or "ask".

@@ -48,13 +48,17 @@ LearningAck LessonDesk::teach_object(const FrameBlock& block, std::uint32_t k,
   }
   const auto current = block.descriptor(k).first(o.descriptor_length);
   std::size_t views = 1;
-  if (TrackMemory* t = o.track_id == 0 ? nullptr : memories_.find(o.track_id)) {
+  TrackMemory* t = o.track_id == 0 ? nullptr : memories_.find(o.track_id);
+  const std::uint32_t untaught = t != nullptr ? t->untaught : 0;
+  if (t != nullptr) {
     views = memories_.lesson(*t, current, o.key_view, lesson_);
   } else {
     std::copy(current.begin(), current.end(), lesson_.begin());
   }
   const auto lesson = std::span<const float>(lesson_).first(views * o.descriptor_length);
   ack = service_.teach(label, lesson, o.track_id, stamp, ack);
+  if (t != nullptr && !ack.ok())
+    t->untaught = untaught;  // refused: the key views wait for the next teach
   o.taught = ack.ok();
   if (o.taught) o.taught_as.assign(label);
   return ack;

@@ -14,7 +14,7 @@ namespace {
 using Clock = std::chrono::steady_clock;
 const engine::PortSpec PORTS[] = {FRAME_IN, FRAME_OUT, {"objects", "objects", false}};
 
-/// Copies the header and the first count entries (the rest of the 11 KB list is not read).
+/// Copies the header and the first count entries (the rest of the 12.9 KB list is not read).
 void copy_list(const engine::ObjectListPayload& from, engine::ObjectListPayload& to) noexcept {
   std::memcpy(static_cast<void*>(&to), &from, offsetof(engine::ObjectListPayload, objects));
   std::memcpy(static_cast<void*>(to.objects), from.objects,

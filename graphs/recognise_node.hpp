@@ -2,11 +2,12 @@
 /// @file
 /// @brief The `recognise` kind (stateful, ordered frames): asks the learner for every described
 /// object, smooths the answers over each track (majority of the last `smoothing` answers), keeps
-/// each track's key views, and applies the learning events: outside events from the LearningService
-/// queue (teach a track, or the object at a position) and, with `instructor: 1`, the scripted
-/// instructor of the synthetic session, which teaches the first instance of every category it knows
-/// the truth of (session_script.hpp says which) with 3 views, as the thesis's simulated teacher
-/// introduces a category (Algorithm 7.1).
+/// each track's key views (graphs/track_memory.hpp), and applies the learning channel's commands
+/// (graphs/learning_channel.hpp: teach a track or the object at a position, correct, forget, ask;
+/// each acknowledged) and, with `instructor: 1`, the scripted instructor of the synthetic session,
+/// which teaches the first instance of every category it knows the truth of (session_script.hpp
+/// says which) in 3 lessons, as the thesis's simulated teacher introduces a category
+/// (Algorithm 7.1).
 #include "engine/registry.hpp"
 #include "graphs/learning_service.hpp"
 

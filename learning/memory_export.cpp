@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "learning/detail/memory_state.hpp"
+#include "learning/detail/store_dir.hpp"
 #include "learning/perceptual_memory.hpp"
 
 namespace orthoflow::learning {
@@ -76,6 +77,10 @@ struct ImportGroup {
 Result<std::size_t, MemoryError> PerceptualMemory::export_to(
     const std::filesystem::path& file) const {
   const State& s = *state_;
+  if (inside_store(file, s.dir)) {
+    return err(
+        memory_error(Code::FILE_FAILED, file, "is inside the store it would export: refused"));
+  }
   std::ofstream out(file, std::ios::binary | std::ios::trunc);
   if (!out) { return err(memory_error(Code::FILE_FAILED, file, "cannot open for writing")); }
   json header = json::parse(encode_schema(s.cfg.descriptor));

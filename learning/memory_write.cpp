@@ -14,6 +14,10 @@ using Code = MemoryError::Code;
 
 Result<void, MemoryError> write_synced(PerceptualMemory::State& s, leveldb::WriteBatch& batch,
                                        const std::string& what) {
+  if (s.read_only) {
+    return err(
+        memory_error(Code::READ_ONLY, s.dir, what + ": opened read-only, nothing was written"));
+  }
   leveldb::WriteOptions sync;
   sync.sync = true;  // fsync before returning: a crash after this point cannot lose the batch
   const leveldb::Status st = s.db->Write(sync, &batch);

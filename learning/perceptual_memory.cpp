@@ -5,6 +5,7 @@
 #include <algorithm>
 
 #include "learning/detail/memory_state.hpp"
+#include "learning/detail/store_dir.hpp"
 
 namespace orthoflow::learning {
 namespace {
@@ -19,10 +20,17 @@ std::unique_ptr<Learner> make_learner(MemoryConfig& cfg) {
   return std::make_unique<InstanceLearner>(cfg.instance);
 }
 
-// The schema key: written on first open of an empty store, compared on every later open.
-Result<void, MemoryError> check_schema(PerceptualMemory::State& s) {
+// The schema key: written when the store was just created, compared on every later open. A LevelDB
+// database without it is not ours and is left alone.
+Result<void, MemoryError> check_schema(PerceptualMemory::State& s, bool created) {
   std::string value;
   const leveldb::Status st = s.db->Get(leveldb::ReadOptions(), std::string(KEY_SCHEMA), &value);
+  if (st.IsNotFound() && !created) {
+    return err(
+        memory_error(Code::OPEN_FAILED, s.dir,
+                     "a LevelDB database without orthoflow's schema key: not a perceptual memory; "
+                     "nothing was changed"));
+  }
   if (st.IsNotFound()) {
     leveldb::WriteOptions sync;
     sync.sync = true;
@@ -130,6 +138,8 @@ const char* to_string(MemoryError::Code code) noexcept {
       return "unknown_label";
     case Code::FILE_FAILED:
       return "file_failed";
+    case Code::READ_ONLY:
+      return "read_only";
     case Code::BAD_IMPORT:
       return "bad_import";
   }
@@ -161,28 +171,72 @@ Result<std::vector<ViewRecord>, MemoryError> PerceptualMemory::State::read_views
   return out;
 }
 
+PerceptualMemory::State::~State() {
+  db.reset();  // close LevelDB before its private copy goes
+  std::error_code ignored;
+  if (!copy.empty()) std::filesystem::remove_all(copy, ignored);
+}
+
+namespace {
+
+// Where LevelDB is pointed, and whether it may create: refuses everything that is not a store (or,
+// in CREATE mode, an absent or empty directory), before LevelDB can touch it.
+Result<bool, MemoryError> prepare(PerceptualMemory::State& s, OpenMode mode) {
+  switch (inspect_store_dir(s.dir)) {
+    case StoreDir::ABSENT:
+    case StoreDir::EMPTY:
+      if (mode != OpenMode::CREATE) {
+        return err(memory_error(Code::OPEN_FAILED, s.dir,
+                                "no perceptual memory here (nothing was created)"));
+      }
+      return true;
+    case StoreDir::DAMAGED:
+      return err(memory_error(
+          Code::CORRUPT, s.dir,
+          "LevelDB files without CURRENT: a damaged store; nothing was changed (restore "
+          "CURRENT from a backup, or repair a copy)"));
+    case StoreDir::FOREIGN:
+      return err(memory_error(Code::OPEN_FAILED, s.dir,
+                              "not a perceptual memory (other files); nothing was changed"));
+    case StoreDir::STORE:
+      break;
+  }
+  if (mode == OpenMode::READ_ONLY && !writable_dir(s.dir)) {
+    auto copy = private_copy(s.dir);
+    if (!copy) return err(copy.error());
+    s.copy = *copy;
+  }
+  s.read_only = mode == OpenMode::READ_ONLY;
+  return false;
+}
+
+}  // namespace
+
 Result<PerceptualMemory, MemoryError> PerceptualMemory::open(const std::filesystem::path& dir,
-                                                             const MemoryConfig& cfg) {
+                                                             const MemoryConfig& cfg,
+                                                             OpenMode mode) {
   if (auto valid = cfg.descriptor.validate(); !valid)
     return err(memory_error(Code::OPEN_FAILED, dir, valid.error()));
   auto s = std::make_unique<State>();
   s->dir = dir;
   s->cfg = cfg;
   s->learner = make_learner(s->cfg);
-  std::error_code
-      ignored;  // LevelDB creates only the last path component; a failure shows up in Open below
-  std::filesystem::create_directories(dir, ignored);
+  auto create = prepare(*s, mode);
+  if (!create) return err(create.error());
+  std::error_code ignored;  // LevelDB creates only the last path component; Open reports failures
+  if (*create) std::filesystem::create_directories(dir, ignored);
   leveldb::Options options;
-  options.create_if_missing = true;
+  options.create_if_missing = *create;
   options.paranoid_checks = true;
   leveldb::DB* raw = nullptr;
-  const leveldb::Status st = leveldb::DB::Open(options, dir.string(), &raw);
+  const std::filesystem::path where = s->copy.empty() ? dir : s->copy;
+  const leveldb::Status st = leveldb::DB::Open(options, where.string(), &raw);
   if (!st.ok()) {
     return err(
         memory_error(st.IsCorruption() ? Code::CORRUPT : Code::OPEN_FAILED, dir, st.ToString()));
   }
   s->db.reset(raw);
-  if (auto r = check_schema(*s); !r) { return err(r.error()); }
+  if (auto r = check_schema(*s, *create); !r) { return err(r.error()); }
   if (auto r = load(*s); !r) { return err(r.error()); }
   return PerceptualMemory(std::move(s));
 }

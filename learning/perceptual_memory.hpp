@@ -56,6 +56,7 @@ struct MemoryError {
     UNKNOWN_LABEL,  ///< forget of a label that is not stored
     FILE_FAILED,    ///< an export/import file could not be opened, read or written
     BAD_IMPORT,     ///< an import line is malformed or its parameters differ from the store's
+    READ_ONLY,      ///< a write to a store opened with OpenMode::READ_ONLY: nothing was written
   };
   Code code = Code::CORRUPT;
   std::string
@@ -85,12 +86,25 @@ struct MemoryStats {
 /// @note Writers (teach, correct, forget, import_from) must be serialised by the caller (one writer
 /// thread, e.g. a graph node with concurrency 1); learner().ask() may run on any thread at any
 /// time.
+/// @brief How a store is opened. Whatever the mode, a directory that is not an orthoflow store
+/// (other files, LevelDB files without CURRENT, a LevelDB database without the schema key) is
+/// refused and left untouched.
+enum class OpenMode : std::uint8_t {
+  READ_ONLY,   ///< the store must exist; every write is refused (READ_ONLY). A store on a read-only
+               ///< mount or without write permission is read from a private copy (LevelDB may fold
+               ///< its log into a table when it opens a writable one)
+  READ_WRITE,  ///< the store must exist
+  CREATE,      ///< READ_WRITE, and a store is created when the directory is absent or empty
+};
+
 class PerceptualMemory {
  public:
-  /// @brief Opens (creating if missing) the store at @p dir and loads every category into the
-  /// learner. Errors: OPEN_FAILED, PARAMS_MISMATCH (message names both parameter sets), CORRUPT.
+  /// @brief Opens the store at @p dir (see OpenMode) and loads every category into the learner.
+  /// Errors: OPEN_FAILED (no store, not a store, in use, unreadable), PARAMS_MISMATCH (message
+  /// names both specifications), CORRUPT.
   [[nodiscard]] static Result<PerceptualMemory, MemoryError> open(const std::filesystem::path& dir,
-                                                                  const MemoryConfig& cfg);
+                                                                  const MemoryConfig& cfg,
+                                                                  OpenMode mode = OpenMode::CREATE);
   PerceptualMemory(PerceptualMemory&&) noexcept;
   PerceptualMemory& operator=(PerceptualMemory&&) noexcept;
   ~PerceptualMemory();

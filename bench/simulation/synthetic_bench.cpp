@@ -1,6 +1,6 @@
 // Synthetic Kinect frames: cost of rendering one 640x480 frame by object count, of one sequence
 // frame (warm cloud, the allocation-free path) and of one segmented dataset view.
-// Run: build-<name>/bench/drivers/synthetic_bench --benchmark_min_time=0.3
+// Run: build/<preset>/bench/simulation/synthetic_bench --benchmark_min_time=0.3
 #include <benchmark/benchmark.h>
 
 #include <cmath>

@@ -22,7 +22,10 @@ struct IndexedCategory {
 };
 
 struct PerceptualMemory::State {
+  ~State();
   std::filesystem::path dir;
+  std::filesystem::path copy;  ///< READ_ONLY on a read-only store: the private copy LevelDB opened
+  bool read_only = false;
   MemoryConfig cfg;
   std::unique_ptr<leveldb::DB> db;
   std::unique_ptr<Learner> learner;

@@ -85,6 +85,12 @@ TEST(FixedText, TruncatesTerminatesAndCompares) {
   const std::string with_zero("ab\0cd", 5);
   EXPECT_EQ(Text::from(with_zero).view(), "ab");  // as view() reads it
   static_assert(std::is_trivially_copyable_v<Text>);
+  Text checked;
+  EXPECT_TRUE(checked.try_assign(std::string(TEXT_MAX_BYTES, 'y')));
+  EXPECT_EQ(checked.view().size(), TEXT_MAX_BYTES);
+  EXPECT_FALSE(checked.try_assign(std::string(TEXT_MAX_BYTES + 1, 'y')));  // would be cut: refused
+  EXPECT_TRUE(checked.empty());
+  EXPECT_FALSE(checked.try_assign(with_zero));
 }
 
 TEST(SpscRing, FullEmptyAndAllOrNothing) {

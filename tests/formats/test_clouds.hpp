@@ -1,5 +1,5 @@
 #pragma once
-// Helpers shared by the drivers tests: small clouds with every field, and bitwise comparison.
+// Helpers shared by the formats tests: small clouds with every field, and bitwise comparison.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -75,7 +75,7 @@ LearningCommand command(LearningCommand::Kind kind, std::uint32_t track, std::st
   LearningCommand c;
   c.kind = kind;
   c.track_id = track;
-  c.label.assign(label);
+  EXPECT_TRUE(c.label.try_assign(label));
   return c;
 }
 
@@ -106,6 +106,13 @@ void teach_correct_forget(LearningService& learning, Outcome stored) {
       200);
   ASSERT_TRUE(seen);
   EXPECT_TRUE(entry_of(teacher.last(), track)->unknown);  // nothing is known yet
+  // a refused teach stores nothing and keeps the key views for the next one
+  LearningCommand empty_label =
+      command(LearningCommand::Kind::TEACH, static_cast<std::uint32_t>(track), "x");
+  empty_label.label = core::Text{};
+  auto bad = teacher.call(empty_label);
+  ASSERT_TRUE(bad);
+  EXPECT_EQ(bad->outcome, Outcome::BAD_LABEL);
   // teach: the key views and the current view are stored
   auto taught = teacher.call(
       command(LearningCommand::Kind::TEACH, static_cast<std::uint32_t>(track), "alpha"));
@@ -149,10 +156,6 @@ void teach_correct_forget(LearningService& learning, Outcome stored) {
   auto missing = teacher.call(command(LearningCommand::Kind::TEACH, 99999, "gamma"));
   ASSERT_TRUE(missing);
   EXPECT_EQ(missing->outcome, Outcome::NO_SUCH_TRACK);
-  auto bad =
-      teacher.call(command(LearningCommand::Kind::TEACH, static_cast<std::uint32_t>(track), ""));
-  ASSERT_TRUE(bad);
-  EXPECT_EQ(bad->outcome, Outcome::BAD_LABEL);
   engine.request_stop();
   runner.join();
   EXPECT_EQ(learning.commands_dropped(), 0U);

@@ -232,7 +232,7 @@ TEST(SyntheticScene, TenObjectFrameReusesTheCloud) {
   EXPECT_EQ(scene.objects.size(), 10U);
   std::printf("[ info ] %ux%u frame with %zu objects rendered in %.1f ms\n", cloud.width(),
               cloud.height(), scene.objects.size(), ms);
-  // Speed is measured in bench/drivers/synthetic_bench.cpp, never asserted here.
+  // Speed is measured in bench/simulation/synthetic_bench.cpp, never asserted here.
 }
 
 }  // namespace
