@@ -2,8 +2,10 @@
 // given on the command line), with learning, and a summary of what it saw, learned and how fast.
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <iostream>
 #include <memory>
 #include <string>
@@ -214,12 +216,16 @@ void add_run_command(CLI::App& app) {
   cmd->add_option("--rate", o->rate,
                   "source rate in Hz, or max (no pacing, no deadline); default: the graph's period")
       ->check([](const std::string& v) {
+        // The whole text is the number ("5abc" is not 5), and the period 1e9 / rate must stay a
+        // sane int64 of nanoseconds: 0.01 Hz (100 s) to 1000 Hz.
         if (v == "max") return std::string();
-        try {
-          return std::stod(v) > 0.0 && std::stod(v) <= 1000.0
-                     ? std::string()
-                     : std::string("rate must be in (0, 1000] or max");
-        } catch (...) { return std::string("rate must be a number or max"); }
+        char* end = nullptr;
+        const double hz = std::strtod(v.c_str(), &end);
+        if (v.empty() || end != v.c_str() + v.size() || !std::isfinite(hz)) {
+          return std::string("rate must be a number of Hz or max, not '" + v + "'");
+        }
+        return hz >= 0.01 && hz <= 1000.0 ? std::string()
+                                          : std::string("rate must be in [0.01, 1000] Hz or max");
       });
   cmd->add_option("--db", o->db,
                   "perceptual memory directory (LevelDB); default: learn in memory only");

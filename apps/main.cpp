@@ -2,6 +2,7 @@
 #include <cstdio>
 
 #include "apps/commands.hpp"
+#include "apps/option_checks.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"orthoflow: real-time open-ended 3D object perception"};
@@ -15,6 +16,7 @@ int main(int argc, char** argv) {
   orthoflow::apps::add_ipc_command(app);
   orthoflow::apps::add_run_command(app);
   orthoflow::apps::add_evaluate_command(app);
+  orthoflow::apps::check_numeric_options(app);  // every numeric option: finite and non-negative
   app.set_version_flag("--version", ORTHOFLOW_VERSION);
   try {
     app.parse(argc, argv);

@@ -1,0 +1,16 @@
+#pragma once
+/// @file
+/// @brief One rule for every numeric option of every command (issue 16: `--ct nan` aborted,
+/// `ipc echo --timeout-ms -5` never returned): a value must be a finite, non-negative number. CLI11
+/// already refuses trailing garbage ("5abc") when it converts; NaN, infinities and negative numbers
+/// it accepts, so check_numeric_options() adds the rule to every INT, UINT and FLOAT option once
+/// all commands are declared. Commands add their own ranges on top.
+#include <CLI/CLI.hpp>
+
+namespace orthoflow::apps {
+
+/// @brief Adds the finite, non-negative rule to every numeric option of @p app and its subcommands,
+/// recursively. Call once, after every command is added.
+void check_numeric_options(CLI::App& app);
+
+}  // namespace orthoflow::apps
