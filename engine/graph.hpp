@@ -44,6 +44,7 @@ struct GraphSpec {
   std::size_t block_bytes = 4096;  ///< frame pool: bytes per block
   std::size_t blocks = 8;          ///< frame pool: number of blocks
   std::size_t max_in_flight = 0;   ///< frames in flight (limiter); 0 = blocks
+  int pool_line = 0;               ///< line of the pool entry in the graph file (0 if none)
   std::vector<NodeSpec> nodes;
   std::vector<EdgeSpec> edges;
 };

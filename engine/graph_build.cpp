@@ -5,6 +5,8 @@
 #include <map>
 #include <optional>
 
+#include <unistd.h>
+
 #include "engine/graph.hpp"
 
 namespace orthoflow::engine {
@@ -13,6 +15,13 @@ namespace {
 
 using Code = GraphError::Code;
 using Built = Result<std::unique_ptr<Graph>, GraphError>;
+
+// Physical memory of this machine in bytes (0 if unknown).
+std::size_t physical_memory_bytes() noexcept {
+  const long pages = ::sysconf(_SC_PHYS_PAGES), page = ::sysconf(_SC_PAGESIZE);
+  return pages > 0 && page > 0 ? static_cast<std::size_t>(pages) * static_cast<std::size_t>(page)
+                               : 0;
+}
 
 GraphError error_at(const GraphSpec& spec, Code code, int line, std::string message) {
   return GraphError{code, spec.file, line, std::move(message)};
@@ -183,10 +192,22 @@ Built build_graph(const GraphSpec& spec, const NodeRegistry& registry, BuildMode
                             " exceeds the pool's " + std::to_string(spec.blocks) +
                             " blocks (the limiter is sized to the pool)"));
   }
-  auto pool_result =
-      memory_pool::BlockPool::create_owned({spec.block_bytes, spec.blocks, graph->spec.name});
+  // Each field within its limit can still ask for more memory than the machine has (1 GiB x 2^20
+  // blocks): refuse it like every other graph error, before allocating anything.
+  const memory_pool::PoolConfig pool_config{spec.block_bytes, spec.blocks, graph->spec.name};
+  const std::size_t needed = memory_pool::required_bytes(pool_config);
+  const std::size_t physical = physical_memory_bytes();
+  if (needed != 0 && physical != 0 && needed > physical) {
+    return err(error_at(spec, Code::POOL, spec.pool_line,
+                        "the pool needs " + std::to_string(needed >> 20) + " MiB (block_bytes " +
+                            std::to_string(spec.block_bytes) + " x blocks " +
+                            std::to_string(spec.blocks) + "), more than this machine's " +
+                            std::to_string(physical >> 20) + " MiB"));
+  }
+  auto pool_result = memory_pool::BlockPool::create_owned(pool_config);
   if (!pool_result)
-    return err(error_at(spec, Code::POOL, 0, memory_pool::to_string(pool_result.error())));
+    return err(
+        error_at(spec, Code::POOL, spec.pool_line, memory_pool::to_string(pool_result.error())));
   graph->pool = std::move(*pool_result);
   if (auto e = make_nodes(*graph, registry)) return err(*e);
   if (auto e = resolve_edges(*graph)) return err(*e);

@@ -44,6 +44,15 @@ double number(const YAML::Node& node, const std::string& file, const std::string
   return value;
 }
 
+// A count of bytes or blocks: a whole number (4096.5 bytes is not a size).
+std::size_t whole(const YAML::Node& node, const std::string& file, const std::string& what,
+                  double max) {
+  const double value = number(node, file, what, max);
+  if (value != std::floor(value))
+    fail(Code::BAD_PARAMETER, file, node, what + " must be a whole number");
+  return static_cast<std::size_t>(value);
+}
+
 void parse_header(const YAML::Node& graph, GraphSpec& spec) {
   if (!graph) return;
   if (!graph.IsMap()) fail(Code::BAD_STRUCTURE, spec.file, graph, "'graph' must be a map");
@@ -59,14 +68,13 @@ void parse_header(const YAML::Node& graph, GraphSpec& spec) {
       spec.max_in_flight =
           static_cast<std::size_t>(number(value, spec.file, "graph.max_in_flight", 4096));
     } else if (key == "pool" && value.IsMap()) {
+      spec.pool_line = value.Mark().line + 1;
       for (const auto& p : value) {
         const std::string pkey = p.first.Scalar();
         if (pkey == "block_bytes") {
-          spec.block_bytes =
-              static_cast<std::size_t>(number(p.second, spec.file, "pool.block_bytes", 1 << 30));
+          spec.block_bytes = whole(p.second, spec.file, "pool.block_bytes", 1 << 30);
         } else if (pkey == "blocks") {
-          spec.blocks =
-              static_cast<std::size_t>(number(p.second, spec.file, "pool.blocks", 1 << 20));
+          spec.blocks = whole(p.second, spec.file, "pool.blocks", 1 << 20);
         } else {
           fail(Code::BAD_PARAMETER, spec.file, p.first, "unknown pool key '" + pkey + "'");
         }

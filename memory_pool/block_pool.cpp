@@ -44,6 +44,8 @@ std::string_view to_string(PoolError::Code code) noexcept {
       return "MEMORY_TOO_SMALL";
     case PoolError::Code::MEMORY_MISALIGNED:
       return "MEMORY_MISALIGNED";
+    case PoolError::Code::OUT_OF_MEMORY:
+      return "OUT_OF_MEMORY";
   }
   return "UNKNOWN";
 }
@@ -67,6 +69,8 @@ std::string to_string(const PoolError& error) {
       return text + who + " provided " + bytes + " bytes of memory but the pool needs " + limit;
     case PoolError::Code::MEMORY_MISALIGNED:
       return text + who + " provided memory that is not 64-byte aligned";
+    case PoolError::Code::OUT_OF_MEMORY:
+      return text + "the system refused " + bytes + " bytes for " + limit + " blocks";
   }
   return text + "unknown error";
 }
@@ -101,8 +105,12 @@ Result<std::unique_ptr<BlockPool>, PoolError> BlockPool::create_owned(const Pool
     return err(PoolError{PoolError::Code::BAD_CONFIG, config.name, "create", config.block_bytes,
                          config.block_count});
   }
-  auto* memory =
-      static_cast<std::byte*>(::operator new (needed, std::align_val_t{CACHE_LINE_BYTES}));
+  auto* memory = static_cast<std::byte*>(
+      ::operator new (needed, std::align_val_t{CACHE_LINE_BYTES}, std::nothrow));
+  if (memory == nullptr) {
+    return err(PoolError{PoolError::Code::OUT_OF_MEMORY, config.name, "create", needed,
+                         config.block_count});
+  }
   auto pool = std::unique_ptr<BlockPool>(
       new BlockPool(config, std::span<std::byte>(memory, needed), memory));
   pool->owned_bytes_ = needed;

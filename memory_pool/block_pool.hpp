@@ -31,7 +31,14 @@ inline constexpr std::size_t MAX_BLOCK_BYTES = std::size_t{1} << 30;
 /// @brief Why a pool could not be created or a block could not be handed out.
 /// Holds only views and numbers so that building it on the frame path never allocates.
 struct PoolError {
-  enum class Code { EXHAUSTED, TOO_LARGE, BAD_CONFIG, MEMORY_TOO_SMALL, MEMORY_MISALIGNED };
+  enum class Code {
+    EXHAUSTED,
+    TOO_LARGE,
+    BAD_CONFIG,
+    MEMORY_TOO_SMALL,
+    MEMORY_MISALIGNED,
+    OUT_OF_MEMORY
+  };
   Code code = Code::BAD_CONFIG;
   std::string_view pool;       ///< name of the pool
   std::string_view requester;  ///< who asked (a node name, "create", ...)

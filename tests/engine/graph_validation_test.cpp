@@ -117,8 +117,8 @@ TEST(GraphValidation, SourceCount) {
 }
 
 TEST(GraphValidation, PoolErrors) {
-  expect_error("graph:\n  pool: {block_bytes: 0, blocks: 2}\nnodes:\n" + SRC, Code::POOL, 0,
-               "block_bytes");
+  expect_error("graph:\n  pool: {block_bytes: 0, blocks: 2}\nnodes:\n" + SRC, Code::POOL, 2,
+               "block_bytes");  // the pool's own line
   expect_error("graph:\n  max_in_flight: 9\n  pool: {blocks: 4}\nnodes:\n" + SRC, Code::POOL, 0,
                "exceeds");
 }

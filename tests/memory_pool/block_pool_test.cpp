@@ -94,6 +94,12 @@ TEST(BlockPool, EveryErrorCodeIsReachable) {
   ASSERT_FALSE(misaligned);
   EXPECT_EQ(misaligned.error().code, PoolError::Code::MEMORY_MISALIGNED);
   EXPECT_EQ(to_string(PoolError::Code::MEMORY_MISALIGNED), "MEMORY_MISALIGNED");
+
+  // Within every field's limit, far beyond any machine: refused as an error, never std::bad_alloc.
+  auto huge = BlockPool::create_owned({MAX_BLOCK_BYTES, MAX_BLOCKS, "p"});
+  ASSERT_FALSE(huge);
+  EXPECT_EQ(huge.error().code, PoolError::Code::OUT_OF_MEMORY);
+  EXPECT_NE(to_string(huge.error()).find("refused"), std::string::npos) << to_string(huge.error());
 }
 
 TEST(BlockPool, LastHandleReturnsTheBlock) {
