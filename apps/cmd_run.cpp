@@ -1,11 +1,16 @@
 // `orthoflow run`: the tabletop graph end to end on the embedded synthetic session (or a source
 // given on the command line), with learning, and a summary of what it saw, learned and how fast.
+#include <unistd.h>
+
 #include <algorithm>
 #include <atomic>
+#include <cerrno>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <string>
@@ -43,6 +48,7 @@ struct RunOptions {
   std::string snapshot;
   std::string telemetry_json;
   bool publish_objects = false;  // every frame's objects to orthoflow/<graph>/objects over iceoryx
+  std::string on_bad_frame = "skip";  // skip: count and report; fail: also exit 2
   int threads = 0;
 };
 
@@ -155,6 +161,59 @@ void print_summary(const graphs::SessionSummary& s, const engine::GraphStats& st
   }
 }
 
+// A file the run will write at the end: its directory (and the file, if it exists) must be
+// writable.
+void check_output_path(const std::string& path, const char* flag) {
+  if (path.empty()) return;
+  const std::filesystem::path p(path);
+  const std::filesystem::path dir = p.has_parent_path() ? p.parent_path() : ".";
+  const bool ok = std::filesystem::exists(p) ? ::access(p.c_str(), W_OK) == 0
+                                             : ::access(dir.c_str(), W_OK) == 0;
+  if (!ok)
+    fail(std::string(flag) + ": cannot write '" + path + "': " + std::strerror(errno),
+         EXIT_FAILURE_GENERIC);
+}
+
+// After the run: every output the user asked for was written whole, or the exit is non-zero; frames
+// that failed are reported (and fail the run with --on-bad-frame fail).
+void finish_outputs(const RunOptions& o, graphs::SessionLog& log, const engine::GraphStats& stats,
+                    std::unique_ptr<graphs::LineWriter> telemetry) {
+  int exit_code = EXIT_OK;
+  const graphs::SessionSummary summary = log.summary();
+  if (!summary.first_error.empty()) {
+    std::cerr << "run: " << summary.frames_with_error << " frame(s) failed; the first, frame "
+              << summary.first_error_frame << ": " << summary.first_error.to_string() << "\n";
+    if (o.on_bad_frame == "fail") exit_code = EXIT_BAD_INPUT;
+  }
+  if (log.json() != nullptr && (log.json()->dropped() > 0 || log.json()->failed())) {
+    std::cerr << "run: --json-out " << o.json_out << ": " << log.json()->dropped()
+              << " lines dropped" << (log.json()->failed() ? ", a write failed" : "") << "\n";
+    exit_code = EXIT_FAILURE_GENERIC;
+  }
+  if (telemetry) {
+    telemetry->write(engine::to_json(stats));
+    telemetry->flush();
+    if (telemetry->failed() || telemetry->dropped() > 0) {
+      std::cerr << "run: --telemetry-json " << o.telemetry_json << ": the write failed\n";
+      exit_code = EXIT_FAILURE_GENERIC;
+    }
+  }
+  if (!o.snapshot.empty()) {
+    if (auto drawn = write_scene_snapshot_png(log.snapshot(), o.snapshot); !drawn) {
+      std::cerr << "run: --snapshot: " << drawn.error() << "\n";
+      exit_code = EXIT_FAILURE_GENERIC;
+    } else {
+      std::cout << "snapshot: " << o.snapshot << "\n";
+    }
+  }
+  std::cout.flush();
+  if (!std::cout) {
+    std::cerr << "run: writing the summary to standard output failed\n";
+    exit_code = EXIT_FAILURE_GENERIC;
+  }
+  if (exit_code != EXIT_OK) throw CLI::RuntimeError(exit_code);
+}
+
 void run(const RunOptions& o) {
   auto spec = o.graph.empty() ? engine::parse_graph(std::string(graphs::embedded_tabletop_yaml()),
                                                     "embedded:tabletop.yaml")
@@ -165,6 +224,14 @@ void run(const RunOptions& o) {
   if (o.publish_objects) add_objects_publisher(*spec);
   auto learning = graphs::LearningService::open(learning_settings(*spec, o));
   if (!learning) fail(learning.error(), EXIT_FAILURE_GENERIC);
+  // Every output the user asked for is checked before the run, so a bad path fails at once.
+  check_output_path(o.snapshot, "--snapshot");
+  std::unique_ptr<graphs::LineWriter> telemetry;
+  if (!o.telemetry_json.empty()) {
+    auto writer = graphs::LineWriter::open(o.telemetry_json);
+    if (!writer) fail(writer.error(), EXIT_FAILURE_GENERIC);
+    telemetry = std::move(*writer);
+  }
   std::unique_ptr<graphs::LineWriter> json;
   if (!o.json_out.empty()) {
     auto writer = graphs::LineWriter::open(o.json_out);
@@ -188,20 +255,7 @@ void run(const RunOptions& o) {
             << (reason == engine::StopReason::STOP_REQUESTED ? " (stopped by signal)" : "") << "\n";
   print_summary(log.summary(), engine.stats(), **learning);
   std::cout << engine::format_table(engine.stats());
-  if (log.json() != nullptr && (log.json()->dropped() > 0 || log.json()->failed())) {
-    std::cerr << "run: JSON lines: " << log.json()->dropped() << " lines dropped"
-              << (log.json()->failed() ? ", a write failed" : "") << "\n";
-  }
-  if (!o.telemetry_json.empty()) {
-    auto writer = graphs::LineWriter::open(o.telemetry_json);
-    if (!writer) fail(writer.error(), EXIT_FAILURE_GENERIC);
-    (*writer)->write(engine::to_json(engine.stats()));
-  }
-  if (!o.snapshot.empty()) {
-    if (auto drawn = write_scene_snapshot_png(log.snapshot(), o.snapshot); !drawn)
-      fail(drawn.error(), EXIT_FAILURE_GENERIC);
-    std::cout << "snapshot: " << o.snapshot << "\n";
-  }
+  finish_outputs(o, log, engine.stats(), std::move(telemetry));
 }
 
 }  // namespace
@@ -242,6 +296,11 @@ void add_run_command(CLI::App& app) {
   cmd->add_option("--snapshot", o->snapshot,
                   "PNG of the last frame with objects, seen from above the table");
   cmd->add_option("--telemetry-json", o->telemetry_json, "engine telemetry as JSON to FILE");
+  cmd->add_option(
+         "--on-bad-frame", o->on_bad_frame,
+         "a frame that fails (unreadable file, no table, ...): skip (count and report) or fail "
+         "(also exit 2 at the end)")
+      ->check(CLI::IsMember({"skip", "fail"}));
   cmd->add_flag(
       "--publish-objects", o->publish_objects,
       "publish every frame's objects on the iceoryx topic orthoflow/<graph>/objects (needs RouDi)");

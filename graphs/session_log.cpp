@@ -57,6 +57,10 @@ void SessionLog::record(const FrameBlock& block, std::uint64_t frame_id) noexcep
   ++summary_.frames;
   summary_.frames_with_table += s.table_found ? 1U : 0U;
   summary_.frames_with_error += s.error.empty() ? 0U : 1U;
+  if (!s.error.empty() && summary_.first_error.empty()) {
+    summary_.first_error = s.error;
+    summary_.first_error_frame = frame_id;
+  }
   summary_.object_views += s.object_count;
   for (std::uint32_t k = 0; k < s.object_count; ++k) {
     const ObjectRecord& o = s.objects[k];

@@ -35,6 +35,8 @@ struct SessionSummary {
   Score after_teaching;   ///< category taught: its label is right
   Score new_instances;    ///< subset of after_teaching: instances that were never taught themselves
   std::vector<std::string> taught;  ///< labels taught, in teaching order
+  FrameError first_error;           ///< the first error a frame reported (empty: none)
+  std::uint64_t first_error_frame = 0;
 };
 
 /// @brief The last frame with objects, in table-plane coordinates, for a top-view picture.
