@@ -1,5 +1,7 @@
 #include "learning/learner.hpp"
 
+#include "core/label_text.hpp"
+
 #include "learning/detail/learner_common.hpp"
 
 #include <algorithm>
@@ -12,6 +14,8 @@ const char* to_string(LearnError error) noexcept {
   switch (error) {
     case LearnError::EMPTY_LABEL:
       return "empty label: a category needs a name";
+    case LearnError::BAD_CHARACTERS:
+      return "label is not valid UTF-8 or holds a control character (newline, tab, NUL, ...)";
     case LearnError::LABEL_TOO_LONG:
       return "label longer than 63 bytes";
     case LearnError::NO_VIEWS:
@@ -31,11 +35,18 @@ const char* to_string(LearnError error) noexcept {
 }
 
 Result<void, LearnError> validate_label(std::string_view label) noexcept {
-  if (label.empty()) { return err(LearnError::EMPTY_LABEL); }
-  if (label.size() > LABEL_MAX_BYTES) { return err(LearnError::LABEL_TOO_LONG); }
-  // An embedded zero would silently cut the label short in Label::view().
-  if (label.find('\0') != std::string_view::npos) { return err(LearnError::EMPTY_LABEL); }
-  return {};
+  switch (core::check_label(label)) {  // the one label rule (core/label_text.hpp)
+    case core::LabelProblem::NONE:
+      return {};
+    case core::LabelProblem::EMPTY:
+      return err(LearnError::EMPTY_LABEL);
+    case core::LabelProblem::TOO_LONG:
+      return err(LearnError::LABEL_TOO_LONG);
+    case core::LabelProblem::NOT_UTF8:
+    case core::LabelProblem::CONTROL_CHARACTER:
+      return err(LearnError::BAD_CHARACTERS);
+  }
+  return err(LearnError::BAD_CHARACTERS);
 }
 
 Result<void, LearnError> validate_batch(DescriptorBatch views, std::size_t length,

@@ -51,6 +51,8 @@ struct Prediction {
 enum class LearnError : std::uint8_t {
   EMPTY_LABEL,     ///< the label is ""
   LABEL_TOO_LONG,  ///< the label has more than LABEL_MAX_BYTES bytes
+  BAD_CHARACTERS,  ///< the label is not valid UTF-8 or holds a control character
+                   ///< (core/label_text.hpp)
   NO_VIEWS,        ///< the batch holds no view
   WRONG_LENGTH,    ///< a descriptor's length differs from descriptor_length()
   NOT_FINITE,      ///< a descriptor value is NaN or infinite
@@ -61,7 +63,8 @@ enum class LearnError : std::uint8_t {
 /// @brief A sentence saying what was wrong, e.g. "label longer than 63 bytes".
 [[nodiscard]] const char* to_string(LearnError error) noexcept;
 
-/// @brief Checks a label: EMPTY_LABEL or LABEL_TOO_LONG, or success.
+/// @brief Checks a label with the one label rule (core::check_label): EMPTY_LABEL, LABEL_TOO_LONG
+/// or BAD_CHARACTERS, or success.
 [[nodiscard]] Result<void, LearnError> validate_label(std::string_view label) noexcept;
 
 /// @brief Several views of one object, row-major: view v is values[v * length .. (v + 1) * length).

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/fixed_text.hpp"
+#include "core/label_text.hpp"
 #include "core/rng.hpp"
 #include "core/spin_lock.hpp"
 #include "core/spsc_ring.hpp"
@@ -91,6 +92,22 @@ TEST(FixedText, TruncatesTerminatesAndCompares) {
   EXPECT_FALSE(checked.try_assign(std::string(TEXT_MAX_BYTES + 1, 'y')));  // would be cut: refused
   EXPECT_TRUE(checked.empty());
   EXPECT_FALSE(checked.try_assign(with_zero));
+}
+
+TEST(LabelText, OneRuleForEveryLabel) {
+  EXPECT_EQ(check_label("mug"), LabelProblem::NONE);
+  EXPECT_EQ(check_label("\xF0\x9F\x8D\xB5 cup"), LabelProblem::NONE);  // a 4-byte code point
+  EXPECT_EQ(check_label(std::string(TEXT_MAX_BYTES, 'a')), LabelProblem::NONE);
+  EXPECT_EQ(check_label(""), LabelProblem::EMPTY);
+  EXPECT_EQ(check_label(std::string(TEXT_MAX_BYTES + 1, 'a')), LabelProblem::TOO_LONG);
+  EXPECT_EQ(check_label("a\nb"), LabelProblem::CONTROL_CHARACTER);
+  EXPECT_EQ(check_label(std::string("a\0b", 3)), LabelProblem::CONTROL_CHARACTER);
+  EXPECT_EQ(check_label("\xC2\x9F"), LabelProblem::CONTROL_CHARACTER);  // C1
+  EXPECT_EQ(check_label("\x80"), LabelProblem::NOT_UTF8);               // stray continuation
+  EXPECT_EQ(check_label("\xE0\x80\xAF"), LabelProblem::NOT_UTF8);       // overlong
+  EXPECT_EQ(check_label("\xF4\x90\x80\x80"), LabelProblem::NOT_UTF8);   // beyond U+10FFFF
+  EXPECT_EQ(check_label("\xE2\x82"), LabelProblem::NOT_UTF8);           // cut short
+  static_assert(check_label("constexpr") == LabelProblem::NONE);
 }
 
 TEST(SpscRing, FullEmptyAndAllOrNothing) {

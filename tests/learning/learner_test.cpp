@@ -244,6 +244,14 @@ TEST(Learners, EveryLearnErrorIsReported) {
   EXPECT_TRUE(instance.teach(std::string(63, 'a'), batch({1, 0}, 2)));
   EXPECT_EQ(instance.teach(std::string(64, 'a'), batch({1, 0}, 2)).error(),
             LearnError::LABEL_TOO_LONG);
+  for (const std::string& bad :
+       {std::string("mug\nbowl"), std::string("a\tb"), std::string("a\0b", 3), std::string("\xC3"),
+        std::string("\xC0\xAF"), std::string("\xED\xA0\x80"), std::string("x\x7F"),
+        std::string("\xC2\x85")}) {
+    EXPECT_EQ(instance.teach(bad, batch({1, 0}, 2)).error(), LearnError::BAD_CHARACTERS) << bad;
+  }
+  InstanceLearner utf8(InstanceConfig{2});  // UTF-8 beyond ASCII is fine
+  EXPECT_TRUE(utf8.teach("tasse \xC3\xA0 caf\xC3\xA9", batch({1, 0}, 2)));
   EXPECT_EQ(instance.teach("a", batch({}, 2)).error(), LearnError::NO_VIEWS);
   EXPECT_EQ(instance.teach("a", batch({1, 0, 1}, 3)).error(), LearnError::WRONG_LENGTH);
   EXPECT_EQ(instance.teach("a", batch({1, 0, 1}, 2)).error(), LearnError::WRONG_LENGTH);
