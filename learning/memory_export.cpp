@@ -1,5 +1,6 @@
 // Export and import of the perceptual memory as JSON lines (format in docs/LEARNING.md): line 1 is
 // the header with the schema version and the representation parameters, then one line per view.
+#include <algorithm>
 #include <fstream>
 #include <nlohmann/json.hpp>
 
@@ -72,6 +73,67 @@ struct ImportGroup {
   std::vector<ViewRecord> views;
 };
 
+constexpr std::uint64_t FNV_OFFSET = 0xcbf29ce484222325ULL;
+
+// FNV-1a over @p text and a newline: the digest of an export file, line by line.
+std::uint64_t fnv1a(std::string_view text, std::uint64_t h) {
+  for (const char c : text) h = (h ^ static_cast<unsigned char>(c)) * 0x100000001b3ULL;
+  return (h ^ static_cast<unsigned char>('\n')) * 0x100000001b3ULL;
+}
+
+// The export header says how many views and categories follow; a file with fewer (cut short) or
+// more lines is refused. Headers without the counts (hand-written files) are taken as they are.
+Result<void, std::string> check_counts(const std::string& header_line, std::size_t views,
+                                       std::size_t categories) {
+  const json header = json::parse(header_line, nullptr, false);
+  const auto v = header.find("views"), c = header.find("categories");
+  if (v != header.end() && v->is_number_unsigned() && v->get<std::size_t>() != views) {
+    return err("the header says " + std::to_string(v->get<std::size_t>()) +
+               " views, the file has " + std::to_string(views) +
+               " (truncated?): nothing was imported");
+  }
+  if (c != header.end() && c->is_number_unsigned() && c->get<std::size_t>() != categories) {
+    return err("the header says " + std::to_string(c->get<std::size_t>()) +
+               " categories, the file has " + std::to_string(categories) +
+               ": nothing was imported");
+  }
+  return {};
+}
+
+std::string import_key(std::uint64_t digest) {
+  static constexpr char HEX[] = "0123456789abcdef";
+  std::string key = "i";
+  for (int shift = 60; shift >= 0; shift -= 4) key += HEX[(digest >> shift) & 0xFU];
+  return key;
+}
+
+// One synced batch for every category of the file plus the import marker; the index and the learner
+// take the categories only after it.
+Result<std::size_t, MemoryError> commit_import(PerceptualMemory::State& s,
+                                               const std::filesystem::path& file,
+                                               const std::vector<ImportGroup>& groups,
+                                               std::uint64_t digest, std::size_t count) {
+  std::string seen;
+  if (s.db->Get(leveldb::ReadOptions(), import_key(digest), &seen).ok()) {
+    return err(
+        memory_error(Code::BAD_IMPORT, file,
+                     "this export was imported into the store already: nothing was imported"));
+  }
+  leveldb::WriteBatch batch;
+  CategoryId next_id = s.next_id;
+  std::vector<StagedTeach> staged;
+  for (const ImportGroup& g : groups) {
+    auto one = stage_teach(s, g.label, g.views, next_id, batch);
+    if (!one) return err(one.error());
+    staged.push_back(std::move(*one));
+  }
+  batch.Put(std::string(KEY_NEXT_ID), encode_u32(next_id));
+  batch.Put(import_key(digest), std::to_string(count));
+  if (auto r = write_synced(s, batch, "import " + file.string()); !r) return err(r.error());
+  for (const StagedTeach& t : staged) apply_staged(s, t);
+  return count;
+}
+
 }  // namespace
 
 Result<std::size_t, MemoryError> PerceptualMemory::export_to(
@@ -109,6 +171,7 @@ Result<std::size_t, MemoryError> PerceptualMemory::import_from(const std::filesy
   std::uint32_t version = 0;
   std::string why;
   const auto params = std::getline(in, line) ? decode_schema(line, version, why) : std::nullopt;
+  const std::string header_line = line;
   if (!params || version != MEMORY_SCHEMA_VERSION || !(*params == state_->cfg.descriptor)) {
     const std::string reason =
         !params ? (why.empty() ? "empty file" : why)
@@ -117,10 +180,14 @@ Result<std::size_t, MemoryError> PerceptualMemory::import_from(const std::filesy
             : "file has " + params->describe() + ", store has " + state_->cfg.descriptor.describe();
     return err(memory_error(Code::BAD_IMPORT, file, "line 1: " + reason));
   }
-  // Everything is parsed and checked before the first teach, so a bad line imports nothing.
+  // Everything is parsed and checked first, then written in ONE synced batch with a marker of this
+  // file's content: a bad line, a short file or a kill imports nothing, and the same export twice
+  // is refused the second time.
   std::vector<ImportGroup> groups;
   std::size_t count = 0;
+  std::uint64_t digest = fnv1a(line, FNV_OFFSET);
   for (std::size_t number = 2; std::getline(in, line); ++number) {
+    digest = fnv1a(line, digest);
     if (line.empty()) { continue; }
     std::string label;
     ViewRecord v;
@@ -134,10 +201,11 @@ Result<std::size_t, MemoryError> PerceptualMemory::import_from(const std::filesy
     g->views.push_back(std::move(v));
     ++count;
   }
-  for (const ImportGroup& g : groups) {
-    if (auto r = teach(g.label, g.views); !r) { return err(r.error()); }
+  if (in.bad()) return err(memory_error(Code::FILE_FAILED, file, "read failed"));
+  if (auto r = check_counts(header_line, count, groups.size()); !r) {
+    return err(memory_error(Code::BAD_IMPORT, file, r.error()));
   }
-  return count;
+  return commit_import(*state_, file, groups, digest, count);
 }
 
 }  // namespace orthoflow::learning

@@ -8,7 +8,6 @@
 #include "learning/perceptual_memory.hpp"
 
 namespace orthoflow::learning {
-namespace {
 
 using Code = MemoryError::Code;
 
@@ -27,6 +26,8 @@ Result<void, MemoryError> write_synced(PerceptualMemory::State& s, leveldb::Writ
   ++s.writes;
   return {};
 }
+
+namespace {
 
 // Every check the learner would make, done before anything is written, so a refused teach leaves
 // both the store and the learner untouched.
@@ -57,45 +58,62 @@ Result<std::vector<float>, MemoryError> checked_values(const PerceptualMemory::S
 
 }  // namespace
 
-Result<CategoryId, MemoryError> PerceptualMemory::teach(std::string_view label,
-                                                        std::span<const ViewRecord> views) {
-  State& s = *state_;
+Result<StagedTeach, MemoryError> stage_teach(PerceptualMemory::State& s, std::string_view label,
+                                             std::span<const ViewRecord> views, CategoryId& next_id,
+                                             leveldb::WriteBatch& batch) {
   auto flat_result = checked_values(s, label, views);
   if (!flat_result) { return err(flat_result.error()); }
   const std::size_t length = s.learner->descriptor_length();
   const IndexedCategory* existing = s.find(label);
-  IndexedCategory next = existing != nullptr
-                             ? *existing
-                             : IndexedCategory{s.next_id, {0, 0, std::string(label)}, {0, {}}};
+  StagedTeach staged{existing != nullptr
+                         ? *existing
+                         : IndexedCategory{next_id, {0, 0, std::string(label)}, {0, {}}},
+                     existing == nullptr, std::move(*flat_result)};
+  IndexedCategory& next = staged.next;
+  if (staged.fresh) ++next_id;
   if (next.model.sums.empty()) { next.model.sums.assign(length, 0.0); }
-  leveldb::WriteBatch batch;
   for (const ViewRecord& v : views) {
     batch.Put(view_key(next.id, next.record.next_seq++), encode_view(v, s.cfg.descriptor));
   }
   next.record.views += static_cast<std::uint32_t>(views.size());
   // Thesis Bayes update a_k <- a_k + x' in the same batch as the views, so model and views never
   // disagree.
-  const DescriptorBatch batch_views{*flat_result, length};
-  accumulate_views(batch_views, next.model.sums);
+  accumulate_views(DescriptorBatch{staged.values, length}, next.model.sums);
   next.model.seen += views.size();
   batch.Put(category_key(KIND_CATEGORY, next.id), encode_category(next.record));
   batch.Put(category_key(KIND_MODEL, next.id), encode_model(next.model));
-  if (existing == nullptr) { batch.Put(std::string(KEY_NEXT_ID), encode_u32(s.next_id + 1)); }
+  return staged;
+}
+
+void apply_staged(PerceptualMemory::State& s, const StagedTeach& staged) {
+  // Durable from here on: update the index, then the learner (which publishes the snapshot for
+  // ask()).
+  const std::string& label = staged.next.record.label;
+  if (staged.fresh) {
+    s.next_id = std::max(s.next_id, staged.next.id + 1);
+    s.index.push_back(staged.next);
+  } else {
+    *s.find(label) = staged.next;
+  }
+  const DescriptorBatch views{staged.values, s.learner->descriptor_length()};
+  const auto learned = s.learner->teach(label, views);
+  OF_ENFORCE(learned.has_value() && *learned == staged.next.id,
+             "learner and memory disagree on a category id");
+}
+
+Result<CategoryId, MemoryError> PerceptualMemory::teach(std::string_view label,
+                                                        std::span<const ViewRecord> views) {
+  State& s = *state_;
+  leveldb::WriteBatch batch;
+  CategoryId next_id = s.next_id;
+  auto staged = stage_teach(s, label, views, next_id, batch);
+  if (!staged) return err(staged.error());
+  if (staged->fresh) batch.Put(std::string(KEY_NEXT_ID), encode_u32(next_id));
   if (auto r = write_synced(s, batch, "teach \"" + std::string(label) + "\""); !r) {
     return err(r.error());
   }
-  // Durable from here on: update the index, then the learner (which publishes the snapshot for
-  // ask()).
-  if (existing == nullptr) {
-    ++s.next_id;
-    s.index.push_back(next);
-  } else {
-    *s.find(label) = next;
-  }
-  const auto learned = s.learner->teach(label, batch_views);
-  OF_ENFORCE(learned.has_value() && *learned == next.id,
-             "learner and memory disagree on a category id");
-  return next.id;
+  apply_staged(s, *staged);
+  return staged->next.id;
 }
 
 Result<CategoryId, MemoryError> PerceptualMemory::correct(std::string_view label,

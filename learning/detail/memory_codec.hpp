@@ -7,6 +7,8 @@
 ///   id (u32) "c" id                  category: u64 next view sequence, u32 live views, label bytes
 ///   "m" id                  Bayes model: u64 N_k, u32 length, length x f64 sums of descriptors
 ///   "v" id seq              view: see encode_view()
+///   "i" digest (16 hex)     an imported export file (FNV-1a of its lines): a second import is
+///   refused
 /// Values are little-endian. Internal to learning/.
 #include <cstdint>
 #include <optional>

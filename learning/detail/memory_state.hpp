@@ -3,6 +3,7 @@
 /// @brief The state behind PerceptualMemory (shared by perceptual_memory.cpp and
 /// memory_export.cpp). Internal to learning/.
 #include <leveldb/db.h>
+#include <leveldb/write_batch.h>
 
 #include <memory>
 #include <string>
@@ -45,6 +46,29 @@ struct PerceptualMemory::State {
     return nullptr;
   }
 };
+
+/// @brief A teach written into a batch but not applied yet: the memory's index and learner change
+/// only after the batch's synced write (teach, and import's one batch for every category).
+struct StagedTeach {
+  IndexedCategory next;
+  bool fresh = false;         ///< a new category (next.id taken from the running next id)
+  std::vector<float> values;  ///< the views' descriptors, row-major
+};
+
+/// @brief Checks @p views, adds their records to @p batch and returns what to apply after the
+/// write.
+/// @p next_id is the running next category id (advanced for a new category). Nothing else changes.
+[[nodiscard]] Result<StagedTeach, MemoryError> stage_teach(PerceptualMemory::State& s,
+                                                           std::string_view label,
+                                                           std::span<const ViewRecord> views,
+                                                           CategoryId& next_id,
+                                                           leveldb::WriteBatch& batch);
+/// @brief After the synced write: the index and the learner take the staged teach.
+void apply_staged(PerceptualMemory::State& s, const StagedTeach& staged);
+/// @brief Writes @p batch synced (READ_ONLY and WRITE_FAILED name @p what).
+[[nodiscard]] Result<void, MemoryError> write_synced(PerceptualMemory::State& s,
+                                                     leveldb::WriteBatch& batch,
+                                                     const std::string& what);
 
 /// @brief The bytes of a LevelDB slice.
 [[nodiscard]] inline std::string_view as_view(const leveldb::Slice& s) noexcept {
