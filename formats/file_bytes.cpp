@@ -2,8 +2,10 @@
 
 #include <cerrno>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <memory>
+#include <string>
 
 namespace orthoflow::formats {
 namespace {
@@ -19,7 +21,8 @@ IoError io_error(IoError::Code code, const std::filesystem::path& path, const ch
 
 }  // namespace
 
-Result<std::vector<char>, IoError> read_file_bytes(const std::filesystem::path& path) {
+Result<std::vector<char>, IoError> read_file_bytes(const std::filesystem::path& path,
+                                                   std::size_t max_bytes) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) {
     return err(IoError{IoError::Code::OPEN_FAILED, path.string() + ": is a directory"});
@@ -30,6 +33,11 @@ Result<std::vector<char>, IoError> read_file_bytes(const std::filesystem::path& 
   char chunk[1 << 16];
   std::size_t got = 0;
   while ((got = std::fread(chunk, 1, sizeof(chunk), file.get())) > 0) {
+    if (bytes.size() + got > max_bytes) {
+      return err(IoError{IoError::Code::TOO_LARGE,
+                         path.string() + ": larger than the input limit of " +
+                             std::to_string(max_bytes) + " bytes (ORTHOFLOW_MAX_INPUT_BYTES)"});
+    }
     bytes.insert(bytes.end(), chunk, chunk + got);
   }
   if (std::ferror(file.get()) != 0) {

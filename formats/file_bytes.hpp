@@ -5,13 +5,17 @@
 #include <string_view>
 #include <vector>
 
+#include "core/input_limit.hpp"
 #include "core/result.hpp"
 #include "formats/io_error.hpp"
 
 namespace orthoflow::formats {
 
-/// @brief Reads the whole file. Errors name the path and the reason (errno text).
-[[nodiscard]] Result<std::vector<char>, IoError> read_file_bytes(const std::filesystem::path& path);
+/// @brief Reads the whole file, at most @p max_bytes of it: a longer file (or an endless one such
+/// as /dev/zero) is TOO_LARGE, never an allocation without bound. Errors name the path and the
+/// reason.
+[[nodiscard]] Result<std::vector<char>, IoError> read_file_bytes(
+    const std::filesystem::path& path, std::size_t max_bytes = core::max_input_bytes());
 
 /// @brief Writes @p bytes to a temporary file beside @p path, then renames it over @p path,
 /// so that readers never see a half-written file.

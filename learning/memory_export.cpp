@@ -4,6 +4,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "core/input_limit.hpp"
 #include "learning/detail/memory_state.hpp"
 #include "learning/detail/store_dir.hpp"
 #include "learning/perceptual_memory.hpp"
@@ -74,6 +75,23 @@ struct ImportGroup {
 };
 
 constexpr std::uint64_t FNV_OFFSET = 0xcbf29ce484222325ULL;
+constexpr std::size_t MAX_LINE_BYTES = 1 << 20;  // a view line is ~15 KB at 20 bins
+
+// std::getline with bounds: a line longer than MAX_LINE_BYTES, or more than core::max_input_bytes()
+// read in all, stops the read (an endless input such as /dev/zero never grows a string without
+// end).
+enum class LineRead { LINE, END, TOO_LONG };
+LineRead read_line(std::istream& in, std::string& line, std::size_t& total) {
+  line.clear();
+  std::streambuf* buffer = in.rdbuf();
+  for (int c = buffer->sbumpc(); c != std::char_traits<char>::eof(); c = buffer->sbumpc()) {
+    if (++total > core::max_input_bytes() || line.size() == MAX_LINE_BYTES)
+      return LineRead::TOO_LONG;
+    if (c == '\n') return LineRead::LINE;
+    line.push_back(static_cast<char>(c));
+  }
+  return line.empty() ? LineRead::END : LineRead::LINE;
+}
 
 // FNV-1a over @p text and a newline: the digest of an export file, line by line.
 std::uint64_t fnv1a(std::string_view text, std::uint64_t h) {
@@ -170,7 +188,11 @@ Result<std::size_t, MemoryError> PerceptualMemory::import_from(const std::filesy
   std::string line;
   std::uint32_t version = 0;
   std::string why;
-  const auto params = std::getline(in, line) ? decode_schema(line, version, why) : std::nullopt;
+  std::size_t total = 0;
+  const LineRead first = read_line(in, line, total);
+  if (first == LineRead::TOO_LONG)
+    return err(memory_error(Code::BAD_IMPORT, file, "line 1 is too long"));
+  const auto params = first == LineRead::LINE ? decode_schema(line, version, why) : std::nullopt;
   const std::string header_line = line;
   if (!params || version != MEMORY_SCHEMA_VERSION || !(*params == state_->cfg.descriptor)) {
     const std::string reason =
@@ -186,7 +208,8 @@ Result<std::size_t, MemoryError> PerceptualMemory::import_from(const std::filesy
   std::vector<ImportGroup> groups;
   std::size_t count = 0;
   std::uint64_t digest = fnv1a(line, FNV_OFFSET);
-  for (std::size_t number = 2; std::getline(in, line); ++number) {
+  LineRead got = LineRead::LINE;
+  for (std::size_t number = 2; (got = read_line(in, line, total)) == LineRead::LINE; ++number) {
     digest = fnv1a(line, digest);
     if (line.empty()) { continue; }
     std::string label;
@@ -201,7 +224,13 @@ Result<std::size_t, MemoryError> PerceptualMemory::import_from(const std::filesy
     g->views.push_back(std::move(v));
     ++count;
   }
-  if (in.bad()) return err(memory_error(Code::FILE_FAILED, file, "read failed"));
+  if (got == LineRead::TOO_LONG) {
+    return err(memory_error(Code::BAD_IMPORT, file,
+                            "a line longer than " + std::to_string(MAX_LINE_BYTES) +
+                                " bytes, or more than the input limit of " +
+                                std::to_string(core::max_input_bytes()) +
+                                " bytes: nothing was imported"));
+  }
   if (auto r = check_counts(header_line, count, groups.size()); !r) {
     return err(memory_error(Code::BAD_IMPORT, file, r.error()));
   }
