@@ -4,6 +4,7 @@
 #include <functional>
 #include <map>
 #include <optional>
+#include <set>
 
 #include <unistd.h>
 
@@ -80,7 +81,13 @@ std::optional<GraphError> resolve_edges(Graph& graph) {
   const GraphSpec& spec = graph.spec;
   std::map<std::string, std::size_t> index;
   for (std::size_t i = 0; i < spec.nodes.size(); ++i) index[spec.nodes[i].name] = i;
+  std::set<std::string> seen;  // the same edge twice would deliver every message twice
   for (const auto& e : spec.edges) {
+    if (!seen.insert(e.from_node + "." + e.from_port + "->" + e.to_node + "." + e.to_port).second) {
+      return error_at(spec, Code::BAD_STRUCTURE, e.line,
+                      "edge " + e.from_node + "." + e.from_port + " -> " + e.to_node + "." +
+                          e.to_port + " is listed twice");
+    }
     const auto from = index.find(e.from_node);
     const auto to = index.find(e.to_node);
     if (from == index.end() || to == index.end()) {

@@ -53,6 +53,21 @@ std::size_t whole(const YAML::Node& node, const std::string& file, const std::st
   return static_cast<std::size_t>(value);
 }
 
+// A graph or node name: letters, digits, '_', '-' and '.', at most 64 of them. Names end up in DOT
+// files, iceoryx topics (orthoflow/<graph>/objects), telemetry and error messages, where a quote, a
+// slash or a space would break them.
+std::string identifier(const YAML::Node& node, const std::string& file, const std::string& what) {
+  const std::string name = scalar(node, file, what);
+  const bool ok =
+      !name.empty() && name.size() <= 64 && std::all_of(name.begin(), name.end(), [](char c) {
+        return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '_' || c == '-' || c == '.';
+      });
+  if (!ok)
+    fail(Code::BAD_PARAMETER, file, node,
+         what + " '" + name + "' must be 1-64 letters, digits, '_', '-' or '.'");
+  return name;
+}
+
 void parse_header(const YAML::Node& graph, GraphSpec& spec) {
   if (!graph) return;
   if (!graph.IsMap()) fail(Code::BAD_STRUCTURE, spec.file, graph, "'graph' must be a map");
@@ -60,7 +75,7 @@ void parse_header(const YAML::Node& graph, GraphSpec& spec) {
     const std::string key = item.first.Scalar();
     const YAML::Node& value = item.second;
     if (key == "name") {
-      spec.name = scalar(value, spec.file, "graph.name");
+      spec.name = identifier(value, spec.file, "graph.name");
     } else if (key == "period_ms") {
       spec.period_ns =
           static_cast<std::int64_t>(number(value, spec.file, "graph.period_ms", 3.6e6) * 1e6);
@@ -88,7 +103,7 @@ void parse_header(const YAML::Node& graph, GraphSpec& spec) {
 void parse_node_key(const std::string& key, const YAML::Node& value, NodeSpec& node,
                     const std::string& file) {
   if (key == "name") {
-    node.name = scalar(value, file, "node name");
+    node.name = identifier(value, file, "node name");
   } else if (key == "kind") {
     node.kind = scalar(value, file, "node kind");
   } else if (key == "policy") {

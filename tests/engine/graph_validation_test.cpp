@@ -140,3 +140,24 @@ TEST(ParamMap, TypedGettersReportKeyAndLine) {
 
 }  // namespace
 }  // namespace orthoflow::engine
+
+namespace orthoflow::engine {
+namespace {
+
+TEST(GraphValidation, DuplicateEdgesAndUnsafeNamesAreRefusedWithTheirLine) {
+  // The same edge twice would deliver every message twice (a sink counted 40 messages for 20
+  // frames).
+  expect_error(HEADER + SRC + SINK + "edges:\n  - src.out -> sink.in\n  - src.out -> sink.in\n",
+               Code::BAD_STRUCTURE, 9, "listed twice");
+  // Names end up in DOT, iceoryx topics and messages: a quote, a slash or a space is refused.
+  expect_error(
+      "graph:\n  name: 'a\"b'\n  pool: {block_bytes: 256, blocks: 4}\nnodes:\n" + SRC + SINK,
+      Code::BAD_PARAMETER, 2, "graph.name");
+  expect_error(HEADER + "  - {name: 'my node', kind: ticker}\n" + SINK, Code::BAD_PARAMETER, 5,
+               "node name");
+  expect_error(HEADER + SRC + "  - {name: a/b, kind: count}\n", Code::BAD_PARAMETER, 6,
+               "node name");
+}
+
+}  // namespace
+}  // namespace orthoflow::engine
