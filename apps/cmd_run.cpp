@@ -137,6 +137,12 @@ std::string percent(const graphs::Score& s) {
 
 void print_summary(const graphs::SessionSummary& s, const engine::GraphStats& stats,
                    const graphs::LearningService& l) {
+  if (s.frames == 0 && stats.frames_done.load() > 0) {  // e.g. graphs/example_pipeline.yaml
+    std::cout << "frames:      " << stats.frames_done.load() << " processed, "
+              << stats.total_drops()
+              << " dropped (the graph has no session_log node: no tabletop summary)\n";
+    return;
+  }
   std::cout << "frames:      " << s.frames << " processed, " << stats.total_drops() << " dropped ("
             << stats.source_drops.load() << " at the source), " << s.frames_with_table
             << " with a table, " << stats.deadline_misses.load() << " over the period, "
