@@ -29,7 +29,7 @@ struct FixedText {
   /// @brief Stores @p s, truncated to CAPACITY bytes (and at an embedded zero, as view() reads it).
   void assign(std::string_view s) noexcept {
     const std::size_t n = std::min(s.size(), CAPACITY);
-    std::memcpy(chars.data(), s.data(), n);
+    if (n > 0) std::memcpy(chars.data(), s.data(), n);  // an empty view may hold a null pointer
     std::fill(chars.begin() + static_cast<std::ptrdiff_t>(n), chars.end(), '\0');
   }
   /// @brief Stores @p s only if it fits whole (at most CAPACITY bytes, no embedded zero); otherwise

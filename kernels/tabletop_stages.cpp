@@ -142,12 +142,15 @@ Result<PlaneInput, SegmentationError> PlaneInputStage::run(CloudView cloud,
     const std::uint32_t s = p.organized_stride;
     const std::size_t dense_max = cells(cloud.width, s) * cells(cloud.height, s);
     const std::size_t sparse_max = cells(cloud.width, 2 * s) * cells(cloud.height, 2 * s);
-    if (out.size() < dense_max + sparse_max) {
-      return err(fail(C::OUTPUT_TOO_SMALL, 0, static_cast<double>(dense_max + sparse_max)));
+    if (out.size() < dense_max) {
+      return err(fail(C::OUTPUT_TOO_SMALL, 0, static_cast<double>(dense_max)));
     }
     const std::size_t dense = pixel_subsample(cloud, s, p.roi, out);
+    // No room for the scoring sample after the dense one (stride 1 on a full frame): RANSAC then
+    // scores on the dense sample itself, as for small frames.
     const PointsSpan rest{out.x.subspan(dense), out.y.subspan(dense), out.z.subspan(dense)};
-    const std::size_t sparse = pixel_subsample(cloud, 2 * s, p.roi, rest);
+    const std::size_t sparse =
+        out.size() >= dense_max + sparse_max ? pixel_subsample(cloud, 2 * s, p.roi, rest) : 0;
     return PlaneInput{first(out, 0, dense), first(out, dense, sparse), dense, ms_since(start), 0.0};
   }
   if (out.size() < n) return err(fail(C::OUTPUT_TOO_SMALL, 0, static_cast<double>(n)));

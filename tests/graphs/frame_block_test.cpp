@@ -45,6 +45,35 @@ TEST(FrameBlock, RegionsAreAlignedAndDisjoint) {
                                         engine::FRAME_FIELD_RGB | engine::FRAME_FIELD_LABEL));
 }
 
+TEST(FrameError, TheFirstErrorAFrameMeetsIsTheOneItReports) {
+  FrameError e;
+  EXPECT_TRUE(e.empty());
+  EXPECT_FALSE(e.set(FrameError::Code::NONE, "source"));
+  EXPECT_TRUE(e.set(FrameError::Code::FILE_UNREADABLE, "source", 3));
+  e.detail.assign("a.pcd: truncated");
+  const kernels::SegmentationError later{kernels::SegmentationError::Code::NO_PLANE, 1, 0.0, 0, 0};
+  EXPECT_FALSE(e.set("table", later));  // a later stage does not overwrite it
+  EXPECT_EQ(e.code, FrameError::Code::FILE_UNREADABLE);
+  EXPECT_EQ(e.to_string(), "source: FILE_UNREADABLE: a.pcd: truncated");
+  FrameError seg;
+  EXPECT_TRUE(seg.set("table", later));
+  EXPECT_EQ(seg.segmentation.code, kernels::SegmentationError::Code::NO_PLANE);
+  EXPECT_NE(seg.to_string().find("table: SEGMENTATION: segmentation: NO_PLANE: ransac_plane"),
+            std::string::npos)
+      << seg.to_string();
+  for (const auto c : {FrameError::Code::NONE, FrameError::Code::FRAME_TOO_LARGE,
+                       FrameError::Code::FILE_UNREADABLE, FrameError::Code::INVALID_FRAME,
+                       FrameError::Code::SEGMENTATION}) {
+    EXPECT_NE(FrameError::name(c), "UNKNOWN");
+  }
+  FrameError big;
+  EXPECT_TRUE(big.set(FrameError::Code::FRAME_TOO_LARGE, "source", 0, 400000.0));
+  EXPECT_EQ(big.to_string(), "source: FRAME_TOO_LARGE: 400000 points");
+  FrameError invalid;
+  EXPECT_TRUE(invalid.set(FrameError::Code::INVALID_FRAME, "preprocess", 2));
+  EXPECT_EQ(invalid.to_string(), "preprocess: INVALID_FRAME: frame error 2");
+}
+
 TEST(FrameBlock, TextTruncatesAndTerminates) {
   Text t;
   EXPECT_TRUE(t.empty());
