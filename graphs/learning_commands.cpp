@@ -36,16 +36,21 @@ std::int64_t LessonDesk::find_object(const FrameState& s, const LearningCommand&
   return best;
 }
 
+// A lesson needs the object's descriptor of this frame; without one the sender is told
+// NOT_DESCRIBED.
+bool LessonDesk::described(const ObjectRecord& o, LearningAck& ack) noexcept {
+  if (o.described && o.descriptor_length == service_.descriptor_length()) return true;
+  ack.outcome = Outcome::NOT_DESCRIBED;
+  if (ack.sequence != 0) service_.acknowledge(ack);
+  return false;
+}
+
 LearningAck LessonDesk::teach_object(const FrameBlock& block, std::uint32_t k,
                                      std::string_view label, LearningAck ack,
                                      std::int64_t stamp) noexcept {
   ObjectRecord& o = block.state().objects[k];
   ack.track_id = o.track_id;
-  if (!o.described || o.descriptor_length != service_.descriptor_length()) {
-    ack.outcome = Outcome::NOT_DESCRIBED;
-    if (ack.sequence != 0) service_.acknowledge(ack);
-    return ack;
-  }
+  if (!described(o, ack)) return ack;
   const auto current = block.descriptor(k).first(o.descriptor_length);
   std::size_t views = 1;
   TrackMemory* t = o.track_id == 0 ? nullptr : memories_.find(o.track_id);
@@ -80,11 +85,7 @@ void LessonDesk::correct(const FrameBlock& block, std::int64_t k, std::string_vi
                          LearningAck ack) noexcept {
   ObjectRecord& o = block.state().objects[static_cast<std::size_t>(k)];
   ack.track_id = o.track_id;
-  if (!o.described || o.descriptor_length != service_.descriptor_length()) {
-    ack.outcome = Outcome::NOT_DESCRIBED;
-    service_.acknowledge(ack);
-    return;
-  }
+  if (!described(o, ack)) return;
   const auto stamp = static_cast<std::int64_t>(ack.frame_id);
   ack = service_.teach(label,
                        block.descriptor(static_cast<std::size_t>(k)).first(o.descriptor_length),

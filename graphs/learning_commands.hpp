@@ -30,6 +30,7 @@ class LessonDesk {
              std::uint64_t frame_id) noexcept;
 
  private:
+  [[nodiscard]] bool described(const ObjectRecord& o, LearningAck& ack) noexcept;
   [[nodiscard]] std::int64_t find_object(const FrameState& s,
                                          const LearningCommand& c) const noexcept;
   void answer(const FrameBlock& block, std::int64_t k, LearningAck ack) noexcept;
