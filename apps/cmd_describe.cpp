@@ -38,7 +38,7 @@ struct Described {
 };
 
 nlohmann::json flags_json(std::uint32_t flags) {
-  static const std::array<std::pair<std::uint32_t, const char*>, 7> NAMES{{
+  static const std::array<std::pair<std::uint32_t, const char*>, 8> NAMES{{
       {kernels::FEW_POINTS, "few_points"},
       {kernels::COLLINEAR, "collinear"},
       {kernels::COPLANAR, "coplanar"},
@@ -46,6 +46,7 @@ nlohmann::json flags_json(std::uint32_t flags) {
       {kernels::SIGN_AMBIGUOUS, "sign_ambiguous"},
       {kernels::NAN_IGNORED, "nan_ignored"},
       {kernels::EMPTY_VIEW, "empty_view"},
+      {kernels::FAR_POINTS_DROPPED, "far_points_dropped"},
   }};
   nlohmann::json out = nlohmann::json::array();
   for (const auto& [bit, name] : NAMES) {
@@ -66,6 +67,7 @@ nlohmann::json to_json(const DescribeOptions& o, const Described& d) {
           {"bbox", floats_json(r.bbox)},
           {"order", order},
           {"points_used", r.points_used},
+          {"far_points", r.far_points},
           {"flags", flags_json(r.flags)},
           {"reliable", (r.flags & kernels::FRAME_UNRELIABLE) == 0U},
           {"side", floats_json(std::array<float, 1>{r.side})[0]},
@@ -76,6 +78,7 @@ void print_text(const nlohmann::json& j) {
   std::cout << "file:        " << j["file"].get<std::string>()
             << "\nmode:        " << j["mode"].get<std::string>() << " (" << j["bins"] << " bins, "
             << j["descriptor"].size() << " values)\npoints used: " << j["points_used"]
+            << " (far points left out: " << j["far_points"] << ")"
             << "\norder:       " << j["order"].dump() << "\nbbox:        " << j["bbox"].dump()
             << "\nflags:       " << j["flags"].dump() << "\nframe:       " << j["frame"].dump()
             << "\ndescriptor:  " << j["descriptor"].dump() << '\n';

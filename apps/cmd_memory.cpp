@@ -57,6 +57,9 @@ learning::PerceptualMemory open_memory(const MemoryOptions& o, learning::OpenMod
         memory_result.error().code == learning::MemoryError::Code::CORRUPT;
     fail(memory_result.error().to_string(), bad_input ? EXIT_BAD_INPUT : EXIT_FAILURE_GENERIC);
   }
+  for (const std::string& warning : memory_result->open_warnings()) {
+    std::cerr << "orthoflow memory: warning: " << o.db << ": " << warning << '\n';
+  }
   return std::move(memory_result).value();
 }
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <vector>
 
 namespace orthoflow::graphs {
@@ -45,6 +46,10 @@ Result<std::unique_ptr<LearningService>, std::string> LearningService::open(
   if (settings.db) {
     auto memory = learning::PerceptualMemory::open(*settings.db, cfg);
     if (!memory) return err("learning: " + memory.error().to_string());
+    for (const std::string& warning : memory->open_warnings()) {
+      std::fprintf(stderr, "orthoflow: learning: warning: %s: %s\n", settings.db->c_str(),
+                   warning.c_str());
+    }
     s->memory_ = std::make_unique<learning::PerceptualMemory>(std::move(*memory));
     s->worker_ = std::thread([raw = s.get()] { raw->worker_loop(); });
   } else if (cfg.learner == learning::LearnerKind::BAYES) {

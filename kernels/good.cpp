@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <new>
 
 #include "kernels/detail/good_kernel.hpp"
 #include "kernels/detail/good_order.hpp"
+#include "kernels/far_points.hpp"
 
 namespace orthoflow::kernels {
 
@@ -106,11 +108,19 @@ std::array<int, 3> choose_signs(PointsView points, const GoodConfig& cfg, const 
 }
 
 template <class FrameFn, class StatsFn, class BinFn>
-Result<GoodResult, GoodError> run_good(PointsView points, const GoodConfig& cfg,
+Result<GoodResult, GoodError> run_good(PointsView all_points, const GoodConfig& cfg,
                                        GoodScratch& scratch, std::span<float> out,
                                        FrameFn&& frame_fn, StatsFn&& stats_fn,
                                        BinFn&& bin_fn) noexcept {
-  if (const auto bad = validate(points, cfg, scratch, out)) { return err(*bad); }
+  if (const auto bad = validate(all_points, cfg, scratch, out)) { return err(*bad); }
+  const FarPoints far = find_far_points(all_points);
+  PointsView points = all_points;
+  if (far.count > 0) {
+    const PointsSpan near = scratch.near_points(all_points.size() - far.count);
+    if (near.size() != all_points.size() - far.count) { return err(GoodError::OUT_OF_MEMORY); }
+    copy_near_points(all_points, far, near);
+    points = near;
+  }
   const auto frame_result = frame_fn(points);
   if (!frame_result) { return err(GoodError::NO_FINITE_POINTS); }
   const PcaFrame& f = frame_result.value();
@@ -142,7 +152,9 @@ Result<GoodResult, GoodError> run_good(PointsView points, const GoodConfig& cfg,
   for (std::size_t a = 0; a < 3; ++a) { r.eigenvalues[a] = static_cast<float>(f.eigenvalues[a]); }
   r.side = static_cast<float>(side);
   r.points_used = f.finite;
+  r.far_points = far.count;
   if (o.empty_view) { r.flags |= EMPTY_VIEW; }
+  if (far.count > 0) { r.flags |= FAR_POINTS_DROPPED; }
   return r;
 }
 
@@ -174,8 +186,18 @@ const char* to_string(GoodError error) noexcept {
       return "compute_good: descriptor_out holds fewer than 3*bins*bins values";
     case GoodError::SCRATCH_TOO_SMALL:
       return "compute_good: the GoodScratch was made for fewer bins than requested";
+    case GoodError::OUT_OF_MEMORY:
+      return "compute_good: out of memory for a copy of the view without its far points";
   }
   return "compute_good: unknown error";
+}
+
+PointsSpan GoodScratch::near_points(std::size_t n) noexcept {
+  try {
+    if (near_.size() < 3 * n) { near_.resize(3 * n); }
+  } catch (const std::bad_alloc&) { return {}; }
+  const std::span<float> all(near_);
+  return {all.subspan(0, n), all.subspan(n, n), all.subspan(2 * n, n)};
 }
 
 Result<GoodResult, GoodError> compute_good_scalar(PointsView points, const GoodConfig& cfg,

@@ -71,7 +71,8 @@ struct GoodResult {
   std::array<float, 3> eigenvalues{};  ///< lambda1 >= lambda2 >= lambda3
   std::array<int, 3> signs{};          ///< signs applied to (v1, v2, v3) to get (X, Y, Z)
   float side = 0.0F;                   ///< square side L = largest edge + 0.02 m
-  std::size_t points_used = 0;         ///< finite points
+  std::size_t points_used = 0;         ///< finite points the frame and the projections used
+  std::size_t far_points = 0;          ///< finite points left out as far (kernels/far_points.hpp)
   std::uint32_t flags = 0;  ///< FrameFlag bits (FRAME_UNRELIABLE: do not trust invariance)
 };
 
@@ -83,6 +84,7 @@ enum class GoodError : std::uint8_t {
   BAD_THRESHOLD,      ///< the threshold is negative or not finite
   OUTPUT_TOO_SMALL,   ///< descriptor_out holds fewer than 3 n^2 values
   SCRATCH_TOO_SMALL,  ///< the scratch was made for fewer bins than requested
+  OUT_OF_MEMORY,      ///< the scratch could not grow to hold a view without its far points
 };
 /// @brief What the error means, as a sentence naming compute_good and the offending value's role.
 [[nodiscard]] const char* to_string(GoodError error) noexcept;
@@ -105,23 +107,31 @@ class GoodScratch {
   /// @brief The whole buffer (3 n^2 counts in canonical order, then 3 drop counters); for
   /// compute_good() only.
   [[nodiscard]] std::span<std::uint32_t> buffer() noexcept { return counts_; }
+  /// @brief Room for a copy of @p n points (a view without its far points); for compute_good()
+  /// only. Grows (allocates) only when a view with far points is larger than any before it.
+  /// @return the room, or an empty span when memory ran out.
+  [[nodiscard]] PointsSpan near_points(std::size_t n) noexcept;
 
  private:
   std::size_t max_bins_;
   std::vector<std::uint32_t> counts_;
+  std::vector<float> near_;  ///< x, y and z of near_points(), one third each
 };
 
-/// @brief Computes the GOOD descriptor of the finite points of @p points.
+/// @brief Computes the GOOD descriptor of the finite points of @p points, far points left out
+/// (kernels/far_points.hpp: a view without far points is described exactly as before; one with
+/// them is described from a copy in the scratch, flagged FAR_POINTS_DROPPED).
 /// The three n x n projection matrices are the three blocks of @p descriptor_out, in
 /// GoodResult::order; each block is row-major (row = first named axis, column = second) and sums
 /// to 1.
 /// @pre x, y and z have equal lengths.
-/// @note No allocation; thread-safe with one scratch per thread; deterministic on one machine.
-/// Tolerance against compute_good_scalar(): the frame is identical (computed by the same scalar
-/// code); the AVX2/AVX-512 units let the compiler fuse a*b+c into FMA, so a transformed coordinate
-/// may differ by one rounding and a point lying within that of a bin edge or of +-t may change
-/// side: the descriptor L1 difference is at most a few points / kept (tested <= 1e-3 on the shared
-/// clouds). SSE2 is exact.
+/// @note No allocation (but for a view with far points larger than any before, see
+/// GoodScratch::near_points); thread-safe with one scratch per thread; deterministic on one
+/// machine. Tolerance against compute_good_scalar(): the frame is identical (computed by the same
+/// scalar code); the AVX2/AVX-512 units let the compiler fuse a*b+c into FMA, so a transformed
+/// coordinate may differ by one rounding and a point lying within that of a bin edge or of +-t may
+/// change side: the descriptor L1 difference is at most a few points / kept (tested <= 1e-3 on the
+/// shared clouds). SSE2 is exact.
 [[nodiscard]] Result<GoodResult, GoodError> compute_good(PointsView points, const GoodConfig& cfg,
                                                          GoodScratch& scratch,
                                                          std::span<float> descriptor_out) noexcept;

@@ -25,8 +25,10 @@ enum FrameFlag : std::uint32_t {
   SIGN_AMBIGUOUS = 1U << 4,  ///< an axis sign fell through every rule of the invariant tie chain
   NAN_IGNORED = 1U << 5,     ///< some points had a non-finite coordinate and were skipped
   EMPTY_VIEW = 1U << 6,      ///< a projection kept no point (only with extents that overflow float)
+  FAR_POINTS_DROPPED = 1U << 7,  ///< far points were left out of the frame (kernels/far_points.hpp)
 };
-/// @brief The flags that make a frame unreliable (NAN_IGNORED and EMPTY_VIEW are informative).
+/// @brief The flags that make a frame unreliable (NAN_IGNORED, EMPTY_VIEW and FAR_POINTS_DROPPED
+/// are informative).
 inline constexpr std::uint32_t FRAME_UNRELIABLE =
     FEW_POINTS | COLLINEAR | COPLANAR | AXES_AMBIGUOUS | SIGN_AMBIGUOUS;
 

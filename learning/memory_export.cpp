@@ -141,7 +141,7 @@ Result<std::size_t, MemoryError> commit_import(PerceptualMemory::State& s,
   CategoryId next_id = s.next_id;
   std::vector<StagedTeach> staged;
   for (const ImportGroup& g : groups) {
-    auto one = stage_teach(s, g.label, g.views, next_id, batch);
+    auto one = stage_teach(s, g.label, g.views, next_id, batch, ViewSource::IMPORT);
     if (!one) return err(one.error());
     staged.push_back(std::move(*one));
   }

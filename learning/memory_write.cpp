@@ -3,6 +3,7 @@
 #include <leveldb/write_batch.h>
 
 #include <algorithm>
+#include <cmath>
 
 #include "learning/detail/memory_state.hpp"
 #include "learning/perceptual_memory.hpp"
@@ -29,11 +30,30 @@ Result<void, MemoryError> write_synced(PerceptualMemory::State& s, leveldb::Writ
 
 namespace {
 
+bool all_finite(std::span<const float> values) noexcept {
+  return std::all_of(values.begin(), values.end(), [](float v) { return std::isfinite(v); });
+}
+
+// What the store cannot hold (an export writes JSON, which has no NaN or infinity) or should not
+// (a view whose descriptor is all zeros: no point fell in any projection), as a sentence; null when
+// the view is fine.
+const char* view_problem(const ViewRecord& v, ViewSource source) noexcept {
+  if (!all_finite(v.frame)) { return "its object frame is not finite"; }
+  if (!all_finite(v.bbox)) { return "its bounding box is not finite"; }
+  const bool empty =
+      std::all_of(v.descriptor.begin(), v.descriptor.end(), [](float x) { return x == 0.0F; });
+  if (empty && source == ViewSource::TEACH) {
+    return "its descriptor is all zeros (an empty view: no point fell in any projection)";
+  }
+  return nullptr;
+}
+
 // Every check the learner would make, done before anything is written, so a refused teach leaves
 // both the store and the learner untouched.
 Result<std::vector<float>, MemoryError> checked_values(const PerceptualMemory::State& s,
                                                        std::string_view label,
-                                                       std::span<const ViewRecord> views) {
+                                                       std::span<const ViewRecord> views,
+                                                       ViewSource source) {
   const std::string what = "teach \"" + std::string(label.substr(0, LABEL_MAX_BYTES)) + "\"";
   if (auto r = validate_label(label); !r) {
     return err(memory_error(Code::REJECTED, s.dir, what + ": " + to_string(r.error())));
@@ -48,6 +68,10 @@ Result<std::vector<float>, MemoryError> checked_values(const PerceptualMemory::S
                                   " (" + std::to_string(d.size()) + " values, expected " +
                                   std::to_string(length) + ")"));
     }
+    if (const char* problem = view_problem(views[v], source)) {
+      return err(memory_error(Code::REJECTED, s.dir,
+                              what + ": view " + std::to_string(v) + ": " + problem));
+    }
     flat.insert(flat.end(), d.begin(), d.end());
   }
   if (flat.empty()) {
@@ -60,8 +84,8 @@ Result<std::vector<float>, MemoryError> checked_values(const PerceptualMemory::S
 
 Result<StagedTeach, MemoryError> stage_teach(PerceptualMemory::State& s, std::string_view label,
                                              std::span<const ViewRecord> views, CategoryId& next_id,
-                                             leveldb::WriteBatch& batch) {
-  auto flat_result = checked_values(s, label, views);
+                                             leveldb::WriteBatch& batch, ViewSource source) {
+  auto flat_result = checked_values(s, label, views, source);
   if (!flat_result) { return err(flat_result.error()); }
   const std::size_t length = s.learner->descriptor_length();
   const IndexedCategory* existing = s.find(label);

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 
+#include "learning/detail/log_tail.hpp"
 #include "learning/detail/memory_state.hpp"
 #include "learning/detail/store_dir.hpp"
 
@@ -201,7 +202,10 @@ Result<bool, MemoryError> prepare(PerceptualMemory::State& s, OpenMode mode) {
     case StoreDir::STORE:
       break;
   }
-  if (mode == OpenMode::READ_ONLY && !writable_dir(s.dir)) {
+  if (const auto damage = check_store_log(s.dir)) s.warnings.push_back(damage->to_string());
+  // A read-only open must change nothing, so a store LevelDB would rewrite (a read-only mount, or a
+  // damaged log tail LevelDB would fold away on replay) is read from a private copy.
+  if (mode == OpenMode::READ_ONLY && (!writable_dir(s.dir) || !s.warnings.empty())) {
     auto copy = private_copy(s.dir);
     if (!copy) return err(copy.error());
     s.copy = *copy;
@@ -249,6 +253,9 @@ PerceptualMemory::~PerceptualMemory() = default;
 
 const Learner& PerceptualMemory::learner() const noexcept { return *state_->learner; }
 const MemoryConfig& PerceptualMemory::config() const noexcept { return state_->cfg; }
+const std::vector<std::string>& PerceptualMemory::open_warnings() const noexcept {
+  return state_->warnings;
+}
 
 Result<std::vector<ViewRecord>, MemoryError> PerceptualMemory::views_of(CategoryId id) const {
   return State::read_views(*state_, id);

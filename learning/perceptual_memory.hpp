@@ -126,6 +126,12 @@ class PerceptualMemory {
   [[nodiscard]] MemoryStats stats() const;
   /// @brief The learner to ask(); valid as long as the memory lives. @note ask() is lock-free.
   [[nodiscard]] const Learner& learner() const noexcept;
+  /// @brief What opening found wrong and went on from, one sentence each; empty when nothing.
+  /// Today: a write-ahead log whose tail is not a whole record (LevelDB drops such a tail quietly,
+  /// and it may have been an acknowledged write). A READ_ONLY open of such a store reads a private
+  /// copy, so the store keeps the evidence; a writable open replays the log and the tail is gone
+  /// after it, so callers must show these warnings.
+  [[nodiscard]] const std::vector<std::string>& open_warnings() const noexcept;
   /// @brief The configuration in use (descriptor parameters as stored).
   [[nodiscard]] const MemoryConfig& config() const noexcept;
   /// @brief Every view of category @p id, in teaching order (reads the store; not for the frame

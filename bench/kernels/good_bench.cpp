@@ -1,7 +1,7 @@
 // GOOD descriptor time: timing_5k.pcd (5,000 points) and a 50,000-point cloud (timing_5k repeated
 // 10x with seeded 0.3 mm jitter), 5 and 15 bins, both modes, dispatched SIMD against the scalar
-// twin. Reference (testdata/good/timing/TIMING.txt, same machine kind): 0.37 ms at 5k, 3.9 ms at
-// 50k.
+// twin, and the far-point check alone. Reference (testdata/good/timing/TIMING.txt, same machine
+// kind): 0.37 ms at 5k, 3.9 ms at 50k.
 #include <benchmark/benchmark.h>
 
 #include <cstdio>
@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "formats/pcd_io.hpp"
+#include "kernels/far_points.hpp"
 #include "kernels/good.hpp"
 #include "kernels/simd_arch.hpp"
 
@@ -74,6 +75,19 @@ BENCHMARK(BM_good)
     ->ArgNames({"copies", "bins", "reference", "simd"})
     ->ArgsProduct({{1, 10}, {5, 15}, {0, 1}, {0, 1}})
     ->Unit(benchmark::kMicrosecond);
+
+// The far-point check compute_good() runs first (kernels/far_points.hpp), alone: its share of the
+// BM_good time above. Args: copies.
+void BM_find_far_points(benchmark::State& state) {
+  const Cloud& c = cloud(static_cast<std::size_t>(state.range(0)));
+  for (auto _ : state) {
+    const ok::FarPoints far = ok::find_far_points(c.view());
+    benchmark::DoNotOptimize(far);
+  }
+  state.counters["points"] = static_cast<double>(c.x.size());
+}
+
+BENCHMARK(BM_find_far_points)->ArgNames({"copies"})->Arg(1)->Arg(10)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 

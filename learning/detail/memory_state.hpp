@@ -33,6 +33,7 @@ struct PerceptualMemory::State {
   std::vector<IndexedCategory> index;  // by id
   CategoryId next_id = 0;
   std::uint64_t writes = 0;
+  std::vector<std::string> warnings;  ///< PerceptualMemory::open_warnings()
 
   /// @brief Every view of category @p id in sequence order, decoded and checked against params.
   [[nodiscard]] static Result<std::vector<ViewRecord>, MemoryError> read_views(State& s,
@@ -58,11 +59,12 @@ struct StagedTeach {
 /// @brief Checks @p views, adds their records to @p batch and returns what to apply after the
 /// write.
 /// @p next_id is the running next category id (advanced for a new category). Nothing else changes.
-[[nodiscard]] Result<StagedTeach, MemoryError> stage_teach(PerceptualMemory::State& s,
-                                                           std::string_view label,
-                                                           std::span<const ViewRecord> views,
-                                                           CategoryId& next_id,
-                                                           leveldb::WriteBatch& batch);
+/// @brief Where staged views come from: a new teach must carry a real view (its descriptor has a
+/// non-zero value); an import may restore the all-zero views that stores of earlier releases took.
+enum class ViewSource : std::uint8_t { TEACH, IMPORT };
+[[nodiscard]] Result<StagedTeach, MemoryError> stage_teach(
+    PerceptualMemory::State& s, std::string_view label, std::span<const ViewRecord> views,
+    CategoryId& next_id, leveldb::WriteBatch& batch, ViewSource source = ViewSource::TEACH);
 /// @brief After the synced write: the index and the learner take the staged teach.
 void apply_staged(PerceptualMemory::State& s, const StagedTeach& staged);
 /// @brief Writes @p batch synced (READ_ONLY and WRITE_FAILED name @p what).
