@@ -8,19 +8,14 @@
 #include <thread>
 
 #include "apps/commands.hpp"
-#include "engine/engine.hpp"
+#include "apps/graph_run.hpp"
 #include "engine/frame_payload.hpp"
-#include "engine/generic_nodes.hpp"
 #include "engine/ipc_nodes.hpp"
 #include "engine/object_list_payload.hpp"
 
 namespace orthoflow::apps {
 
 namespace {
-
-constexpr int EXIT_NO_ROUDI = 20;
-constexpr int EXIT_POOLS = 21;
-constexpr int EXIT_ROUDI_LOST = 22;
 
 std::atomic<bool> stop_flag{false};
 extern "C" void on_signal(int /*sig*/) { stop_flag.store(true); }
@@ -57,13 +52,6 @@ void start_runtime(const char* role) {
   std::signal(SIGTERM, on_signal);  // RouDi SIGTERMs its apps when it shuts down
 }
 
-engine::NodeRegistry make_ipc_registry() {
-  engine::NodeRegistry registry;
-  engine::add_generic_nodes(registry);
-  engine::add_ipc_nodes(registry);
-  return registry;
-}
-
 /// One demand per IPC node of a graph file: payload bytes and chunks it can hold at once.
 struct Demand {
   std::string topic;
@@ -71,9 +59,12 @@ struct Demand {
   std::uint64_t chunks = 0;
 };
 
+// The file is validated as `graph check` does (every graph error, cycles included, with file and
+// line, exit 2): a graph that cannot run gets no RouDi configuration.
 std::vector<Demand> demands_of(const std::string& file) {
-  auto spec = engine::load_graph_file(file);
-  if (!spec) fail(EXIT_BAD_INPUT, engine::to_string(spec.error()));
+  const auto registry = make_graph_registry();
+  const auto graph = load_graph_or_throw(file, registry, engine::BuildMode::CHECK);
+  const engine::GraphSpec* spec = &graph->spec;
   std::vector<Demand> demands;
   for (const auto& node : spec->nodes) {
     auto get = [&](const char* key, std::int64_t fallback) {
@@ -219,7 +210,6 @@ void run_echo(const EchoArgs& a) {
 }  // namespace
 
 void add_ipc_send(CLI::App& ipc);
-void run_ipc_graph(const std::string& file, std::uint64_t frames);
 
 void add_ipc_command(CLI::App& app) {
   auto* ipc =
@@ -255,39 +245,21 @@ void add_ipc_command(CLI::App& app) {
       ->check(CLI::Range(0, 10000));
   echo->callback([] { run_echo(echo_args); });
   add_ipc_send(*ipc);
-  auto* run =
-      ipc->add_subcommand("run", "run a graph with the IPC node kinds; exit 22 if RouDi is lost");
-  static std::string graph_file;
-  static std::uint64_t frames = 0;
-  run->add_option("graph", graph_file, "graph YAML")->required()->check(CLI::ExistingFile);
-  run->add_option("--frames", frames, "stop after N frames");
-  run->callback([] { run_ipc_graph(graph_file, frames); });
-}
-
-void run_ipc_graph(const std::string& file, std::uint64_t frames) {
-  if (auto probe = engine::probe_roudi(); !probe) fail(EXIT_NO_ROUDI, to_string(probe.error()));
-  auto spec = engine::load_graph_file(file);
-  if (!spec) fail(EXIT_BAD_INPUT, engine::to_string(spec.error()));
-  const auto registry = make_ipc_registry();
-  auto graph = engine::build_graph(*spec, registry);
-  if (!graph) fail(EXIT_BAD_INPUT, engine::to_string(graph.error()));
-  std::signal(SIGINT, on_signal);
-  std::signal(SIGTERM, on_signal);
-  engine::Engine engine(**graph, engine::EngineConfig{});
-  engine.run(engine::RunOptions{frames, &stop_flag});
-  std::cout << engine::format_table(engine.stats());
-  for (const auto& node : (*graph)->spec.nodes) {
-    const auto* ipc = dynamic_cast<const engine::IpcNode*>(engine.node(node.name));
-    if (ipc == nullptr) continue;
-    const auto& c = ipc->ipc_counters();
-    std::cout << "ipc " << node.name << " " << ipc->topic() << " samples " << c.samples.load()
-              << " dropped " << c.dropped.load() << " rejected " << c.rejected.load()
-              << " loan_failures " << c.loan_failures.load() << "\n";
-  }
-  std::cout.flush();
-  if (engine::ipc_roudi_lost() || (engine::ipc_runtime_ready() && !engine::probe_roudi())) {
-    fail(EXIT_ROUDI_LOST, "RouDi lost while running " + file);
-  }
+  // `ipc run` is `graph run` (same registry: every kind, so the shipped two-process graphs run)
+  // with the IPC exit codes: 20 when no RouDi answers before the start, 22 when it is lost while
+  // running.
+  auto* run = ipc->add_subcommand(
+      "run",
+      "run a graph file like `graph run` (e.g. graphs/sensor.yaml); exit 20 without RouDi, "
+      "22 if RouDi is lost");
+  static GraphRunArgs run_args;
+  run_args.command = "orthoflow ipc run";
+  run->add_option("graph", run_args.file, "graph YAML")->required()->check(CLI::ExistingFile);
+  run->add_option("--frames", run_args.frames, "stop after N frames");
+  run->callback([] {
+    if (auto probe = engine::probe_roudi(); !probe) fail(EXIT_NO_ROUDI, to_string(probe.error()));
+    run_graph_file(run_args);
+  });
 }
 
 }  // namespace orthoflow::apps

@@ -13,6 +13,10 @@ inline constexpr int EXIT_FAILURE_GENERIC = 1;  ///< the operation failed (messa
 inline constexpr int EXIT_BAD_INPUT = 2;        ///< unreadable or malformed input file
 inline constexpr int EXIT_USAGE =
     106;  ///< bad arguments (the code CLI11 uses for RequiredError; its own validators exit 105)
+/// IPC exit codes (docs/IPC.md), used by `ipc ...` and by every command that runs IPC nodes.
+inline constexpr int EXIT_NO_ROUDI = 20;    ///< RouDi unreachable
+inline constexpr int EXIT_POOLS = 21;       ///< RouDi's pools do not fit the topics
+inline constexpr int EXIT_ROUDI_LOST = 22;  ///< RouDi disappeared while running
 
 /// @brief `graph check|dot|run FILE`: validate, draw (Graphviz) and run dataflow graph files.
 void add_graph_command(CLI::App& app);

@@ -51,8 +51,11 @@ class IpcPublishNode final : public IpcNode {
   std::span<const PortSpec> outputs() const noexcept override { return {}; }
   bool stateful() const noexcept override { return true; }  // a publisher is single-threaded
   void process(const Message& in, Emitter& /*out*/) noexcept override {
-    if (!liveness_.alive()) return;
     if (in.skipped || !in.payload) return;
+    if (!liveness_.alive()) {  // counted, so that a summary never claims it was sent
+      publisher_->count_unpublished();
+      return;
+    }
     const auto bytes = resolve_frame_bytes(in.payload.bytes());
     // Failures (pool exhausted, bad header) are counted in the publisher's counters; no I/O here.
     auto published = publisher_->publish_copy(bytes);

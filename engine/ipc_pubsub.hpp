@@ -74,6 +74,7 @@ struct IpcCounters {
   std::atomic<std::uint64_t> dropped{0};        ///< subscriber: gaps in the publisher's sequence
   std::atomic<std::uint64_t> rejected{0};       ///< header mismatch (never handed out)
   std::atomic<std::uint64_t> loan_failures{0};  ///< publisher: exhausted or too many loans
+  std::atomic<std::uint64_t> unpublished{0};    ///< publisher: not sent, RouDi was lost
 };
 
 /// @brief Publishes payloads on one topic. Move-only; destroy before the process exits.
@@ -101,6 +102,10 @@ class IpcPublisher {
   [[nodiscard]] Result<void, IpcError> publish_copy(std::span<const std::byte> payload) noexcept;
   /// @brief True if a subscriber is connected.
   [[nodiscard]] bool has_subscribers() const noexcept;
+  /// @brief Counts a sample the caller did not publish because RouDi was lost (`unpublished`).
+  void count_unpublished() noexcept {
+    counters_.unpublished.fetch_add(1, std::memory_order_relaxed);
+  }
   [[nodiscard]] const IpcCounters& counters() const noexcept { return counters_; }
   [[nodiscard]] const std::string& topic() const noexcept { return topic_; }
 

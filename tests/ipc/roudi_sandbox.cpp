@@ -124,9 +124,8 @@ pid_t Sandbox::spawn_orthoflow(const std::string& name, const std::vector<std::s
   return spawn(name, argv, false);
 }
 
-pid_t Sandbox::start_roudi() {
-  const pid_t pid = spawn(
-      "roudi", {"/usr/bin/iox-roudi", "-c", ORTHOFLOW_SOURCE_DIR "/config/roudi_test.toml"}, true);
+pid_t Sandbox::start_roudi(const std::string& config) {
+  const pid_t pid = spawn("roudi", {"/usr/bin/iox-roudi", "-c", config}, true);
   const auto until = Clock::now() + std::chrono::seconds(5);
   while (Clock::now() < until) {
     if (engine::probe_roudi()) return pid;

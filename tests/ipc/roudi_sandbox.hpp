@@ -26,9 +26,10 @@ class Sandbox {
  public:
   /// @brief Starts `orthoflow ARGS...` with stdout/stderr in /tmp/NAME.{out,err}.
   pid_t spawn_orthoflow(const std::string& name, const std::vector<std::string>& args);
-  /// @brief Starts `iox-roudi -c config/roudi_test.toml` (setsid, stdin /dev/null) and waits at
-  /// most 5 s until engine::probe_roudi succeeds. Records a failure and returns -1 otherwise.
-  pid_t start_roudi();
+  /// @brief Starts `iox-roudi -c CONFIG` (default config/roudi_test.toml; setsid, stdin /dev/null)
+  /// and waits at most 5 s until engine::probe_roudi succeeds. Records a failure and returns -1
+  /// otherwise.
+  pid_t start_roudi(const std::string& config = ORTHOFLOW_SOURCE_DIR "/config/roudi_test.toml");
   /// @brief Waits at most `timeout` for `pid` (kills it if hung) and collects its output.
   ProcResult wait(pid_t pid, std::chrono::milliseconds timeout);
   /// @brief Waits at most `timeout` until NAME's stdout contains `needle`.
