@@ -6,7 +6,10 @@
 // the objects are the ones `orthoflow run` finds with that graph. The flags, applied after --graph,
 // mean what the PCL parameters mean: --leaf is VoxelGrid's leaf, --plane-tau/--plane-iters
 // SACSegmentation's distance threshold and max iterations, --cluster-tol and --min-cluster
-// EuclideanClusterExtraction's tolerance and minimum size.
+// EuclideanClusterExtraction's tolerance and minimum size. An organized frame fits its plane on a
+// strided pixel sample, which has no leaf: --leaf given there replaces the sample by the voxel grid
+// of that leaf (organized_stride 0), so that the flag always does what it says. The plane input
+// used is printed ("plane input:") and in the JSON ("plane_input").
 #include <algorithm>
 #include <cstdio>
 #include <iostream>
@@ -18,6 +21,7 @@
 #include <vector>
 
 #include "apps/commands.hpp"
+#include "apps/json_numbers.hpp"
 #include "engine/graph.hpp"
 #include "formats/pcd_io.hpp"
 #include "graphs/embedded_graphs.hpp"
@@ -72,9 +76,22 @@ nlohmann::json stats_json(std::span<const kernels::ClusterStats> list) {
   return out;
 }
 
-nlohmann::json to_json(const kernels::SegmentationResult& seg, const nlohmann::json& timings) {
+/// What the plane was fitted on: the strided pixel sample, the voxel grid or every kept point
+/// (kernels/tabletop_stages.hpp, PlaneInputStage).
+nlohmann::json plane_input_json(const kernels::PointCloud& cloud,
+                                const kernels::SegmentationParams& p) {
+  if (kernels::takes_strided_sample(cloud.view(), p)) {
+    return {{"kind", "pixel_sample"}, {"stride", p.organized_stride}};
+  }
+  if (p.leaf > 0.0F) return {{"kind", "voxel_grid"}, {"leaf", floats_json(std::array{p.leaf})[0]}};
+  return {{"kind", "every_point"}};
+}
+
+nlohmann::json to_json(const kernels::SegmentationResult& seg, const nlohmann::json& timings,
+                       const nlohmann::json& plane_input) {
   const kernels::CandidateCounts& c = seg.candidate_counts;
-  return {{"plane", {{"normal", triple(seg.plane.plane.normal)}, {"d", seg.plane.plane.d}}},
+  return {{"plane_input", plane_input},
+          {"plane", {{"normal", triple(seg.plane.plane.normal)}, {"d", seg.plane.plane.d}}},
           {"inliers", seg.plane.inliers},
           {"clusters", stats_json(seg.clusters)},
           {"objects", stats_json(seg.candidates)},
@@ -84,6 +101,14 @@ nlohmann::json to_json(const kernels::SegmentationResult& seg, const nlohmann::j
 }
 
 void print_text(const nlohmann::json& j) {
+  const auto& in = j["plane_input"];
+  if (in["kind"] == "pixel_sample") {
+    std::printf("plane input: pixel sample, stride %u\n", in["stride"].get<unsigned>());
+  } else if (in["kind"] == "voxel_grid") {
+    std::printf("plane input: voxel grid, leaf %g m\n", in["leaf"].get<double>());
+  } else {
+    std::printf("plane input: every point inside the region of interest\n");
+  }
   const auto& n = j["plane"]["normal"];
   std::printf("plane: normal (%.5f, %.5f, %.5f) d %.5f, %zu inliers\n", n[0].get<double>(),
               n[1].get<double>(), n[2].get<double>(), j["plane"]["d"].get<double>(),
@@ -129,7 +154,10 @@ void resolve_params(SegmentOptions& opt) {
     opt.params = seg->stages;
     opt.candidates = seg->candidates;
   }
-  if (opt.leaf) opt.params.leaf = *opt.leaf;
+  if (opt.leaf) {
+    opt.params.leaf = *opt.leaf;
+    opt.params.organized_stride = 0;  // organized frames too: the voxel grid of this leaf
+  }
   if (opt.plane_tau) opt.params.ransac.tau = *opt.plane_tau;
   if (opt.plane_iters) opt.params.ransac.max_iterations = *opt.plane_iters;
   if (opt.cluster_tol) opt.params.cluster.tolerance = *opt.cluster_tol;
@@ -153,7 +181,9 @@ void run_segment(SegmentOptions& opt) {
       throw CLI::RuntimeError(EXIT_FAILURE_GENERIC);
     }
     runs.push_back(seg_result->timings);
-    if (r + 1 == opt.repeat) { out = to_json(*seg_result, median_timings(runs)); }
+    if (r + 1 == opt.repeat) {
+      out = to_json(*seg_result, median_timings(runs), plane_input_json(*cloud_result, opt.params));
+    }
   }
   if (opt.json) {
     std::cout << out.dump() << '\n';
@@ -175,7 +205,9 @@ void add_segment_command(CLI::App& app) {
   cmd->add_option(
       "--graph", opt->graph,
       "Take the segmentation parameters from this graph file ('tabletop': the embedded one)");
-  cmd->add_option("--leaf", opt->leaf, "Voxel leaf in metres (0: no voxel grid)")
+  cmd->add_option("--leaf", opt->leaf,
+                  "Voxel leaf in metres (0: no voxel grid). An organized frame otherwise fits its "
+                  "plane on a strided pixel sample; --leaf replaces that sample by this voxel grid")
       ->check(CLI::Range(0.0, 1e6));
   cmd->add_option("--plane-tau", opt->plane_tau, "RANSAC inlier distance, metres")
       ->check(CLI::Range(0.0, 1e6));

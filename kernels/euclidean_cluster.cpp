@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "kernels/detail/number_text.hpp"
 #include "kernels/detail/radix_sort.hpp"
 
 namespace orthoflow::kernels {
@@ -12,11 +13,11 @@ namespace orthoflow::kernels {
 std::string ClusterError::to_string() const {
   switch (code) {
     case Code::BAD_PARAMS:
-      return "euclidean_cluster: invalid parameter value " + std::to_string(value);
+      return "euclidean_cluster: invalid parameter value " + detail::value_text(value);
     case Code::SCRATCH_TOO_SMALL:
-      return "euclidean_cluster: scratch too small for " + std::to_string(value) + " points";
+      return "euclidean_cluster: scratch too small for " + detail::count_text(value) + " points";
     case Code::GRID_OVERFLOW:
-      return "euclidean_cluster: extent/tolerance " + std::to_string(value) +
+      return "euclidean_cluster: extent/tolerance " + detail::value_text(value) +
              " overflows the 64-bit cell key";
   }
   return "euclidean_cluster: unknown error";

@@ -4,19 +4,20 @@
 #include <cmath>
 
 #include "core/rng.hpp"
+#include "kernels/detail/number_text.hpp"
 
 namespace orthoflow::kernels {
 
 std::string RansacError::to_string() const {
   switch (code) {
     case Code::BAD_PARAMS:
-      return "ransac_plane: invalid parameter value " + std::to_string(value);
+      return "ransac_plane: invalid parameter value " + detail::value_text(value);
     case Code::TOO_FEW_POINTS:
-      return "ransac_plane: " + std::to_string(value) + " finite points, need at least 3";
+      return "ransac_plane: " + detail::count_text(value) + " finite points, need at least 3";
     case Code::NO_HYPOTHESIS:
-      return "ransac_plane: all " + std::to_string(value) + " draws were degenerate";
+      return "ransac_plane: all " + detail::count_text(value) + " draws were degenerate";
     case Code::OUTPUT_TOO_SMALL:
-      return "ransac_plane: inlier output too small for " + std::to_string(value);
+      return "ransac_plane: inlier output too small for " + detail::count_text(value);
   }
   return "ransac_plane: unknown error";
 }

@@ -8,8 +8,8 @@
 /// - organized frame: strided pixel sample inside the ROI -> RANSAC plane (hypotheses scored on the
 ///   sample at twice the stride, refit on the sample) -> hull of the sample inliers -> prism (and
 ///   ROI) over the full-resolution pixels -> image-space clustering of those pixels -> footprint
-///   merge. With organized_stride == 0 the sample is replaced by the voxel grid of every kept
-///   pixel.
+///   merge. With organized_stride == 0, or a frame too narrow for the sample (MIN_SAMPLE_LINES),
+///   the sample is replaced by the voxel grid of every kept pixel.
 /// - unorganized cloud: ROI -> voxel grid -> RANSAC -> hull -> prism -> grid clustering, all on
 /// voxels. leaf == 0 skips the voxel grid where it runs (RANSAC and hull then run on every kept
 /// point).

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "kernels/cloud_stats.hpp"
 #include "kernels/pixel_subsample.hpp"
 #include "kernels/polygonal_prism.hpp"
 
@@ -50,66 +51,30 @@ SegmentationError fail(SegmentationError::Code code, std::uint8_t cause = 0,
   return SegmentationError{code, cause, value, 0, 0};
 }
 
+constexpr std::size_t MIN_PLANE_POINTS = 3;  // RANSAC's minimum
+
+/// FEW_POINTS_IN_ROI with the cloud's finite points: says whether the points are missing or
+/// outside the ROI. Only on the failure path (a pass over the cloud).
+SegmentationError few_points_in_roi(PointsView points, const AxisBox& roi,
+                                    std::size_t inside) noexcept {
+  SegmentationError e =
+      fail(SegmentationError::Code::FEW_POINTS_IN_ROI, 0, static_cast<double>(inside));
+  e.finite = cloud_stats(points).finite;
+  e.roi = roi;
+  return e;
+}
+
 }  // namespace
-
-std::string_view to_string(SegmentationError::Code code) noexcept {
-  using C = SegmentationError::Code;
-  switch (code) {
-    case C::CLOUD_TOO_LARGE:
-      return "CLOUD_TOO_LARGE";
-    case C::NOT_WIDTH_X_HEIGHT:
-      return "NOT_WIDTH_X_HEIGHT";
-    case C::OUTPUT_TOO_SMALL:
-      return "OUTPUT_TOO_SMALL";
-    case C::VOXEL_GRID_FAILED:
-      return "VOXEL_GRID_FAILED";
-    case C::NO_PLANE:
-      return "NO_PLANE";
-    case C::FEW_SAMPLE_INLIERS:
-      return "FEW_SAMPLE_INLIERS";
-    case C::DEGENERATE_HULL:
-      return "DEGENERATE_HULL";
-    case C::HULL_TOO_LARGE:
-      return "HULL_TOO_LARGE";
-    case C::CLUSTERING_FAILED:
-      return "CLUSTERING_FAILED";
-  }
-  return "UNKNOWN";
-}
-
-std::string SegmentationError::to_string() const {
-  using C = Code;
-  const std::string name(kernels::to_string(code));
-  const std::string count = std::to_string(static_cast<std::uint64_t>(value));
-  switch (code) {
-    case C::CLOUD_TOO_LARGE:
-      return "segmentation: " + name + ": " + count + " points, more than it was sized for";
-    case C::NOT_WIDTH_X_HEIGHT:
-      return "segmentation: " + name + ": organized cloud of " + count + " points is not " +
-             std::to_string(width) + " x " + std::to_string(height);
-    case C::OUTPUT_TOO_SMALL:
-      return "segmentation: " + name + ": the plane input needs room for " + count + " points";
-    case C::VOXEL_GRID_FAILED:
-      return "segmentation: " + name + ": " +
-             VoxelGridError{VoxelGridError::Code{cause}, value}.to_string();
-    case C::NO_PLANE:
-      return "segmentation: " + name + ": " +
-             RansacError{RansacError::Code{cause}, value}.to_string();
-    case C::FEW_SAMPLE_INLIERS:
-      return "segmentation: " + name + ": the plane has fewer than 3 inliers on the sample";
-    case C::DEGENERATE_HULL:
-      return "segmentation: " + name + ": the plane inliers have a degenerate hull";
-    case C::HULL_TOO_LARGE:
-      return "segmentation: " + name + ": " + count + " hull vertices";
-    case C::CLUSTERING_FAILED:
-      return "segmentation: " + name + ": " +
-             ClusterError{ClusterError::Code{cause}, value}.to_string();
-  }
-  return "segmentation: " + name;
-}
 
 bool takes_organized_path(CloudView cloud, const SegmentationParams& params) noexcept {
   return params.use_organized && cloud.organized();
+}
+
+bool takes_strided_sample(CloudView cloud, const SegmentationParams& params) noexcept {
+  const std::uint32_t s = params.organized_stride;
+  return takes_organized_path(cloud, params) && s > 0 &&
+         sample_lines(cloud.width, s) >= MIN_SAMPLE_LINES &&
+         sample_lines(cloud.height, s) >= MIN_SAMPLE_LINES;
 }
 
 PlaneInputStage::PlaneInputStage(std::size_t max_points)
@@ -127,34 +92,46 @@ Result<PlaneInput, SegmentationError> PlaneInputStage::run(CloudView cloud,
   auto start = Clock::now();
   const std::size_t n = cloud.points.size();
   if (n > max_points_) return err(fail(C::CLOUD_TOO_LARGE, 0, static_cast<double>(n)));
-  const bool organized = takes_organized_path(cloud, p);
-  if (organized && n != std::size_t{cloud.width} * cloud.height) {
+  if (takes_organized_path(cloud, p) && n != std::size_t{cloud.width} * cloud.height) {
     SegmentationError e = fail(C::NOT_WIDTH_X_HEIGHT, 0, static_cast<double>(n));
     e.width = cloud.width;
     e.height = cloud.height;
     return err(e);
   }
-  if (organized && p.organized_stride > 0) {
-    // The plane and hull need a sample about as dense as 5 mm voxels, not a voxel grid over every
-    // kept pixel: a strided pixel sample costs 1/stride^2 of the frame and needs no sort. RANSAC
-    // scores its hypotheses on the sample at twice the stride (a quarter of the points), written
-    // after the dense one.
-    const std::uint32_t s = p.organized_stride;
-    const std::size_t dense_max = cells(cloud.width, s) * cells(cloud.height, s);
-    const std::size_t sparse_max = cells(cloud.width, 2 * s) * cells(cloud.height, 2 * s);
-    if (out.size() < dense_max) {
-      return err(fail(C::OUTPUT_TOO_SMALL, 0, static_cast<double>(dense_max)));
-    }
-    const std::size_t dense = pixel_subsample(cloud, s, p.roi, out);
-    // No room for the scoring sample after the dense one (stride 1 on a full frame): RANSAC then
-    // scores on the dense sample itself, as for small frames.
-    const PointsSpan rest{out.x.subspan(dense), out.y.subspan(dense), out.z.subspan(dense)};
-    const std::size_t sparse =
-        out.size() >= dense_max + sparse_max ? pixel_subsample(cloud, 2 * s, p.roi, rest) : 0;
-    return PlaneInput{first(out, 0, dense), first(out, dense, sparse), dense, ms_since(start), 0.0};
+  if (!takes_strided_sample(cloud, p)) return every_kept_point(cloud, p, out);
+  // The plane and hull need a sample about as dense as 5 mm voxels, not a voxel grid over every
+  // kept pixel: a strided pixel sample costs 1/stride^2 of the frame and needs no sort. RANSAC
+  // scores its hypotheses on the sample at twice the stride (a quarter of the points), written
+  // after the dense one.
+  const std::uint32_t s = p.organized_stride;
+  const std::size_t dense_max = cells(cloud.width, s) * cells(cloud.height, s);
+  const std::size_t sparse_max = cells(cloud.width, 2 * s) * cells(cloud.height, 2 * s);
+  if (out.size() < dense_max) {
+    return err(fail(C::OUTPUT_TOO_SMALL, 0, static_cast<double>(dense_max)));
   }
+  const std::size_t dense = pixel_subsample(cloud, s, p.roi, out);
+  // Too few sampled pixels for a plane (a frame with little inside the ROI): every kept pixel may
+  // still hold enough, as for an unorganized cloud.
+  if (dense < MIN_PLANE_POINTS && out.size() >= n) return every_kept_point(cloud, p, out);
+  // No room for the scoring sample after the dense one (stride 1 on a full frame): RANSAC then
+  // scores on the dense sample itself, as for small frames.
+  const PointsSpan rest{out.x.subspan(dense), out.y.subspan(dense), out.z.subspan(dense)};
+  const std::size_t sparse =
+      out.size() >= dense_max + sparse_max ? pixel_subsample(cloud, 2 * s, p.roi, rest) : 0;
+  return PlaneInput{first(out, 0, dense), first(out, dense, sparse), dense, ms_since(start), 0.0};
+}
+
+/// The unorganized path (and the organized one without a strided sample): ROI crop, then the voxel
+/// grid, or every kept point when leaf == 0.
+Result<PlaneInput, SegmentationError> PlaneInputStage::every_kept_point(CloudView cloud,
+                                                                        const SegmentationParams& p,
+                                                                        PointsSpan out) noexcept {
+  using C = SegmentationError::Code;
+  auto start = Clock::now();
+  const std::size_t n = cloud.points.size();
   if (out.size() < n) return err(fail(C::OUTPUT_TOO_SMALL, 0, static_cast<double>(n)));
   const std::size_t kept = crop_box_mask(cloud.points, p.roi, mask_);  // NaN points never pass
+  if (kept < MIN_PLANE_POINTS) return err(few_points_in_roi(cloud.points, p.roi, kept));
   if (p.leaf == 0.0F) {
     compact_masked(cloud.points, mask_,
                    PointsSpan{out.x.first(kept), out.y.first(kept), out.z.first(kept)}, {});

@@ -68,11 +68,16 @@ struct SegmentationError {
     HULL_TOO_LARGE,      ///< the hull has more vertices than the caller's hull span holds (value:
                          ///< count)
     CLUSTERING_FAILED,   ///< cause: ClusterError::Code
+    /// fewer than 3 finite points inside the ROI, too few for a plane (value: the points inside;
+    /// finite: the finite points of the whole cloud; roi: the box)
+    FEW_POINTS_IN_ROI,
   };
   Code code = Code::NO_PLANE;
   std::uint8_t cause = 0;
   double value = 0.0;
   std::uint32_t width = 0, height = 0;  ///< NOT_WIDTH_X_HEIGHT: the image size the cloud claims
+  std::uint64_t finite = 0;             ///< FEW_POINTS_IN_ROI: the finite points of the cloud
+  AxisBox roi{};                        ///< FEW_POINTS_IN_ROI: the region of interest
   /// @brief The full message: stage, reason and the kernel's own message. Allocates: off the frame
   /// path.
   [[nodiscard]] std::string to_string() const;
@@ -94,21 +99,42 @@ struct PlaneInput {
 /// @brief True when the chain takes its organized path for @p cloud under @p params.
 [[nodiscard]] bool takes_organized_path(CloudView cloud, const SegmentationParams& params) noexcept;
 
-/// @brief Stage 1: ROI, strided sample or voxel grid. @note Not thread-safe; one instance per
-/// thread.
+/// @brief Fewest sample columns and rows the organized strided path needs: one column of a depth
+/// image lies in a plane through the camera, so a sample of one or two columns (or rows) cannot
+/// tell the table from that plane. A narrower organized frame takes the voxel grid of every kept
+/// pixel, as an unorganized cloud does (the prism and the clustering still run on its pixels).
+inline constexpr std::uint32_t MIN_SAMPLE_LINES = 3;
+
+/// @brief The number of sample lines pixel_subsample takes across @p extent pixels at @p stride.
+/// @pre stride >= 1.
+[[nodiscard]] constexpr std::uint32_t sample_lines(std::uint32_t extent,
+                                                   std::uint32_t stride) noexcept {
+  const std::uint32_t first = stride / 2;
+  return extent > first ? (extent - first - 1) / stride + 1 : 0;
+}
+
+/// @brief True when the organized strided path samples @p cloud (organized_stride > 0 and at least
+/// MIN_SAMPLE_LINES sample columns and rows); false: the voxel grid of every kept pixel.
+[[nodiscard]] bool takes_strided_sample(CloudView cloud, const SegmentationParams& params) noexcept;
+
+/// @brief Stage 1: ROI, strided sample or voxel grid. Fewer than 3 finite points inside the ROI is
+/// FEW_POINTS_IN_ROI; a strided sample of fewer than 3 points falls back to every kept pixel.
+/// @note Not thread-safe; one instance per thread.
 class PlaneInputStage {
  public:
   /// @brief Allocates its scratch for clouds of up to @p max_points points.
   explicit PlaneInputStage(std::size_t max_points);
   /// @brief Writes the plane input of @p cloud to the front of @p out (dense sample, then the
   /// sparse one).
-  /// @pre out.size() >= max_points, or at least the sample bounds of an organized cloud.
-  /// Allocation-free.
+  /// @pre out.size() >= max_points, or at least the sample bounds of an organized cloud that
+  /// takes_strided_sample(). Allocation-free.
   [[nodiscard]] Result<PlaneInput, SegmentationError> run(CloudView cloud,
                                                           const SegmentationParams& params,
                                                           PointsSpan out) noexcept;
 
  private:
+  [[nodiscard]] Result<PlaneInput, SegmentationError> every_kept_point(
+      CloudView cloud, const SegmentationParams& params, PointsSpan out) noexcept;
   std::size_t max_points_;
   std::vector<std::uint8_t> mask_;
   std::vector<float> kx_, ky_, kz_;  // kept points before the voxel grid

@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "kernels/cloud_stats.hpp"
+#include "kernels/detail/number_text.hpp"
 #include "kernels/detail/radix_sort.hpp"
 
 namespace orthoflow::kernels {
@@ -14,14 +15,15 @@ namespace orthoflow::kernels {
 std::string VoxelGridError::to_string() const {
   switch (code) {
     case Code::INVALID_LEAF:
-      return "voxel_grid: invalid leaf size " + std::to_string(value) + " (must be finite and > 0)";
+      return "voxel_grid: invalid leaf size " + detail::value_text(value) +
+             " (must be finite and > 0)";
     case Code::INDEX_OVERFLOW:
-      return "voxel_grid: leaf too small for the extent, coordinate/leaf " + std::to_string(value) +
-             " does not fit a 64-bit voxel index";
+      return "voxel_grid: leaf too small for the extent, coordinate/leaf " +
+             detail::value_text(value) + " does not fit a 64-bit voxel index";
     case Code::SCRATCH_TOO_SMALL:
-      return "voxel_grid: scratch too small for " + std::to_string(value) + " points";
+      return "voxel_grid: scratch too small for " + detail::count_text(value) + " points";
     case Code::OUTPUT_TOO_SMALL:
-      return "voxel_grid: output too small for " + std::to_string(value) + " voxels";
+      return "voxel_grid: output too small for " + detail::count_text(value) + " voxels";
   }
   return "voxel_grid: unknown error";
 }

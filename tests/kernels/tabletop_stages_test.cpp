@@ -1,6 +1,7 @@
 // The stage objects of kernels/tabletop_stages.hpp on hand-made inputs: every SegmentationError
 // code is triggered and named (STYLE rule 9), the kernel's reason is kept, and a full-frame
 // stride-1 sample without room for the scoring sample falls back to scoring on the dense sample.
+// Narrow organized frames and frames outside the ROI: narrow_frames_test.cpp.
 #include "kernels/tabletop_stages.hpp"
 
 #include <gtest/gtest.h>
@@ -39,9 +40,10 @@ struct Buffers {
 };
 
 TEST(TabletopStages, EveryCodeHasAName) {
-  for (const Code c : {Code::CLOUD_TOO_LARGE, Code::NOT_WIDTH_X_HEIGHT, Code::OUTPUT_TOO_SMALL,
-                       Code::VOXEL_GRID_FAILED, Code::NO_PLANE, Code::FEW_SAMPLE_INLIERS,
-                       Code::DEGENERATE_HULL, Code::HULL_TOO_LARGE, Code::CLUSTERING_FAILED}) {
+  for (const Code c :
+       {Code::CLOUD_TOO_LARGE, Code::NOT_WIDTH_X_HEIGHT, Code::OUTPUT_TOO_SMALL,
+        Code::VOXEL_GRID_FAILED, Code::NO_PLANE, Code::FEW_SAMPLE_INLIERS, Code::DEGENERATE_HULL,
+        Code::HULL_TOO_LARGE, Code::CLUSTERING_FAILED, Code::FEW_POINTS_IN_ROI}) {
     EXPECT_NE(ok::to_string(c), "UNKNOWN");
     const ok::SegmentationError e{c, 0, 0.0, 0, 0};
     EXPECT_NE(e.to_string().find(std::string(ok::to_string(c))), std::string::npos);
@@ -94,6 +96,9 @@ TEST(TabletopStages, TableErrors) {
   ASSERT_FALSE(none);
   EXPECT_EQ(none.error().code, Code::NO_PLANE);
   EXPECT_EQ(none.error().cause, static_cast<std::uint8_t>(ok::RansacError::Code::TOO_FEW_POINTS));
+  // Counts print as integers (issue 16: "2.000000 finite points").
+  EXPECT_NE(none.error().to_string().find("ransac_plane: 2 finite points"), std::string::npos)
+      << none.error().to_string();
   // A 600-point planar scoring sample at z = 1, and a dense sample far from that plane: the refit
   // finds fewer than 3 inliers on the dense sample.
   std::vector<float> sx, sy, sz, dx, dy, dz;

@@ -1,0 +1,106 @@
+#!/usr/bin/env python3
+"""The "smaller, same classes" items of issue 16, through the CLI, one sub-case per command.
+
+segment   a 2-12 pixel wide organized strip of a Kinect-like table view finds the table as the same
+          points unorganized do; --leaf is applied to organized frames (and says so); error counts
+          print as integers; finite points outside the ROI are reported as such.
+synth     synth-dataset refuses an empty --out and duplicate categories, writing nothing.
+derive    derive-views refuses two inputs with one stem (naming both) and an input without finite
+          points, before writing anything; a read-only output reports the real errno and the path.
+evaluate  the teacher protocol on a one-category dataset is refused up front with the reason.
+frames    --frames -1 is refused with a message that names the option and the value.
+
+Usage: check_small_edge_cases.py ORTHOFLOW SHARED_DIR WORK_DIR CASE
+"""
+import json
+import math
+import os
+import re
+import shutil
+import subprocess
+import sys
+
+NY, NZ = -math.sin(math.radians(50)), -math.cos(math.radians(50))
+
+
+def run(cli, *args, code=0):
+    p = subprocess.run([cli, *map(str, args)], capture_output=True, text=True)
+    if code is not None and p.returncode != code:
+        sys.exit(f"FAIL: {' '.join(map(str, args))}: exit {p.returncode}, wanted {code}\n"
+                 f"stdout: {p.stdout}\nstderr: {p.stderr}")
+    return p
+
+
+def expect(condition, what):
+    if not condition:
+        sys.exit(f"FAIL: {what}")
+
+
+def write_pcd(path, points, width, height):
+    with open(path, "w") as f:
+        f.write("VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n"
+                f"WIDTH {width}\nHEIGHT {height}\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS {len(points)}\n"
+                "DATA ascii\n")
+        for p in points:
+            f.write(" ".join("nan" if math.isnan(c) else f"{c:.7g}" for c in p) + "\n")
+
+
+def table_strip(u0, w, v0=140, h=340):
+    """Pixels of a 640x480 pinhole view (f 525) of a table 1.1 m away, tilted 50 degrees."""
+    d = -(NY * 0.35 + NZ * 1.1)
+    out = []
+    for v in range(v0, v0 + h):
+        for u in range(u0, u0 + w):
+            rx, ry = (u - 319.5) / 525.0, (v - 239.5) / 525.0
+            s = -d / (NY * ry + NZ)
+            out.append((s * rx, s * ry, s))
+    return out
+
+
+def segment(cli, work, shared):
+    for w in (2, 3, 4, 5, 8):
+        pts = table_strip(320 - w // 2, w)
+        for organized in (True, False):
+            path = os.path.join(work, f"strip{w}{'o' if organized else 'u'}.pcd")
+            write_pcd(path, pts, w if organized else len(pts), 340 if organized else 1)
+            j = json.loads(run(cli, "segment", path, "--json").stdout)
+            n = j["plane"]["normal"]
+            expect(abs(n[1] * NY + n[2] * NZ) > 0.999,
+                   f"{w}-pixel strip ({'organized' if organized else 'unorganized'}): plane {n}")
+    frame = os.path.join(shared, "data", "scenes", "test31.pcd")
+    plain = json.loads(run(cli, "segment", frame, "--json").stdout)
+    expect(plain["plane_input"] == {"kind": "pixel_sample", "stride": 4}, plain["plane_input"])
+    fine = json.loads(run(cli, "segment", frame, "--json", "--leaf", "0.01").stdout)
+    coarse = json.loads(run(cli, "segment", frame, "--json", "--leaf", "0.02").stdout)
+    expect(fine["plane_input"] == {"kind": "voxel_grid", "leaf": 0.01}, fine["plane_input"])
+    expect(fine["inliers"] > coarse["inliers"], "--leaf 0.01 and 0.02 give the same plane input")
+    text = run(cli, "segment", frame, "--leaf", "0.02").stdout
+    expect("plane input: voxel grid, leaf 0.02 m" in text, text)
+    expect("--leaf replaces that sample" in run(cli, "segment", "--help").stdout, "--help")
+    far = os.path.join(work, "far.pcd")
+    write_pcd(far, [(0.01 * (i % 10), 0.01 * (i // 10), 5.0) for i in range(100)], 10, 10)
+    err = run(cli, "segment", far, code=1).stderr
+    expect("100 finite points, 0 inside the region of interest x [-1, 1] y [-1, 1] z [0.3, 2] m"
+           in err, err)
+    two = os.path.join(work, "two.pcd")  # 3 points within 1 mm: one voxel, too few for a plane
+    write_pcd(two, [(0.0, 0.0, 1.0), (0.001, 0.0, 1.0), (0.0, 0.001, 1.0)], 3, 1)
+    err = run(cli, "segment", two, code=1).stderr
+    expect(re.search(r"\b1 finite points, need at least 3", err), err)
+    for e in (err, run(cli, "segment", far, code=1).stderr):
+        expect(not re.search(r"\d\.000000", e), f"a count printed as a float: {e}")
+
+
+CASES = {"segment": segment}
+
+
+def main():
+    cli, shared, work, case = sys.argv[1:5]
+    work = os.path.join(work, case)
+    shutil.rmtree(work, ignore_errors=True)
+    os.makedirs(work)
+    CASES[case](cli, work, shared)
+    print(f"{case}: ok")
+
+
+if __name__ == "__main__":
+    main()
