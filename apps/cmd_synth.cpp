@@ -189,7 +189,8 @@ void add_synth_command(CLI::App& app) {
   CLI::App* ds = app.add_subcommand(
       "synth-dataset", "Write segmented object views as DIR/<category>/<instance>/view_NNN.pcd");
   ds->add_option("--out", ds_args->out, "output directory")->required();
-  ds->add_option("--categories", ds_args->categories, "comma-separated categories (default: all)");
+  ds->add_option("--categories", ds_args->categories,
+                 "comma-separated categories, each named once (default: all)");
   ds->add_option("--instances", ds_args->instances, "instances per category")
       ->check(CLI::Range(1, 1000));
   ds->add_option("--views", ds_args->views, "views per instance")->check(CLI::Range(1, 10000));

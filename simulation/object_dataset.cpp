@@ -43,6 +43,13 @@ Result<void, DatasetError> validate(const DatasetConfig& c) {
         c.max_distance_m <= 3.5)) {
     what = "distance range must satisfy 0.5 <= min <= max <= 3.5 m";
   }
+  for (std::size_t i = 0; i < c.categories.size() && what.empty(); ++i) {
+    // Twice the same category would write its views twice over one directory and count them twice.
+    if (std::find(c.categories.begin(), c.categories.begin() + static_cast<std::ptrdiff_t>(i),
+                  c.categories[i]) != c.categories.begin() + static_cast<std::ptrdiff_t>(i)) {
+      what = "category '" + std::string(category_name(c.categories[i])) + "' is listed twice";
+    }
+  }
   if (what.empty()) { return {}; }
   return err(DatasetError{DatasetError::Code::BAD_CONFIG, "dataset config: " + what});
 }
@@ -174,6 +181,10 @@ std::filesystem::path dataset_view_path(Category category, std::uint32_t i, std:
 Result<DatasetSummary, DatasetError> write_object_dataset(const DatasetConfig& config,
                                                           const std::filesystem::path& dir) {
   if (auto ok = validate(config); !ok) { return err(ok.error()); }
+  if (dir.empty()) {  // "" would write into the working directory
+    return err(DatasetError{DatasetError::Code::BAD_CONFIG,
+                            "dataset config: the output directory is an empty path"});
+  }
   std::vector<Category> cats = config.categories;
   if (cats.empty()) {
     for (std::size_t c = 0; c < CATEGORY_COUNT; ++c) { cats.push_back(static_cast<Category>(c)); }

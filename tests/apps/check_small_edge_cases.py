@@ -90,7 +90,26 @@ def segment(cli, work, shared):
         expect(not re.search(r"\d\.000000", e), f"a count printed as a float: {e}")
 
 
-CASES = {"segment": segment}
+def synth(cli, work, shared):
+    cwd = os.path.join(work, "cwd")
+    os.makedirs(cwd)
+    p = subprocess.run([cli, "synth-dataset", "--out", "", "--categories", "mug", "--instances", "1",
+                        "--views", "1"], capture_output=True, text=True, cwd=cwd)
+    expect(p.returncode == 106 and "output directory is an empty path" in p.stderr,
+           f"--out '': exit {p.returncode}: {p.stderr}")
+    expect(os.listdir(cwd) == [], f"--out '' wrote into the working directory: {os.listdir(cwd)}")
+    out = os.path.join(work, "twice")
+    err = run(cli, "synth-dataset", "--out", out, "--categories", "mug,bowl,mug", "--instances", 1,
+              "--views", 2, code=106).stderr
+    expect("category 'mug' is listed twice" in err, err)
+    expect(not os.path.exists(out), "--categories mug,bowl,mug wrote views")
+    text = run(cli, "synth-dataset", "--out", out, "--categories", "mug,bowl", "--instances", 1,
+               "--views", 2).stdout
+    written = sum(len(files) for _, _, files in os.walk(out))
+    expect("= 4 views written" in text and written == 4, f"{text} ({written} files)")
+
+
+CASES = {"segment": segment, "synth": synth}
 
 
 def main():

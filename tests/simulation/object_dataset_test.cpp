@@ -152,6 +152,24 @@ TEST(ObjectDataset, ErrorsSayWhat) {
   EXPECT_EQ(bad_result.error().code, DatasetError::Code::BAD_CONFIG);
   EXPECT_NE(bad_result.error().to_string().find("views"), std::string::npos);
 
+  // Issue 16: an empty path (the working directory) and a category listed twice are refused, and
+  // nothing is written.
+  DatasetConfig one_view = small_config();
+  one_view.instances = one_view.views = 1;
+  auto empty_result = write_object_dataset(one_view, "");
+  ASSERT_FALSE(empty_result);
+  EXPECT_EQ(empty_result.error().code, DatasetError::Code::BAD_CONFIG);
+  EXPECT_NE(empty_result.error().message.find("empty path"), std::string::npos);
+  DatasetConfig twice = one_view;
+  twice.categories = {Category::MUG, Category::BOWL, Category::MUG};
+  const fs::path twice_dir = fresh_dir("object_dataset_twice");
+  auto twice_result = write_object_dataset(twice, twice_dir);
+  ASSERT_FALSE(twice_result);
+  EXPECT_EQ(twice_result.error().code, DatasetError::Code::BAD_CONFIG);
+  EXPECT_NE(twice_result.error().message.find("category 'mug' is listed twice"), std::string::npos)
+      << twice_result.error().message;
+  EXPECT_FALSE(fs::exists(twice_dir));
+
   // A knife lying flat seen from straight above at 0.5 m is nearer than the sensor's minimum range.
   DatasetConfig blind = small_config();
   blind.categories = {Category::KNIFE};
