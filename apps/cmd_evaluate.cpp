@@ -12,10 +12,8 @@
 #include <vector>
 
 #include "apps/commands.hpp"
-#include "evaluation/derived_views.hpp"
 #include "evaluation/progress.hpp"
 #include "evaluation/report.hpp"
-#include "formats/pcd_io.hpp"
 
 namespace orthoflow::apps {
 namespace {
@@ -140,52 +138,6 @@ void run_evaluate(const EvaluateOptions& o) {
   std::cout << '\n';
 }
 
-struct DeriveOptions {
-  std::vector<std::string> files;
-  std::string out;
-  std::uint32_t views = 10;
-  std::uint64_t seed = 1;
-};
-
-/// FILE stem = category; views go to OUT/<stem>/<stem>_0/view_NNN.pcd.
-void run_derive(const DeriveOptions& o) {
-  for (const std::string& file : o.files) {
-    auto cloud = formats::read_pcd(file);
-    if (!cloud) {
-      std::cerr << "orthoflow derive-views: " << cloud.error().to_string() << '\n';
-      throw CLI::RuntimeError(EXIT_BAD_INPUT);
-    }
-    const std::string stem = std::filesystem::path(file).stem().string();
-    const std::filesystem::path dir = std::filesystem::path(o.out) / stem / (stem + "_0");
-    std::error_code ec;
-    std::filesystem::create_directories(dir, ec);
-    for (std::uint32_t v = 0; v < o.views; ++v) {
-      char name[32];
-      std::snprintf(name, sizeof name, "view_%03u.pcd", v);
-      auto written = formats::write_pcd(evaluation::derive_view(*cloud, v, o.seed), dir / name,
-                                        formats::PcdEncoding::BINARY);
-      if (!written) {
-        std::cerr << "orthoflow derive-views: " << written.error().to_string() << '\n';
-        throw CLI::RuntimeError(EXIT_FAILURE_GENERIC);
-      }
-    }
-    std::cout << dir.string() << ": " << o.views << " views\n";
-  }
-}
-
-void add_derive_command(CLI::App& app) {
-  auto o = std::make_shared<DeriveOptions>();
-  CLI::App* cmd = app.add_subcommand(
-      "derive-views",
-      "Lay single views out as DIR/<file stem>/<stem>_0/view_NNN.pcd with random partial crops");
-  cmd->add_option("files", o->files, "object view PCD files (one category each)")->required();
-  cmd->add_option("--out", o->out, "output dataset directory")->required();
-  cmd->add_option("--views", o->views, "views per file (view 0 is the file itself)")
-      ->check(CLI::Range(1, 10000));
-  cmd->add_option("--seed", o->seed, "seed of the crops and noise");
-  cmd->callback([o] { run_derive(*o); });
-}
-
 }  // namespace
 
 void add_evaluate_command(CLI::App& app) {
@@ -230,7 +182,7 @@ void add_evaluate_command(CLI::App& app) {
   cmd->add_flag("--no-cache", o->no_cache, "compute every descriptor, read and write no cache");
   cmd->add_flag("--quiet", o->quiet, "no progress bar");
   cmd->callback([o] { run_evaluate(*o); });
-  add_derive_command(app);
+  add_derive_views_command(app);
 }
 
 }  // namespace orthoflow::apps

@@ -109,7 +109,47 @@ def synth(cli, work, shared):
     expect("= 4 views written" in text and written == 4, f"{text} ({written} files)")
 
 
-CASES = {"segment": segment, "synth": synth}
+def derive(cli, work, shared):
+    bowl = os.path.join(shared, "data", "objects", "bowl.pcd")
+    for d in ("a", "b"):
+        os.makedirs(os.path.join(work, d))
+        shutil.copy(bowl, os.path.join(work, d, "bowl.pcd"))
+    out = os.path.join(work, "ds")
+    a, b = os.path.join(work, "a", "bowl.pcd"), os.path.join(work, "b", "bowl.pcd")
+    err = run(cli, "derive-views", a, b, "--out", out, code=106).stderr
+    expect(f"{a} and {b} have the same stem 'bowl'" in err, err)
+    expect(not os.path.exists(out), "derive-views wrote before refusing a repeated stem")
+    empty = os.path.join(work, "empty.pcd")
+    write_pcd(empty, [(math.nan,) * 3] * 50, 50, 1)
+    err = run(cli, "derive-views", a, empty, "--out", out, code=2).stderr
+    expect(f"{empty}: no finite points (50 points, all NaN or infinite)" in err, err)
+    expect(not os.path.exists(out), "derive-views wrote before refusing an all-NaN input")
+    # A read-only output: a read-only bind mount where a private mount namespace is allowed (root
+    # ignores file modes), else a mode-555 directory (not root), else /sys (mkdir: EPERM).
+    ro = os.path.join(work, "ro")
+    os.makedirs(ro)
+    target = os.path.join(ro, "ds")
+    if os.geteuid() != 0:
+        os.chmod(ro, 0o555)
+        p = subprocess.run([cli, "derive-views", a, "--out", target], capture_output=True, text=True)
+        want = "Permission denied"
+    elif subprocess.run(["unshare", "-m", "true"], capture_output=True).returncode == 0:
+        p = subprocess.run(["unshare", "-m", "sh", "-c",
+                            f'mount --bind "{ro}" "{ro}" && mount -o remount,ro,bind "{ro}" && '
+                            f'exec "{cli}" derive-views "{a}" --out "{target}"'],
+                           capture_output=True, text=True)
+        want = "Read-only file system"
+    else:
+        target = "/sys/orthoflow-derive-views-test"
+        p = subprocess.run([cli, "derive-views", a, "--out", target], capture_output=True, text=True)
+        want = "Operation not permitted"
+    expect(p.returncode == 1 and f"cannot create {target}/bowl/bowl_0: {want}" in p.stderr,
+           f"read-only output: exit {p.returncode}: {p.stderr}")
+    text = run(cli, "derive-views", a, "--out", out, "--views", 3).stdout
+    expect(text.strip() == f"{out}/bowl/bowl_0: 3 views", text)
+
+
+CASES = {"segment": segment, "synth": synth, "derive": derive}
 
 
 def main():
