@@ -12,6 +12,8 @@ const char* to_string(EvalError::Code code) noexcept {
       return "bad_config";
     case EvalError::Code::TOO_FEW_VIEWS:
       return "too_few_views";
+    case EvalError::Code::TOO_FEW_CATEGORIES:
+      return "too_few_categories";
     case EvalError::Code::WRITE_FAILED:
       return "write_failed";
   }

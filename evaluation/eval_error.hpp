@@ -11,12 +11,14 @@ namespace orthoflow::evaluation {
 /// returned.
 struct EvalError {
   enum class Code : std::uint8_t {
-    BAD_DATASET,    ///< the directory is missing, empty or not laid out as
-                    ///< DIR/<category>/<instance>/<view>.pcd
-    BAD_VIEW,       ///< a view file could not be read or gives no descriptor
-    BAD_CONFIG,     ///< a protocol setting is out of range (folds, runs, bins, levels, ...)
-    TOO_FEW_VIEWS,  ///< the protocol needs more views per category than the dataset has
-    WRITE_FAILED,   ///< results, plots or the cache could not be written
+    BAD_DATASET,         ///< the directory is missing, empty or not laid out as
+                         ///< DIR/<category>/<instance>/<view>.pcd
+    BAD_VIEW,            ///< a view file could not be read or gives no descriptor
+    BAD_CONFIG,          ///< a protocol setting is out of range (folds, runs, bins, levels, ...)
+    TOO_FEW_VIEWS,       ///< the protocol needs more views per category than the dataset has
+    TOO_FEW_CATEGORIES,  ///< the protocol needs more categories than the dataset has (teacher: 2,
+                         ///< teacher-context: 3)
+    WRITE_FAILED,        ///< results, plots or the cache could not be written
   };
   Code code = Code::BAD_CONFIG;
   std::string message;

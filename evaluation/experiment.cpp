@@ -42,6 +42,15 @@ Result<void, EvalError> check(const Dataset& ds, const EvalOptions& o) {
     return err(config_error("teacher needs intro views >= 1, breakpoint >= 1 and tau in [0, 1)"));
   }
   const bool teacher = o.protocol == Protocol::TEACHER || o.protocol == Protocol::TEACHER_CONTEXT;
+  // Algorithm 7.1 measures how many categories a learner tells apart: a learner that knows one
+  // category has none to tell apart, so no question is asked and no accuracy is measured.
+  if (teacher && ds.categories.size() < 2) {
+    return err(EvalError{EvalError::Code::TOO_FEW_CATEGORIES,
+                         "the teacher protocol needs at least 2 categories, the dataset has " +
+                             std::to_string(ds.categories.size()) +
+                             (ds.categories.empty() ? "" : " ('" + ds.categories[0] + "')") +
+                             ": a learner that knows one category has none to tell apart"});
+  }
   for (std::uint32_t c = 0; teacher && c < ds.categories.size(); ++c) {
     if (ds.views_of(c).size() <= o.teacher.intro_views) {
       return err(EvalError{EvalError::Code::TOO_FEW_VIEWS,
@@ -53,7 +62,9 @@ Result<void, EvalError> check(const Dataset& ds, const EvalOptions& o) {
   }
   if (o.protocol == Protocol::TEACHER_CONTEXT && ds.categories.size() < 3) {
     return err(
-        EvalError{EvalError::Code::TOO_FEW_VIEWS, "context change needs at least 3 categories"});
+        EvalError{EvalError::Code::TOO_FEW_CATEGORIES,
+                  "the context change protocol needs at least 3 categories, the dataset has " +
+                      std::to_string(ds.categories.size())});
   }
   return {};
 }

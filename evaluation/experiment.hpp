@@ -69,7 +69,8 @@ struct Evaluation {
 [[nodiscard]] std::size_t evaluation_work(const Dataset& dataset, const EvalOptions& options);
 
 /// @brief Runs @p options.protocol on @p dataset. Errors: BAD_CONFIG (no variant, runs 0, folds <
-/// 2, negative levels), TOO_FEW_VIEWS, BAD_VIEW / BAD_DATASET from describing the views.
+/// 2, negative levels), TOO_FEW_VIEWS, TOO_FEW_CATEGORIES (teacher: 2, teacher-context: 3),
+/// BAD_VIEW / BAD_DATASET from describing the views.
 [[nodiscard]] Result<Evaluation, EvalError> evaluate(const Dataset& dataset,
                                                      const EvalOptions& options,
                                                      Progress* progress);

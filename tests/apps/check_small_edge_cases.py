@@ -149,7 +149,20 @@ def derive(cli, work, shared):
     expect(text.strip() == f"{out}/bowl/bowl_0: 3 views", text)
 
 
-CASES = {"segment": segment, "synth": synth, "derive": derive}
+def evaluate(cli, work, shared):
+    ds, out = os.path.join(work, "ds"), os.path.join(work, "report")
+    run(cli, "synth-dataset", "--out", ds, "--categories", "mug", "--instances", 2, "--views", 4)
+    for protocol in ("teacher", "teacher-context"):
+        p = run(cli, "evaluate", "--dataset", ds, "--protocol", protocol, "--runs", 1, "--out", out,
+                "--no-cache", "--quiet", code=2)
+        expect("too_few_categories: the" in p.stderr and "the dataset has 1" in p.stderr, p.stderr)
+        expect(not os.path.exists(out), f"{protocol}: a report was started")
+    err = run(cli, "evaluate", "--dataset", ds, "--protocol", "teacher", "--no-cache", "--quiet",
+              "--out", out, code=2).stderr
+    expect("the teacher protocol needs at least 2 categories, the dataset has 1 ('mug')" in err, err)
+
+
+CASES = {"segment": segment, "synth": synth, "derive": derive, "evaluate": evaluate}
 
 
 def main():

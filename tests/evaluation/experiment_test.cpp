@@ -7,6 +7,7 @@
 #include "evaluation/experiment.hpp"
 #include "evaluation/report.hpp"
 #include "tests/evaluation/box_dataset.hpp"
+#include "tests/evaluation/eval_fixtures.hpp"
 
 namespace orthoflow::evaluation {
 namespace {
@@ -120,6 +121,20 @@ TEST_F(Experiment, ConfigurationErrors) {
   o = options(Protocol::CV10, 1);
   o.variants.clear();
   EXPECT_EQ(evaluate(ds, o, nullptr).error().code, EvalError::Code::BAD_CONFIG);
+  // Issue 16: one category under the teacher used to fail writing its plots ("no series"); it is
+  // refused up front, as two under the context change are.
+  const auto one = testing::hand_made({{"mug", 12, {1.0F, 0.0F, 0.0F}}});
+  auto single = evaluate(one.dataset, options(Protocol::TEACHER, 1), nullptr);
+  ASSERT_FALSE(single);
+  EXPECT_EQ(single.error().code, EvalError::Code::TOO_FEW_CATEGORIES);
+  EXPECT_NE(single.error().to_string().find("too_few_categories: the teacher protocol needs at "
+                                            "least 2 categories, the dataset has 1 ('mug')"),
+            std::string::npos)
+      << single.error().to_string();
+  const auto two =
+      testing::hand_made({{"a", 12, {1.0F, 0.0F, 0.0F}}, {"b", 12, {0.0F, 1.0F, 0.0F}}});
+  EXPECT_EQ(evaluate(two.dataset, options(Protocol::TEACHER_CONTEXT, 1), nullptr).error().code,
+            EvalError::Code::TOO_FEW_CATEGORIES);
 }
 
 TEST_F(Experiment, ReportWritesJsonMarkdownAndPlots) {
