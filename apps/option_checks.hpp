@@ -4,7 +4,9 @@
 /// `ipc echo --timeout-ms -5` never returned): a value must be a finite, non-negative number. CLI11
 /// already refuses trailing garbage ("5abc") when it converts; NaN, infinities and negative numbers
 /// it accepts, so check_numeric_options() adds the rule to every INT, UINT and FLOAT option once
-/// all commands are declared. Commands add their own ranges on top.
+/// all commands are declared. An INT or UINT option (counts such as --frames) must also be a whole
+/// number within int64: "1.5" and "99999999999999999999" are refused with what is wrong. Commands
+/// add their own ranges on top.
 #include <CLI/CLI.hpp>
 
 namespace orthoflow::apps {

@@ -162,7 +162,24 @@ def evaluate(cli, work, shared):
     expect("the teacher protocol needs at least 2 categories, the dataset has 1 ('mug')" in err, err)
 
 
-CASES = {"segment": segment, "synth": synth, "derive": derive, "evaluate": evaluate}
+def frames(cli, work, shared):
+    graphs = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "graphs")
+    commands = [["run"], ["graph", "run", os.path.join(graphs, "tabletop.yaml")],
+                ["ipc", "run", os.path.join(graphs, "perception.yaml")], ["ipc", "send"]]
+    wanted = {"-1": "'-1' is negative (expected 0 or more)", "1.5": "'1.5' is not a whole number",
+              "99999999999999999999": "'99999999999999999999' is too large (at most 9223372036854775807)"}
+    for command in commands:
+        help_text = run(cli, *command, "--help").stdout
+        expect("--frames" in help_text, f"{command} has no --frames")
+        for value, message in wanted.items():
+            p = subprocess.run([cli, *command, "--frames", value], capture_output=True, text=True,
+                               timeout=30)
+            expect(p.returncode == 105 and f"--frames: {message}" in p.stderr,
+                   f"{' '.join(command)} --frames {value}: exit {p.returncode}: {p.stderr}")
+
+
+CASES = {"segment": segment, "synth": synth, "derive": derive, "evaluate": evaluate,
+         "frames": frames}
 
 
 def main():
