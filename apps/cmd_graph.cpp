@@ -97,6 +97,19 @@ std::unique_ptr<engine::Graph> load_graph_or_throw(const std::string& file,
   return std::move(*graph_result);
 }
 
+engine::StopReason run_watching_roudi(engine::Engine& engine, const engine::RunOptions& options) {
+  // Only a graph whose IPC nodes registered with RouDi is watched; the watch ends the run within
+  // ~100 ms of a loss, also when no IPC node is busy.
+  std::optional<engine::RoudiWatch> watch;
+  if (engine::ipc_runtime_ready()) watch.emplace([&engine] { engine.request_stop(); });
+  return engine.run(options);
+}
+
+std::string roudi_lost_text(const std::string& doing) {
+  return "RouDi lost while " + doing + " (ROUDI_LOST: RouDi no longer answers on " +
+         std::string(engine::ROUDI_SOCKET_PATH) + ")";
+}
+
 void run_graph_file(const GraphRunArgs& args) {
   const auto registry = make_graph_registry();
   auto graph = load_graph_or_throw(args.file, registry, engine::BuildMode::RUN);
@@ -108,13 +121,7 @@ void run_graph_file(const GraphRunArgs& args) {
   std::uint64_t unpublished = 0;
   {
     engine::Engine runner(*graph, {args.threads});
-    {
-      // Only a graph whose IPC nodes registered with RouDi is watched; the watch ends the run
-      // within ~100 ms of a loss, also when no IPC node is busy.
-      std::optional<engine::RoudiWatch> watch;
-      if (engine::ipc_runtime_ready()) watch.emplace([&runner] { runner.request_stop(); });
-      reason = runner.run({args.frames, &g_stop_requested});
-    }
+    reason = run_watching_roudi(runner, {args.frames, &g_stop_requested});
     std::cout << engine::format_table(runner.stats());
     json = engine::to_json(runner.stats());
     print_ipc_counters(*graph, runner);
@@ -131,8 +138,7 @@ void run_graph_file(const GraphRunArgs& args) {
   write_json(args, json);
   std::cout.flush();
   if (lost) {
-    std::cerr << args.command << ": RouDi lost while running " << args.file
-              << " (ROUDI_LOST: RouDi no longer answers on " << engine::ROUDI_SOCKET_PATH << "); "
+    std::cerr << args.command << ": " << roudi_lost_text("running " + args.file) << "; "
               << unpublished << " sample(s) not published; the IPC counters above count only what "
               << "reached shared memory before the loss\n";
     throw CLI::RuntimeError(EXIT_ROUDI_LOST);

@@ -13,16 +13,15 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
-#include <optional>
 #include <string>
 
 #include "apps/commands.hpp"
+#include "apps/graph_run.hpp"
 #include "apps/scene_snapshot_png.hpp"
 #include "engine/engine.hpp"
 #include "engine/graph.hpp"
 #include "engine/ipc_runtime.hpp"
 #include "engine/object_list_payload.hpp"
-#include "engine/roudi_watch.hpp"
 #include "graphs/descriptor_params.hpp"
 #include "graphs/embedded_graphs.hpp"
 #include "graphs/tabletop.hpp"
@@ -233,6 +232,9 @@ void run(const RunOptions& o) {
   if (o.publish_objects) add_objects_publisher(*spec);
   auto learning = graphs::LearningService::open(learning_settings(*spec, o));
   if (!learning) fail(learning.error(), EXIT_FAILURE_GENERIC);
+  for (const std::string& warning : (*learning)->open_warnings()) {
+    std::cerr << "run: warning: --db " << o.db << ": " << warning << '\n';
+  }
   // Every output the user asked for is checked before the run, so a bad path fails at once.
   check_output_path(o.snapshot, "--snapshot");
   std::unique_ptr<graphs::LineWriter> telemetry;
@@ -255,13 +257,8 @@ void run(const RunOptions& o) {
   auto previous_int = std::signal(SIGINT, on_run_signal);
   auto previous_term = std::signal(SIGTERM, on_run_signal);
   engine::Engine engine(**graph, {o.threads});
-  engine::StopReason reason = engine::StopReason::SOURCE_END;
-  {
-    // --publish-objects: a lost RouDi ends the run within ~100 ms (docs/IPC.md), exit 22 below.
-    std::optional<engine::RoudiWatch> watch;
-    if (engine::ipc_runtime_ready()) watch.emplace([&engine] { engine.request_stop(); });
-    reason = engine.run({o.frames, &g_run_stop});
-  }
+  // --publish-objects: a lost RouDi ends the run within ~100 ms (docs/IPC.md), exit 22 below.
+  const auto reason = run_watching_roudi(engine, {o.frames, &g_run_stop});
   std::signal(SIGINT, previous_int);
   std::signal(SIGTERM, previous_term);
   (*learning)->flush();
@@ -272,8 +269,7 @@ void run(const RunOptions& o) {
   std::cout << engine::format_table(engine.stats());
   const bool roudi_lost = engine::ipc_roudi_lost();
   if (roudi_lost) {
-    std::cerr << "run: RouDi lost while publishing objects (ROUDI_LOST: RouDi no longer answers on "
-              << engine::ROUDI_SOCKET_PATH << "); the run stopped\n";
+    std::cerr << "run: " << roudi_lost_text("publishing objects") << "; the run stopped\n";
   }
   finish_outputs(o, log, engine.stats(), std::move(telemetry));
   if (roudi_lost) throw CLI::RuntimeError(EXIT_ROUDI_LOST);

@@ -6,6 +6,7 @@
 #include <memory>
 #include <string>
 
+#include "engine/engine.hpp"
 #include "engine/graph.hpp"
 #include "engine/registry.hpp"
 
@@ -19,6 +20,14 @@ namespace orthoflow::apps {
 /// [CODE]: ...` on stderr, then CLI::RuntimeError(EXIT_BAD_INPUT)).
 [[nodiscard]] std::unique_ptr<engine::Graph> load_graph_or_throw(
     const std::string& file, const engine::NodeRegistry& registry, engine::BuildMode mode);
+
+/// @brief engine.run(options) under a RoudiWatch when the graph's IPC nodes registered with RouDi:
+/// a lost RouDi stops the run within ~100 ms (engine::ipc_roudi_lost() says so afterwards).
+/// Shared by `graph run`, `ipc run` and `orthoflow run --publish-objects`.
+engine::StopReason run_watching_roudi(engine::Engine& engine, const engine::RunOptions& options);
+
+/// @brief "RouDi lost while <doing> (ROUDI_LOST: RouDi no longer answers on /tmp/roudi)".
+[[nodiscard]] std::string roudi_lost_text(const std::string& doing);
 
 /// @brief Settings of one graph run.
 struct GraphRunArgs {

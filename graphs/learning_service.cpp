@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cstdio>
 #include <vector>
 
 namespace orthoflow::graphs {
@@ -46,10 +45,6 @@ Result<std::unique_ptr<LearningService>, std::string> LearningService::open(
   if (settings.db) {
     auto memory = learning::PerceptualMemory::open(*settings.db, cfg);
     if (!memory) return err("learning: " + memory.error().to_string());
-    for (const std::string& warning : memory->open_warnings()) {
-      std::fprintf(stderr, "orthoflow: learning: warning: %s: %s\n", settings.db->c_str(),
-                   warning.c_str());
-    }
     s->memory_ = std::make_unique<learning::PerceptualMemory>(std::move(*memory));
     s->worker_ = std::thread([raw = s.get()] { raw->worker_loop(); });
   } else if (cfg.learner == learning::LearnerKind::BAYES) {
@@ -65,6 +60,11 @@ Result<std::unique_ptr<LearningService>, std::string> LearningService::open(
 LearningService::~LearningService() {
   stop_.store(true);
   if (worker_.joinable()) worker_.join();
+}
+
+const std::vector<std::string>& LearningService::open_warnings() const noexcept {
+  static const std::vector<std::string> NONE;
+  return memory_ ? memory_->open_warnings() : NONE;
 }
 
 const learning::Learner& LearningService::learner() const noexcept {

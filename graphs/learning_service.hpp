@@ -21,6 +21,7 @@
 #include <string>
 #include <string_view>
 #include <thread>
+#include <vector>
 
 #include "core/spin_lock.hpp"
 #include "core/spsc_ring.hpp"
@@ -91,6 +92,9 @@ class LearningService {
   [[nodiscard]] const kernels::DescriptorSpec& descriptor() const noexcept { return spec_; }
   [[nodiscard]] std::size_t descriptor_length() const noexcept { return spec_.length(); }
   [[nodiscard]] bool durable() const noexcept { return memory_ != nullptr; }
+  /// @brief What opening the store found wrong and went on from
+  /// (learning::PerceptualMemory::open_warnings()); the caller must show them.
+  [[nodiscard]] const std::vector<std::string>& open_warnings() const noexcept;
 
   /// @brief A new sender, or nullptr when MAX_LEARNING_CLIENTS are connected. Thread-safe.
   [[nodiscard]] std::unique_ptr<LearningClient> connect();

@@ -202,10 +202,11 @@ Result<bool, MemoryError> prepare(PerceptualMemory::State& s, OpenMode mode) {
     case StoreDir::STORE:
       break;
   }
-  if (const auto damage = check_store_log(s.dir)) s.warnings.push_back(damage->to_string());
+  const auto damage = check_store_log(s.dir);
+  if (damage) s.warnings.push_back(damage->to_string());
   // A read-only open must change nothing, so a store LevelDB would rewrite (a read-only mount, or a
   // damaged log tail LevelDB would fold away on replay) is read from a private copy.
-  if (mode == OpenMode::READ_ONLY && (!writable_dir(s.dir) || !s.warnings.empty())) {
+  if (mode == OpenMode::READ_ONLY && (!writable_dir(s.dir) || damage)) {
     auto copy = private_copy(s.dir);
     if (!copy) return err(copy.error());
     s.copy = *copy;
