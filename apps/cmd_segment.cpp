@@ -21,11 +21,10 @@
 #include <vector>
 
 #include "apps/commands.hpp"
+#include "apps/graph_segmentation.hpp"
 #include "apps/json_numbers.hpp"
-#include "engine/graph.hpp"
 #include "formats/pcd_io.hpp"
-#include "graphs/embedded_graphs.hpp"
-#include "graphs/segment_params.hpp"
+#include "kernels/frame_labels.hpp"
 #include "kernels/segmentation_chain.hpp"
 
 namespace orthoflow::apps {
@@ -35,7 +34,8 @@ struct SegmentOptions {
   std::string file;
   bool json = false;
   int repeat = 1;
-  std::string graph;  ///< empty: the PCL baseline's parameters
+  std::string graph;       ///< empty: the PCL baseline's parameters
+  std::string labels_out;  ///< non-empty: write the frame with our per-point labels here
   kernels::SegmentationParams params{};
   kernels::CandidateParams candidates{};
   // flags given on the command line (applied over the graph's parameters)
@@ -144,12 +144,7 @@ void print_text(const nlohmann::json& j) {
 /// then the flags given.
 void resolve_params(SegmentOptions& opt) {
   if (!opt.graph.empty()) {
-    auto spec =
-        opt.graph == "tabletop"
-            ? engine::parse_graph(std::string(graphs::embedded_tabletop_yaml()), "tabletop.yaml")
-            : engine::load_graph_file(opt.graph);
-    if (!spec) fail(engine::to_string(spec.error()), EXIT_BAD_INPUT);
-    auto seg = graphs::segmentation_of_graph(*spec);
+    auto seg = segmentation_of_graph_arg(opt.graph);
     if (!seg) fail(seg.error(), EXIT_BAD_INPUT);
     opt.params = seg->stages;
     opt.candidates = seg->candidates;
@@ -162,6 +157,22 @@ void resolve_params(SegmentOptions& opt) {
   if (opt.plane_iters) opt.params.ransac.max_iterations = *opt.plane_iters;
   if (opt.cluster_tol) opt.params.cluster.tolerance = *opt.cluster_tol;
   if (opt.min_cluster) opt.params.cluster.min_size = *opt.min_cluster;
+}
+
+/// The frame with a `label` field (0 none, 1 table, k >= 2 object k - 2: kernels/frame_labels.hpp)
+/// in place of any label it had, binary_compressed like the Kinect recordings.
+void write_labels(const kernels::SegmentationResult& seg, const SegmentOptions& opt,
+                  kernels::PointCloud& cloud) {
+  if (!seg.organized) {
+    fail("--labels-out needs an organized frame (per-point labels come from the organized chain; " +
+             opt.file + " has height 1)",
+         EXIT_BAD_INPUT);
+  }
+  cloud.add_field(kernels::Field::LABEL);
+  kernels::frame_labels(cloud.points(), seg.plane.plane, opt.params.ransac.tau, opt.params.roi,
+                        seg.labels, seg.candidate_of, cloud.label());
+  auto written = formats::write_pcd(cloud, opt.labels_out);
+  if (!written) fail(written.error().to_string(), EXIT_FAILURE_GENERIC);
 }
 
 void run_segment(SegmentOptions& opt) {
@@ -183,6 +194,7 @@ void run_segment(SegmentOptions& opt) {
     runs.push_back(seg_result->timings);
     if (r + 1 == opt.repeat) {
       out = to_json(*seg_result, median_timings(runs), plane_input_json(*cloud_result, opt.params));
+      if (!opt.labels_out.empty()) write_labels(*seg_result, opt, *cloud_result);
     }
   }
   if (opt.json) {
@@ -205,6 +217,9 @@ void add_segment_command(CLI::App& app) {
   cmd->add_option(
       "--graph", opt->graph,
       "Take the segmentation parameters from this graph file ('tabletop': the embedded one)");
+  cmd->add_option("--labels-out", opt->labels_out,
+                  "Write the frame as PCD with a label field: 0 no object, 1 table, k >= 2 "
+                  "object k - 2 of the objects list (organized frames)");
   cmd->add_option("--leaf", opt->leaf,
                   "Voxel leaf in metres (0: no voxel grid). An organized frame otherwise fits its "
                   "plane on a strided pixel sample; --leaf replaces that sample by this voxel grid")

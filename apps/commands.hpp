@@ -49,4 +49,6 @@ void add_evaluate_command(CLI::App& app);
 /// @brief `derive-views FILE... --out DIR`: partial views of single object views, as a dataset
 /// (registered by add_evaluate_command).
 void add_derive_views_command(CLI::App& app);
+/// @brief `evaluate-segmentation --dataset DIR`: the chain scored on labelled frames (mOSD labels).
+void add_evaluate_segmentation_command(CLI::App& app);
 }  // namespace orthoflow::apps

@@ -58,6 +58,7 @@ Result<SegmentationResult, SegmentationError> SegmentationChain::run(CloudView c
                             std::span<const ClusterStats>(candidates_).first(counts.kept),
                             counts,
                             objects_result->labels,
+                            std::span<const std::int32_t>(slot_of_).first(clusters.size()),
                             takes_organized_path(cloud, params_),
                             t};
 }

@@ -38,6 +38,8 @@ struct SegmentationResult {
   CandidateCounts candidate_counts;
   /// Per-point cluster id (-1 none): per input point on the organized chain, per voxel otherwise.
   std::span<const std::int32_t> labels;
+  /// Per cluster: its index in candidates, or -1 (rejected by C_size / C_edge or over capacity).
+  std::span<const std::int32_t> candidate_of;
   bool organized = false;
   SegmentationTimings timings;
 };

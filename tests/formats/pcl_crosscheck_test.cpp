@@ -12,6 +12,8 @@
 
 #include "formats/pcd_io.hpp"
 #include "formats/point_fields.hpp"
+#include "kernels/frame_labels.hpp"
+#include "kernels/segmentation_chain.hpp"
 #include "test_clouds.hpp"
 
 namespace ofmt = orthoflow::formats;
@@ -144,6 +146,37 @@ TEST(PclCrossCheck, WeReadWhatPclWrites) {
   pcl::PCLPointCloud2 pc;
   ASSERT_EQ(pcl::io::loadPCDFile(a.string(), pc), 0);
   expect_agrees(pc, *ascii, a.string());  // the same text parsed by both gives the same bits
+  fs::remove_all(dir);
+}
+
+TEST(PclCrosscheck, LabelsOutFileReadsIntoPclsLabelledPoints) {
+  // What `orthoflow segment --labels-out` writes: the frame with our per-point labels in place of
+  // its own (0 none, 1 table, k >= 2 object). PCL reads it into PointXYZRGBL organized, label for
+  // label and bit for bit.
+  auto frame = ofmt::read_pcd(fs::path(ORTHOFLOW_SHARED_DIR) / "data/mosd_learn/learn13.pcd");
+  ASSERT_TRUE(frame) << frame.error().to_string();
+  ok::SegmentationChain chain(frame->size(), ok::SegmentationParams{});
+  auto seg = chain.run(frame->view());
+  ASSERT_TRUE(seg) << seg.error().to_string();
+  ok::frame_labels(frame->points(), seg->plane.plane, 0.02F, ok::SegmentationParams{}.roi,
+                   seg->labels, seg->candidate_of, frame->label());
+  const fs::path dir = fs::temp_directory_path() / "orthoflow_labels_out";
+  fs::create_directories(dir);
+  const fs::path file = dir / "labels.pcd";
+  ASSERT_TRUE(ofmt::write_pcd(*frame, file));
+  pcl::PointCloud<pcl::PointXYZRGBL> pcl_cloud;
+  ASSERT_EQ(pcl::io::loadPCDFile(file.string(), pcl_cloud), 0);
+  ASSERT_EQ(pcl_cloud.width, frame->width());
+  ASSERT_EQ(pcl_cloud.height, frame->height());
+  std::size_t objects = 0, table = 0;
+  for (std::size_t i = 0; i < frame->size(); ++i) {
+    ASSERT_EQ(pcl_cloud[i].label, frame->label()[i]) << "point " << i;
+    ASSERT_EQ(bits(pcl_cloud[i].z), bits(frame->z()[i])) << "point " << i;
+    objects += pcl_cloud[i].label >= ok::FIRST_OBJECT_LABEL ? 1U : 0U;
+    table += pcl_cloud[i].label == ok::TABLE_LABEL ? 1U : 0U;
+  }
+  EXPECT_GT(table, 100000U);  // learn13: a table and three boxes
+  EXPECT_GT(objects, 3000U);
   fs::remove_all(dir);
 }
 

@@ -1,12 +1,14 @@
 #pragma once
-// Detection quality of a labelling against the mOSD ground truth (used by seg_chain_test and the
-// vs_pcl benchmark). Rule: a cluster detects ground-truth object k when their pixel sets have
-// IoU >= 0.5 (then the match is one-to-one). Over-segmented object: >= 2 clusters each hold >= 10 %
-// of its pixels. Under-segmenting cluster: >= 2 objects each put >= 10 % of their pixels in it.
+// Detection quality of a cluster labelling (id or -1 per pixel, SegmentationResult::labels)
+// against mOSD ground truth, used by seg_chain_test and the vs_pcl benchmark: the product's own
+// scoring (evaluation/segmentation_score.hpp, the rule `orthoflow evaluate-segmentation` applies)
+// after turning cluster k into predicted object k + 2.
 #include <cstddef>
 #include <cstdint>
-#include <map>
 #include <span>
+#include <vector>
+
+#include "evaluation/segmentation_score.hpp"
 
 namespace orthoflow::testing {
 
@@ -20,35 +22,15 @@ struct Quality {
   }
 };
 
-/// @p gt_label: mOSD labels (object k = label / 10 for label >= 20); @p cluster: id or -1, same
-/// pixels.
+/// @p gt_label: mOSD labels; @p cluster: id or -1, same pixels.
 inline Quality evaluate(std::span<const std::uint32_t> gt_label,
                         std::span<const std::int32_t> cluster) {
-  std::map<std::uint32_t, std::size_t> obj_size;
-  std::map<std::int32_t, std::size_t> cl_size;
-  std::map<std::pair<std::uint32_t, std::int32_t>, std::size_t> both;
-  for (std::size_t i = 0; i < gt_label.size(); ++i) {
-    const std::uint32_t obj = gt_label[i] >= 20 ? gt_label[i] / 10 : 0;
-    if (obj != 0) { ++obj_size[obj]; }
-    if (cluster[i] >= 0) { ++cl_size[cluster[i]]; }
-    if (obj != 0 && cluster[i] >= 0) { ++both[{obj, cluster[i]}]; }
+  std::vector<std::uint32_t> predicted(cluster.size());
+  for (std::size_t i = 0; i < cluster.size(); ++i) {
+    predicted[i] = cluster[i] >= 0 ? static_cast<std::uint32_t>(cluster[i]) + 2U : 0U;
   }
-  Quality q;
-  q.gt_objects = obj_size.size();
-  q.clusters = cl_size.size();
-  std::map<std::uint32_t, int> parts_of_obj;
-  std::map<std::int32_t, int> objs_in_cl;
-  for (const auto& [key, n] : both) {
-    const double iou = double(n) / double(obj_size[key.first] + cl_size[key.second] - n);
-    if (iou >= 0.5) { ++q.matched; }
-    if (double(n) >= 0.1 * double(obj_size[key.first])) {
-      ++parts_of_obj[key.first];
-      ++objs_in_cl[key.second];
-    }
-  }
-  for (const auto& [obj, parts] : parts_of_obj) { q.over += parts >= 2 ? 1U : 0U; }
-  for (const auto& [cl, objs] : objs_in_cl) { q.under += objs >= 2 ? 1U : 0U; }
-  return q;
+  const auto c = evaluation::score_objects(gt_label, predicted);
+  return Quality{c.truth, c.predicted, c.matched, c.over, c.under};
 }
 
 }  // namespace orthoflow::testing
