@@ -98,6 +98,7 @@ struct SynthArgs {
   std::uint64_t seed = 1;
   std::string out;
   bool touching = false;
+  bool stacked = false;
   bool no_floor = false;
   std::string categories;
   std::string ground_truth;
@@ -107,6 +108,7 @@ void run_synth(const SynthArgs& a) {
   simulation::SceneConfig config;
   config.objects = a.objects;
   config.touching = a.touching;
+  config.stacked = a.stacked;
   config.floor = !a.no_floor;
   config.categories = parse_categories(a.categories);
   const simulation::Scene scene = simulation::make_scene(config, a.seed);
@@ -178,6 +180,8 @@ void add_synth_command(CLI::App& app) {
   synth->add_option("--seed", synth_args->seed, "seed: same seed, same bytes");
   synth->add_option("--out", synth_args->out, "output PCD file")->required();
   synth->add_flag("--touching", synth_args->touching, "place objects in touching pairs");
+  synth->add_flag("--stacked", synth_args->stacked,
+                  "boxes in stacks of two: every second box lies on the previous one");
   synth->add_flag("--no-floor", synth_args->no_floor, "leave the floor out");
   synth->add_option("--categories", synth_args->categories,
                     "comma-separated categories (default: the 12 scene categories)");

@@ -49,9 +49,10 @@ Result<void, std::string> parse_table_params(const engine::ParamMap& params,
 
 Result<void, std::string> parse_objects_params(const engine::ParamMap& params,
                                                TabletopSegmentation& out) {
-  if (auto ok =
-          params.only({"h_min", "h_max", "tolerance", "min_points", "max_points", "pixel_radius",
-                       "min_size", "max_size", "edge_margin", "merge_overlap"});
+  if (auto ok = params.only({"h_min", "h_max", "tolerance", "min_points", "max_points",
+                             "pixel_radius", "min_size", "max_size", "edge_margin", "merge_overlap",
+                             "cluster_mode", "crease_angle", "crease_gap", "normal_offset",
+                             "max_rise", "depth_change", "stand_height"});
       !ok) {
     return err(ok.error());
   }
@@ -65,6 +66,23 @@ Result<void, std::string> parse_objects_params(const engine::ParamMap& params,
   take(params.integer("max_points", p.cluster.max_size, 1, UINT32_MAX), p.cluster.max_size, e);
   take(params.integer("pixel_radius", p.cluster.pixel_radius, 1, 16), p.cluster.pixel_radius, e);
   take(params.number("merge_overlap", p.merge_overlap, 0.0, 1.0), p.merge_overlap, e);
+  const auto mode = params.choice(
+      "cluster_mode", p.cluster_mode == kernels::ClusterMode::CROWDED ? "crowded" : "euclidean",
+      {"euclidean", "crowded"});
+  if (!mode) {
+    e += (e.empty() ? "" : "; ") + mode.error();
+  } else {
+    p.cluster_mode =
+        *mode == "crowded" ? kernels::ClusterMode::CROWDED : kernels::ClusterMode::EUCLIDEAN;
+  }
+  kernels::CreaseParams& k = p.crease;
+  take(params.number("crease_angle", k.min_angle_deg, 1.0, 179.0), k.min_angle_deg, e);
+  take(params.integer("crease_gap", k.gap, 1, 32), k.gap, e);
+  take(params.integer("normal_offset", k.normals.offset, 1, 32), k.normals.offset, e);
+  take(params.number("depth_change", k.normals.depth_change, 0.001, 1.0), k.normals.depth_change,
+       e);
+  take(params.number("max_rise", k.max_rise, 0.0, 1.0), k.max_rise, e);
+  take(params.number("stand_height", k.stand_height, 0.0, 1.0), k.stand_height, e);
   take(params.number("min_size", c.min_size, 0.0, 10.0), c.min_size, e);
   take(params.number("max_size", c.max_size, 0.0, 10.0), c.max_size, e);
   take(params.number("edge_margin", c.edge_margin, -1.0, 1.0), c.edge_margin, e);

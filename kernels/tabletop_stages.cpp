@@ -205,7 +205,14 @@ ObjectStage::ObjectStage(std::size_t max_points, std::uint32_t min_cluster_size)
       cluster_scratch_(max_points),
       footprints_(std::min(MAX_MERGE, moments_.size())),
       root_(footprints_.size()),
-      new_id_(footprints_.size()) {}
+      new_id_(footprints_.size()),
+      nx_(max_points),
+      ny_(max_points),
+      nz_(max_points),
+      off_crease_(max_points),
+      round_(max_points),
+      members_(max_points),
+      pending_(max_points) {}
 
 Result<ObjectClusters, SegmentationError> ObjectStage::run(CloudView cloud,
                                                            const PlaneInput& plane_input,
@@ -225,21 +232,26 @@ Result<ObjectClusters, SegmentationError> ObjectStage::run(CloudView cloud,
   const double prism_ms = ms_since(start);
   const auto mask = std::span<const std::uint8_t>(mask_).first(target.size());
   const auto labels = std::span(labels_).first(target.size());
+  const bool crowded = organized && p.cluster_mode == ClusterMode::CROWDED;
   auto clusters_result =
-      organized ? euclidean_cluster_organized({target, cloud.width, cloud.height}, mask, p.cluster,
-                                              cluster_scratch_, labels)
-                : euclidean_cluster(target, mask, p.cluster, cluster_scratch_, labels);
+      crowded     ? cluster_crowded({target, cloud.width, cloud.height}, p)
+      : organized ? euclidean_cluster_organized({target, cloud.width, cloud.height}, mask,
+                                                p.cluster, cluster_scratch_, labels)
+                  : euclidean_cluster(target, mask, p.cluster, cluster_scratch_, labels);
   if (!clusters_result) {
     const auto& e = clusters_result.error();
     return err(fail(C::CLUSTERING_FAILED, static_cast<std::uint8_t>(e.code), e.value));
   }
   // Organized: only the pixels the clustering listed (the prism's), not a scan of the whole label
   // frame.
-  const auto members =
-      organized ? cluster_scratch_.listed_members() : std::span<const std::uint32_t>{};
+  const auto members = crowded     ? std::span<const std::uint32_t>(members_).first(inside)
+                       : organized ? cluster_scratch_.listed_members()
+                                   : std::span<const std::uint32_t>{};
   std::size_t clusters = std::min(*clusters_result, stats_.size());
   if (p.merge_overlap > 0.0F)
-    clusters = merge_footprints(target, members, basis, clusters, p.merge_overlap);
+    clusters = merge_footprints(target, members, basis, clusters, p.merge_overlap,
+                                crowded ? p.crease.max_rise : -1.0F, p.crease.stand_height,
+                                p.cluster.tolerance);
   const auto stats = std::span(stats_).first(clusters);
   if (organized) {
     cluster_stats_listed(target, labels, members, moments_, stats);

@@ -26,10 +26,41 @@
 #include "kernels/convex_hull.hpp"
 #include "kernels/crop.hpp"
 #include "kernels/euclidean_cluster.hpp"
+#include "kernels/organized_normals.hpp"
 #include "kernels/ransac_plane.hpp"
 #include "kernels/voxel_grid.hpp"
 
 namespace orthoflow::kernels {
+
+/// @brief How the object stage splits the points above the table into objects.
+enum class ClusterMode : std::uint8_t {
+  EUCLIDEAN,  ///< connected components under the distance tolerance (PCL's rule; the cheapest)
+  /// Organized frames: the same components, cut along concave creases of the surface (where a box
+  /// stands on a box, or a mug leans on a bottle), found from per-pixel normals; the crease pixels
+  /// then rejoin the piece beside them. The footprint merge joins a piece to the one below it only
+  /// when it does not rise above it (CreaseParams::max_rise). Unorganized clouds: EUCLIDEAN.
+  CROWDED,
+};
+
+/// @brief The crowded mode's crease test (docs/SEGMENTATION.md, "Crowded scenes").
+struct CreaseParams {
+  NormalParams normals{};
+  /// A pixel lies on a crease when the normals this many pixels to either side of it (along its
+  /// row or its column) differ by more than min_angle_deg and the surface between them is concave.
+  std::uint32_t gap = 6;
+  float min_angle_deg = 35.0F;
+  /// Crowded mode: the footprint merge joins two overlapping pieces only if the one with the
+  /// smaller footprint rises at most this far above the other's top (a bowl's inside within its
+  /// outside), not a box lying on another. Metres.
+  float max_rise = 0.01F;
+  /// Crowded mode: a piece whose lowest point is higher than this above the table and that lies
+  /// neither on nor under another piece (a handle cut off its mug) joins the piece with the nearest
+  /// footprint within the clustering tolerance. Metres (above the prism's h_min to mean anything).
+  float stand_height = 0.015F;
+  /// Rounds of re-attaching crease pixels to the piece beside them (each reaches pixel_radius
+  /// further into the crease band).
+  std::uint32_t attach_rounds = 4;
+};
 
 /// @brief Chain settings; defaults are the PCL baseline's (specs/BASELINES.md).
 struct SegmentationParams {
@@ -49,6 +80,8 @@ struct SegmentationParams {
   /// at least this share of the smaller one are one object in pieces (a bowl's near and far walls).
   /// 0: off (the PCL baseline has no such step); the tabletop graph uses 0.3.
   float merge_overlap = 0.0F;
+  ClusterMode cluster_mode = ClusterMode::EUCLIDEAN;
+  CreaseParams crease{};
 };
 
 /// @brief Why a stage failed. Plain data: building one on the frame path never allocates. @p cause
@@ -194,16 +227,26 @@ class ObjectStage {
 
  private:
   std::size_t merge_footprints(PointsView target, std::span<const std::uint32_t> members,
-                               const PlaneBasis& basis, std::size_t clusters,
-                               float overlap) noexcept;
+                               const PlaneBasis& basis, std::size_t clusters, float overlap,
+                               float max_rise, float stand_height, float attach_gap) noexcept;
+  /// Crowded mode, organized: clusters of the prism pixels off the creases, then the crease pixels
+  /// re-attached; members_ lists every prism pixel. kernels/crease_split.cpp.
+  [[nodiscard]] Result<std::size_t, ClusterError> cluster_crowded(
+      CloudView cloud, const SegmentationParams& p) noexcept;
   std::vector<float> heights_;
   std::vector<std::uint8_t> mask_;
   std::vector<std::int32_t> labels_;
   std::vector<ClusterMoments> moments_;
   std::vector<ClusterStats> stats_;
   ClusterScratch cluster_scratch_;
-  std::vector<std::array<double, 4>> footprints_;  // u_min, u_max, v_min, v_max per cluster
+  std::vector<std::array<double, 7>>
+      footprints_;  // u, v box, highest, lowest height, lies on/under
   std::vector<std::int32_t> root_, new_id_;
+  std::vector<float> nx_, ny_, nz_;       // crowded mode: per-pixel normals
+  std::vector<std::uint8_t> off_crease_;  // crowded mode: prism pixels off the creases
+  std::vector<std::uint8_t> round_;       // crowded mode: attach round of each pixel
+  std::vector<std::uint32_t> members_;    // crowded mode: every prism pixel, ascending
+  std::vector<std::uint32_t> pending_;    // crowded mode: crease pixels not yet attached
 };
 
 }  // namespace orthoflow::kernels

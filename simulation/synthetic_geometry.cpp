@@ -34,7 +34,7 @@ SceneGeometry::SceneGeometry(const Scene& scene) noexcept
     p.ax = c * table_.right + s * table_.forward;
     p.ay = -s * table_.right + c * table_.forward;
     p.az = table_.normal;
-    p.origin = table_.point(o.table_x, o.table_y);
+    p.origin = table_.point(o.table_x, o.table_y, o.base_m);
     const double h = o.model.height;
     p.sphere_center = p.origin + (h / 2) * p.az;
     p.sphere_radius = std::hypot(o.model.footprint_radius, h / 2) + 0.01;

@@ -79,7 +79,7 @@ std::array<double, 16> object_pose(const TableFrame& table, const PlacedObject& 
   const Vec3 ax = c * table.right + s * table.forward;
   const Vec3 ay = (-s) * table.right + c * table.forward;
   const Vec3& az = table.normal;
-  const Vec3 p = table.point(object.table_x, object.table_y);
+  const Vec3 p = table.point(object.table_x, object.table_y, object.base_m);
   return {ax[0], ay[0], az[0], p[0], ax[1], ay[1], az[1], p[1],
           ax[2], ay[2], az[2], p[2], 0,     0,     0,     1};
 }
@@ -108,12 +108,29 @@ Scene make_scene(const SceneConfig& config, std::uint64_t seed) {
   scene.table.floor_drop_m = config.floor ? rng.uniform(0.65, 0.78) : 0.0;
   std::array<ObjectModel, MAX_SCENE_OBJECTS> models{};
   for (std::uint32_t i = 0; i < config.objects; ++i) {
-    const Category category = pick_category(config, rng);
+    const Category category = config.stacked ? Category::BOX : pick_category(config, rng);
     models[i] = make_object_model(
         category, static_cast<std::uint32_t>(rng.below(config.instances_per_category)));
   }
   // Large footprints first: packing them while the table is empty lets more objects fit.
-  if (!config.touching) {
+  if (config.stacked) {  // the smaller box of each pair on top
+    for (std::uint32_t i = 1; i < config.objects; i += 2) {
+      if (models[i].footprint_radius > models[i - 1].footprint_radius) {
+        std::swap(models[i], models[i - 1]);
+      }
+      // The top box fits on the bottom one: the largest box instance at most 0.85 of its size.
+      if (models[i].footprint_radius > 0.85 * models[i - 1].footprint_radius) {
+        for (std::uint32_t k = 0; k < config.instances_per_category; ++k) {
+          const ObjectModel m = make_object_model(Category::BOX, k);
+          const bool fits_on = m.footprint_radius <= 0.85 * models[i - 1].footprint_radius;
+          if (fits_on && (models[i].footprint_radius > 0.85 * models[i - 1].footprint_radius ||
+                          m.footprint_radius > models[i].footprint_radius)) {
+            models[i] = m;
+          }
+        }
+      }
+    }
+  } else if (!config.touching) {
     std::stable_sort(models.begin(), models.begin() + config.objects,
                      [](const ObjectModel& a, const ObjectModel& b) {
                        return a.footprint_radius > b.footprint_radius;
@@ -121,9 +138,23 @@ Scene make_scene(const SceneConfig& config, std::uint64_t seed) {
   }
   scene.objects.reserve(config.objects);
   for (std::uint32_t i = 0; i < config.objects; ++i) {
-    const bool touch = config.touching && i % 2 == 1 && !scene.objects.empty();
-    const PlacedObject* anchor = touch ? &scene.objects.back() : nullptr;
     PlacedObject placed;
+    if (config.stacked && i % 2 == 1) {
+      if (scene.objects.empty() || scene.objects.back().base_m > 0.0) continue;  // no support
+      const PlacedObject& below = scene.objects.back();
+      if (models[i].footprint_radius > 0.85 * below.model.footprint_radius) continue;  // no fit
+      const double slack = 0.3 * (below.model.footprint_radius - models[i].footprint_radius);
+      const double dx = rng.uniform(-slack, slack);
+      const double dy = rng.uniform(-slack, slack);
+      placed = PlacedObject{
+          models[i], below.table_x + dx, below.table_y + dy, below.yaw + rng.uniform(-0.35, 0.35),
+          0,         below.model.height};
+      placed.id = static_cast<std::uint32_t>(scene.objects.size());
+      scene.objects.push_back(placed);
+      continue;
+    }
+    const bool touch = config.touching && !config.stacked && i % 2 == 1 && !scene.objects.empty();
+    const PlacedObject* anchor = touch ? &scene.objects.back() : nullptr;
     if (place(models[i], scene, anchor, rng, placed)) {
       placed.id = static_cast<std::uint32_t>(scene.objects.size());
       scene.objects.push_back(placed);

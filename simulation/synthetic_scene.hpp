@@ -49,6 +49,7 @@ struct PlacedObject {
   double table_y = 0.0;
   double yaw = 0.0;
   std::uint32_t id = 0;  ///< its pixels get label OBJECT_LABEL_BASE + id (make_scene: the index)
+  double base_m = 0.0;   ///< height of its bottom above the table (> 0: it lies on another object)
 };
 
 /// @brief Derived geometry of a table in the sensor frame (x right, y down, z forward).
@@ -74,10 +75,14 @@ struct Scene {
 /// @brief How scenes are drawn at random.
 struct SceneConfig {
   std::uint32_t objects = 6;
-  bool touching = false;               ///< place objects in touching pairs
+  bool touching = false;  ///< place objects in touching pairs
   std::vector<Category> categories{};  ///< empty: the SCENE_CATEGORY_COUNT scene categories
   std::uint32_t instances_per_category = 5;
   bool floor = true;  ///< render a floor below the table
+  /// Boxes in stacks of two: every object is a box, and every second one lies on the previous
+  /// (a box at most 0.85 of its size, roughly centred, turned by up to 20 degrees; none if no box
+  /// instance is that small). Overrides touching.
+  bool stacked = false;
 };
 
 /// @brief Pose of an object in the sensor frame: columns x, y, z axes, then the position (row-major
