@@ -75,7 +75,7 @@ struct Scene {
 /// @brief How scenes are drawn at random.
 struct SceneConfig {
   std::uint32_t objects = 6;
-  bool touching = false;  ///< place objects in touching pairs
+  bool touching = false;               ///< place objects in touching pairs
   std::vector<Category> categories{};  ///< empty: the SCENE_CATEGORY_COUNT scene categories
   std::uint32_t instances_per_category = 5;
   bool floor = true;  ///< render a floor below the table
