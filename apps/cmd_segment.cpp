@@ -93,6 +93,10 @@ nlohmann::json to_json(const kernels::SegmentationResult& seg, const nlohmann::j
   return {{"plane_input", plane_input},
           {"plane", {{"normal", triple(seg.plane.plane.normal)}, {"d", seg.plane.plane.d}}},
           {"inliers", seg.plane.inliers},
+          {"plane_check",
+           {{"near_share", floats_json(std::array{seg.plane_check.near_share})[0]},
+            {"rms_m", floats_json(std::array{seg.plane_check.rms_m})[0]},
+            {"switched", seg.plane_check.switched}}},
           {"clusters", stats_json(seg.clusters)},
           {"objects", stats_json(seg.candidates)},
           {"rejected",
@@ -113,6 +117,12 @@ void print_text(const nlohmann::json& j) {
   std::printf("plane: normal (%.5f, %.5f, %.5f) d %.5f, %zu inliers\n", n[0].get<double>(),
               n[1].get<double>(), n[2].get<double>(), j["plane"]["d"].get<double>(),
               j["inliers"].get<std::size_t>());
+  const auto& check = j["plane_check"];
+  std::printf("plane check: %.3f of the sample inliers within 1 cm, RMS %.4f m%s\n",
+              check["near_share"].get<double>(), check["rms_m"].get<double>(),
+              check["switched"].get<bool>()
+                  ? "; the first plane was another level (floor or an object's top): took the table"
+                  : "");
   std::printf("clusters: %zu; objects (C_size, C_edge): %zu\n", j["clusters"].size(),
               j["objects"].size());
   for (std::size_t k = 0; k < j["objects"].size(); ++k) {

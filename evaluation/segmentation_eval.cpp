@@ -43,6 +43,7 @@ Segmenter make_chain_segmenter(const kernels::SegmentationParams& params,
     kernels::frame_labels(cloud.points(), seg->plane.plane, params.ransac.tau, params.roi,
                           seg->labels, seg->candidate_of, out.labels);
     out.plane = seg->plane.plane;
+    out.plane_fallback = seg->plane_check.switched;
     out.ms = seg->timings.total;
     return out;
   };

@@ -28,7 +28,7 @@ struct SegmenterOutput {
   std::vector<std::uint32_t> labels;  ///< one per point; empty when failed
   kernels::Plane plane{};
   double ms = 0.0;              ///< the segmenter's own time for the frame
-  bool plane_fallback = false;  ///< the plane needed the segmenter's fallback search
+  bool plane_fallback = false;  ///< the segmenter's first plane was not the table (it switched)
   std::string error;            ///< non-empty: the segmenter failed on this frame
 };
 

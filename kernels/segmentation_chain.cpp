@@ -54,6 +54,7 @@ Result<SegmentationResult, SegmentationError> SegmentationChain::run(CloudView c
   t.candidates = ms_between(candidates_start, end);
   t.total = ms_between(start, end);
   return SegmentationResult{table_result->plane,
+                            table_result->check,
                             clusters,
                             std::span<const ClusterStats>(candidates_).first(counts.kept),
                             counts,

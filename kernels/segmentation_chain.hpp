@@ -31,6 +31,7 @@ struct SegmentationTimings {
 /// @brief What run() found. Spans point into the chain and stay valid until the next run().
 struct SegmentationResult {
   RansacPlane plane;
+  PlaneCheck plane_check;                  ///< how sure the table stage is of the plane
   std::span<const ClusterStats> clusters;  ///< every cluster (after the footprint merge, when on)
   /// The clusters that pass C_size and C_edge (CandidateParams), in cluster order: the objects the
   /// tabletop graph hands to tracking.

@@ -154,7 +154,49 @@ TableStage::TableStage(std::size_t max_points)
       hull_scratch_(max_points),
       hull_idx_(max_points + 1),
       pu_(max_points),
-      pv_(max_points) {}
+      pv_(max_points),
+      ox_(max_points),
+      oy_(max_points),
+      oz_(max_points) {}
+
+std::size_t TableStage::refine(PointsView dense, float tau, Plane& plane) noexcept {
+  for (const float t : {tau, 0.5F * tau, 0.25F * tau}) {
+    const std::size_t found = collect_inliers(dense, plane, t, inliers_);
+    if (found < 3) break;
+    plane = fit_plane(dense, std::span<const std::uint32_t>(inliers_).first(found));
+  }
+  return collect_inliers(dense, plane, tau, inliers_);
+}
+
+bool TableStage::other_level(PointsView dense, const SegmentationParams& p,
+                             RansacPlane& plane) noexcept {
+  // The dense sample's points off the plane (farther than 2 tau), then the dominant plane among
+  // them.
+  std::size_t m = 0;
+  const auto& n = plane.plane.normal;
+  for (std::size_t i = 0; i < dense.size(); ++i) {
+    const float h = n[0] * dense.x[i] + n[1] * dense.y[i] + n[2] * dense.z[i] + plane.plane.d;
+    if (!(std::fabs(h) > 2.0F * p.ransac.tau)) continue;  // near the plane, or NaN
+    ox_[m] = dense.x[i], oy_[m] = dense.y[i], oz_[m] = dense.z[i];
+    ++m;
+  }
+  if (m < MIN_SPARSE_POINTS || 5 * m < plane.inliers) return false;  // too little for a level
+  const PointsView off{std::span<const float>(ox_).first(m), std::span<const float>(oy_).first(m),
+                       std::span<const float>(oz_).first(m)};
+  auto second = ransac_plane(off, p.ransac, std::span(inliers_).first(m));
+  if (!second) return false;
+  const auto& n2 = second->plane.normal;
+  const float cos = n[0] * n2[0] + n[1] * n2[1] + n[2] * n2[2];
+  if (!(cos > 0.985F) || 5 * second->inliers < plane.inliers) return false;  // not a big level
+  // Both normals face the sensor (d >= 0), so the level's height above the plane is d - d2.
+  const float above = plane.plane.d - second->plane.d;
+  const bool plane_was_floor = above > p.h_max;
+  const bool plane_was_top = above < 0.0F && -above <= p.h_max;
+  if (!plane_was_floor && !plane_was_top) return false;
+  plane.plane = second->plane;
+  plane.iterations += second->iterations;
+  return true;
+}
 
 Result<TableModel, SegmentationError> TableStage::run(const PlaneInput& input,
                                                       const SegmentationParams& p,
@@ -171,13 +213,34 @@ Result<TableModel, SegmentationError> TableStage::run(const PlaneInput& input,
     return err(fail(C::NO_PLANE, static_cast<std::uint8_t>(e.code), e.value));
   }
   RansacPlane plane = *ransac_result;
-  if (two_level) {
-    // The refit of RANSAC (least squares on the inliers, then the inliers of the refit plane) once
-    // more on the dense sample: the plane and the hull get the density of the stride-s sample.
-    const std::size_t found = collect_inliers(dense, plane.plane, p.ransac.tau, inliers_);
-    if (found < 3) return err(fail(C::FEW_SAMPLE_INLIERS, 0, static_cast<double>(found)));
-    plane.plane = fit_plane(dense, std::span<const std::uint32_t>(inliers_).first(found));
+  // The refit on the dense sample, at tau and then tighter: a hypothesis that RANSAC tilted to take
+  // in the foot of an object settles on the table's own points. Then the other-level check.
+  PlaneCheck check;
+  const std::size_t found = collect_inliers(dense, plane.plane, p.ransac.tau, inliers_);
+  if (found < 3) return err(fail(C::FEW_SAMPLE_INLIERS, 0, static_cast<double>(found)));
+  plane.inliers = refine(dense, p.ransac.tau, plane.plane);
+  if (other_level(dense, p, plane)) {  // (which used inliers_ as scratch)
+    check.switched = true;
+    plane.inliers = refine(dense, p.ransac.tau, plane.plane);
+  } else {
     plane.inliers = collect_inliers(dense, plane.plane, p.ransac.tau, inliers_);
+  }
+  if (plane.inliers < 3) {
+    return err(fail(C::FEW_SAMPLE_INLIERS, 0, static_cast<double>(plane.inliers)));
+  }
+  {
+    double sum_sq = 0.0;
+    std::size_t near = 0;
+    const auto& n = plane.plane.normal;
+    for (std::size_t k = 0; k < plane.inliers; ++k) {
+      const std::uint32_t i = inliers_[k];
+      const float h = n[0] * dense.x[i] + n[1] * dense.y[i] + n[2] * dense.z[i] + plane.plane.d;
+      if (std::fabs(h) > 0.01F) continue;
+      ++near;
+      sum_sq += double(h) * h;
+    }
+    check.near_share = float(double(near) / double(plane.inliers));
+    check.rms_m = near == 0 ? 0.0F : float(std::sqrt(sum_sq / double(near)));
   }
   const PlaneBasis basis = make_plane_basis(plane.plane);
   const auto idx = std::span<const std::uint32_t>(inliers_).first(plane.inliers);
@@ -192,7 +255,7 @@ Result<TableModel, SegmentationError> TableStage::run(const PlaneInput& input,
     hull_u[k] = pu_[hull_idx_[k]];
     hull_v[k] = pv_[hull_idx_[k]];
   }
-  return TableModel{plane, hull_u.first(h), hull_v.first(h)};
+  return TableModel{plane, hull_u.first(h), hull_v.first(h), check};
 }
 
 ObjectStage::ObjectStage(std::size_t max_points, std::uint32_t min_cluster_size)

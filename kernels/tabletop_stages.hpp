@@ -174,14 +174,28 @@ class PlaneInputStage {
   VoxelGridScratch voxel_scratch_;
 };
 
+/// @brief How sure the table stage is of its plane (docs/SEGMENTATION.md, "The table plane").
+struct PlaneCheck {
+  float near_share = 0.0F;  ///< share of the dense sample's plane inliers within 1 cm of the plane
+  float rms_m = 0.0F;       ///< RMS distance of those 1 cm inliers
+  /// The first plane was another level parallel to the table (the floor below it, or the top of an
+  /// object standing on it) and the table stage took the table instead.
+  bool switched = false;
+};
+
 /// @brief The table a frame stands on: plane, inlier count and support polygon (in the caller's
 /// spans).
 struct TableModel {
   RansacPlane plane;
   std::span<const double> hull_u, hull_v;  ///< counter-clockwise, in make_plane_basis(plane.plane)
+  PlaneCheck check{};
 };
 
-/// @brief Stage 2: RANSAC plane and the convex hull of its inliers. @note Not thread-safe.
+/// @brief Stage 2: RANSAC plane, refined on the dense sample (least squares on the inliers within
+/// tau, then tau / 2, then tau / 4), checked against a second plane among the points off it (a
+/// parallel level more than h_max above the plane means the plane was the floor; one less than
+/// h_max below it means the plane was an object's top: the stage takes that level instead), and
+/// the convex hull of its inliers. @note Not thread-safe.
 class TableStage {
  public:
   explicit TableStage(std::size_t max_points);
@@ -194,8 +208,14 @@ class TableStage {
 
  private:
   static constexpr std::size_t MIN_SPARSE_POINTS = 500;  // below: RANSAC on the dense sample
+  /// Refines @p plane on @p dense (refits at tau, tau / 2, tau / 4); @return its tau inliers.
+  std::size_t refine(PointsView dense, float tau, Plane& plane) noexcept;
+  /// The level the table is, given the first plane (PlaneCheck::switched).
+  [[nodiscard]] bool other_level(PointsView dense, const SegmentationParams& p,
+                                 RansacPlane& plane) noexcept;
   std::vector<std::uint32_t> inliers_, hull_scratch_, hull_idx_;
   std::vector<double> pu_, pv_;
+  std::vector<float> ox_, oy_, oz_;  // the dense sample off the first plane
 };
 
 /// @brief What the object stage found. Spans point into the stage and stay valid until its next

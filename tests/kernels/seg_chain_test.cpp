@@ -304,3 +304,68 @@ TEST(CrowdedMode, UnorganizedCloudsFallBackToEuclidean) {
   ASSERT_EQ(ra->clusters.size(), rb->clusters.size());
   EXPECT_TRUE(std::equal(ra->labels.begin(), ra->labels.end(), rb->labels.begin()));
 }
+
+namespace {
+
+/// A 320 x 240 view of a table 1 m away, tilted 50 degrees, whose pixels inside a rectangle
+/// covering @p share of them see the top of a large box 8 cm above it instead (a face parallel to
+/// the table: the misleading sample of issue 17).
+ok::PointCloud table_with_plateau(double share) {
+  const double tilt = 50.0 * 3.14159265358979 / 180.0;
+  const double ny = -std::cos(tilt), nz = -std::sin(tilt);  // normal toward the sensor
+  const double d_table = 1.0 * std::sin(tilt);              // table through (0, 0, 1)
+  ok::PointCloud cloud;
+  cloud.resize(320, 240);
+  const double side = std::sqrt(share);
+  for (std::uint32_t r = 0; r < 240; ++r) {
+    for (std::uint32_t c = 0; c < 320; ++c) {
+      const bool on_box = std::fabs(double(c) - 160.0) < 160.0 * side &&
+                          std::fabs(double(r) - 120.0) < 120.0 * side;
+      const double d = on_box ? d_table - 0.08 : d_table;  // the box top: 8 cm toward the sensor
+      const double rx = (double(c) - 160.0) / 262.5, ry = (double(r) - 120.0) / 262.5;
+      const double t = -d / (ny * ry + nz);
+      const std::size_t i = std::size_t{r} * 320 + c;
+      cloud.x()[i] = float(rx * t), cloud.y()[i] = float(ry * t), cloud.z()[i] = float(t);
+    }
+  }
+  return cloud;
+}
+
+}  // namespace
+
+TEST(TablePlane, ALargeFaceParallelToTheTableStillGivesTheTable) {
+  // The box top holds 60 % of the pixels, so RANSAC's best plane is the box top; the table stage
+  // finds the level 8 cm below it among the other points and takes it (PlaneCheck::switched).
+  const ok::PointCloud cloud = table_with_plateau(0.6);
+  ok::SegmentationChain chain(cloud.size(), tabletop_params(ok::ClusterMode::CROWDED));
+  auto seg = chain.run(cloud.view());
+  ASSERT_TRUE(seg) << seg.error().to_string();
+  const double d_table = std::sin(50.0 * 3.14159265358979 / 180.0);
+  EXPECT_NEAR(seg->plane.plane.d, d_table, 0.003);
+  EXPECT_TRUE(seg->plane_check.switched);
+  EXPECT_GT(seg->plane_check.near_share, 0.99F);
+  // A box top of 20 % is not the dominant plane: the table comes first and stays.
+  const ok::PointCloud small = table_with_plateau(0.2);
+  auto seg_small = chain.run(small.view());
+  ASSERT_TRUE(seg_small);
+  EXPECT_NEAR(seg_small->plane.plane.d, d_table, 0.003);
+  EXPECT_FALSE(seg_small->plane_check.switched);
+}
+
+TEST(TablePlane, TheFloorBelowALargeViewOfItIsNotTheTable) {
+  // Synthetic seed 22 (8 objects apart, table 1.2 m away at 34 degrees): the floor 0.69 m below
+  // fills more of the view than the table; the table stage takes the table above it.
+  orthoflow::simulation::SceneConfig config;
+  config.objects = 8;
+  const auto scene = orthoflow::simulation::make_scene(config, 22);
+  orthoflow::core::Rng rng(22);
+  ok::PointCloud cloud;
+  orthoflow::simulation::render_scene(scene, {}, rng, cloud);
+  ok::SegmentationChain chain(cloud.size(), tabletop_params(ok::ClusterMode::CROWDED));
+  auto seg = chain.run(cloud.view());
+  ASSERT_TRUE(seg) << seg.error().to_string();
+  const auto frame = orthoflow::simulation::table_frame(scene.table);
+  EXPECT_NEAR(seg->plane.plane.d, frame.d, 0.01);
+  EXPECT_TRUE(seg->plane_check.switched);
+  EXPECT_GE(seg->candidates.size(), 6U);
+}
