@@ -24,6 +24,8 @@
 #include "engine/object_list_payload.hpp"
 #include "graphs/descriptor_params.hpp"
 #include "graphs/embedded_graphs.hpp"
+#include "graphs/frame_block.hpp"
+#include "graphs/labels_writer.hpp"
 #include "graphs/tabletop.hpp"
 
 namespace orthoflow::apps {
@@ -47,6 +49,7 @@ struct RunOptions {
   float ct = graphs::DEFAULT_NN_THRESHOLD;
   std::string approach = "nn";
   std::string json_out;
+  std::string labels_out;
   std::string snapshot;
   std::string telemetry_json;
   bool publish_objects = false;  // every frame's objects to orthoflow/<graph>/objects over iceoryx
@@ -182,6 +185,21 @@ void check_output_path(const std::string& path, const char* flag) {
          EXIT_FAILURE_GENERIC);
 }
 
+/// --labels-out: what was written; a failed write is an error (exit 1), frames the writer had to
+/// drop (every buffer still being written, or an unorganized frame) are reported.
+void report_labels(graphs::LabelsWriter& labels, const RunOptions& o) {
+  labels.flush();
+  std::cout << "labels: " << labels.written() << " frame(s) written to " << o.labels_out;
+  if (labels.dropped() > 0) {
+    std::cout << ", " << labels.dropped()
+              << " dropped (the writer was busy, or the frame was unorganized)";
+  }
+  std::cout << "\n";
+  if (const std::string e = labels.first_error(); !e.empty()) {
+    fail("--labels-out: " + e, EXIT_FAILURE_GENERIC);
+  }
+}
+
 // After the run: every output the user asked for was written whole, or the exit is non-zero; frames
 // that failed are reported (and fail the run with --on-bad-frame fail).
 void finish_outputs(const RunOptions& o, graphs::SessionLog& log, const engine::GraphStats& stats,
@@ -250,7 +268,14 @@ void run(const RunOptions& o) {
     json = std::move(*writer);
   }
   graphs::SessionLog log(std::move(json));
-  const auto registry = graphs::make_tabletop_registry(**learning, log);
+  std::unique_ptr<graphs::LabelsWriter> labels;
+  if (!o.labels_out.empty()) {
+    auto writer = graphs::LabelsWriter::open(o.labels_out,
+                                             graphs::FrameBlock::capacity_for(spec->block_bytes));
+    if (!writer) fail(writer.error(), EXIT_FAILURE_GENERIC);
+    labels = std::move(*writer);
+  }
+  const auto registry = graphs::make_tabletop_registry(**learning, log, nullptr, labels.get());
   auto graph = engine::build_graph(*spec, registry);
   if (!graph) fail(engine::to_string(graph.error()), EXIT_BAD_INPUT);
   g_run_stop.store(false);
@@ -263,6 +288,7 @@ void run(const RunOptions& o) {
   std::signal(SIGTERM, previous_term);
   (*learning)->flush();
   if (log.json() != nullptr) log.json()->flush();
+  if (labels) report_labels(*labels, o);
   std::cout << "orthoflow run: graph '" << (*graph)->spec.name << "'"
             << (reason == engine::StopReason::STOP_REQUESTED ? " (stopped by signal)" : "") << "\n";
   print_summary(log.summary(), engine.stats(), **learning);
@@ -310,6 +336,9 @@ void add_run_command(CLI::App& app) {
                   "CT on L2)")
       ->check(CLI::IsMember({"1", "2", "nn"}));
   cmd->add_option("--json-out", o->json_out, "one JSON line per frame to FILE ('-' = stdout)");
+  cmd->add_option("--labels-out", o->labels_out,
+                  "write DIR/frame_<id>.pcd per frame: the organized cloud with a label field (0 "
+                  "none, 1 table, k >= 2 object k - 2 of the frame's objects), off the frame path");
   cmd->add_option("--snapshot", o->snapshot,
                   "PNG of the last frame with objects, seen from above the table");
   cmd->add_option("--telemetry-json", o->telemetry_json, "engine telemetry as JSON to FILE");

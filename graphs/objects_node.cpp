@@ -8,6 +8,7 @@
 #include <array>
 #include <vector>
 
+#include "graphs/labels_writer.hpp"
 #include "graphs/node_support.hpp"
 #include "graphs/segment_nodes.hpp"
 #include "graphs/segment_params.hpp"
@@ -26,8 +27,10 @@ constexpr std::size_t TRUTH_BINS =
 
 class Objects final : public engine::Node {
  public:
-  Objects(std::size_t capacity, std::string name, const TabletopSegmentation& p)
+  Objects(std::size_t capacity, std::string name, const TabletopSegmentation& p,
+          LabelsWriter* labels)
       : capacity_(capacity),
+        labels_(labels),
         name_(std::move(name)),
         p_(p),
         stage_(capacity, p.stages.cluster.min_size),
@@ -42,7 +45,12 @@ class Objects final : public engine::Node {
     FrameState& s = block.state();
     s.object_count = s.clusters = s.rejected_size = s.rejected_edge = s.rejected_capacity = 0;
     auto frame = block.frame();
+    labelled_ = false;
     if (s.table_found && frame) segment(block, *frame);
+    if (labels_ != nullptr && frame && !labelled_) {  // no table (or no objects stage): all 0
+      labels_->offer(frame->header->frame_id, frame->cloud, s.plane, p_.stages.ransac.tau, s.roi,
+                     {}, {});
+    }
     out.emit(0, in);
   }
 
@@ -76,6 +84,12 @@ class Objects final : public engine::Node {
       sizes_[static_cast<std::size_t>(slot_of_[c])] = found->clusters[c].points;
     }
     gather(block, *found, s.organized_path ? frame.label : std::span<const std::uint32_t>{});
+    if (labels_ != nullptr && s.organized_path) {
+      labels_->offer(frame.header->frame_id, frame.cloud, s.plane, p_.stages.ransac.tau, s.roi,
+                     found->labels,
+                     std::span<const std::int32_t>(slot_of_).first(found->clusters.size()));
+      labelled_ = true;
+    }
   }
 
   void gather(const FrameBlock& block, const kernels::ObjectClusters& found,
@@ -99,6 +113,8 @@ class Objects final : public engine::Node {
   }
 
   std::size_t capacity_;
+  LabelsWriter* labels_;   // --labels-out, or null
+  bool labelled_ = false;  // this frame's labels were offered
   std::string name_;
   TabletopSegmentation p_;
   kernels::ObjectStage stage_;
@@ -110,12 +126,14 @@ class Objects final : public engine::Node {
 
 }  // namespace
 
-NodeResult make_objects_node(const engine::ParamMap& params, const engine::NodeContext& context) {
+NodeResult make_objects_node(const engine::ParamMap& params, const engine::NodeContext& context,
+                             LabelsWriter* labels) {
   auto capacity = frame_capacity(context);
   if (!capacity) return err(capacity.error());
   TabletopSegmentation p;
   if (auto ok = parse_objects_params(params, p); !ok) return err(ok.error());
-  return std::unique_ptr<engine::Node>(new Objects(*capacity, std::string(context.name), p));
+  return std::unique_ptr<engine::Node>(
+      new Objects(*capacity, std::string(context.name), p, labels));
 }
 
 }  // namespace orthoflow::graphs

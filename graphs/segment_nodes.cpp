@@ -130,9 +130,10 @@ kernels::PlaneInput plane_input(const FrameBlock& block) noexcept {
 }
 
 // The objects kind is long enough for its own file (objects_node.cpp).
-NodeResult make_objects_node(const ParamMap& params, const engine::NodeContext& context);
+NodeResult make_objects_node(const ParamMap& params, const engine::NodeContext& context,
+                             LabelsWriter* labels);
 
-void add_segment_nodes(engine::NodeRegistry& registry) {
+void add_segment_nodes(engine::NodeRegistry& registry, LabelsWriter* labels) {
   registry.add(
       "preprocess",
       "plane input: drops NaN and out-of-ROI points, strided pixel sample (organized) or voxel "
@@ -146,7 +147,9 @@ void add_segment_nodes(engine::NodeRegistry& registry) {
                "prism + Euclidean clusters + footprint merge + C_size/C_edge: h_min, h_max, "
                "tolerance, min_points, "
                "max_points, pixel_radius, merge_overlap, min_size, max_size, edge_margin (m)",
-               make_objects_node);
+               [labels](const ParamMap& params, const engine::NodeContext& context) {
+                 return make_objects_node(params, context, labels);
+               });
 }
 
 }  // namespace orthoflow::graphs

@@ -8,12 +8,15 @@
 /// graphs/segment_params.hpp.
 #include "engine/registry.hpp"
 #include "graphs/frame_block.hpp"
+#include "graphs/labels_writer.hpp"
 #include "kernels/tabletop_stages.hpp"
 
 namespace orthoflow::graphs {
 
 /// @brief Registers preprocess, table and objects.
-void add_segment_nodes(engine::NodeRegistry& registry);
+/// @param labels `--labels-out`: the objects nodes hand each frame's per-point labels to it (null:
+/// none).
+void add_segment_nodes(engine::NodeRegistry& registry, LabelsWriter* labels = nullptr);
 
 /// @brief The plane input preprocess left in @p block (views into voxels()).
 [[nodiscard]] kernels::PlaneInput plane_input(const FrameBlock& block) noexcept;

@@ -10,12 +10,12 @@
 namespace orthoflow::graphs {
 
 engine::NodeRegistry make_tabletop_registry(LearningService& learning, SessionLog& log,
-                                            ObjectsHub* objects) {
+                                            ObjectsHub* objects, LabelsWriter* labels) {
   engine::NodeRegistry registry;
   engine::add_generic_nodes(registry);
   engine::add_ipc_nodes(registry);  // ipc_subscribe / ipc_publish: graphs split across processes
   add_source_nodes(registry);
-  add_segment_nodes(registry);
+  add_segment_nodes(registry, labels);
   add_track_describe_nodes(registry);
   add_recognise_node(registry, learning);
   add_objects_output_node(registry, objects);

@@ -7,7 +7,9 @@
 - evaluate-segmentation over a folder of three learn-split frames: JSON and Markdown agree, the
   per-category table appears with --names, a PNG per frame with --png, and --out writes both files;
 - an unreadable frame in the folder is a failed row and exit code 2, the others still scored;
-- an unorganized frame asked for --labels-out is refused (exit 2), nothing written.
+- an unorganized frame asked for --labels-out is refused (exit 2), nothing written;
+- run --source pcd:DIR --labels-out OUT writes one labels file per frame, label for label what
+  segment --labels-out writes for that file with the same graph (one chain).
 
 Usage: check_segmentation_eval.py ORTHOFLOW SHARED_DIR WORK_DIR
 """
@@ -90,8 +92,11 @@ def main():
 
     dataset = os.path.join(work, "frames")
     os.makedirs(dataset)
+    dataset_frames = os.path.join(work, "run_frames")  # the same frames, without the broken one
+    os.makedirs(dataset_frames)
     for name in ("learn0", "learn17", "learn33"):
         shutil.copy(os.path.join(shared, "data", "mosd_learn", name + ".pcd"), dataset)
+        shutil.copy(os.path.join(shared, "data", "mosd_learn", name + ".pcd"), dataset_frames)
     names = os.path.join(work, "names.txt")
     with open(names, "w") as f:
         f.write("learn0 boxes\nlearn17 stacked\nlearn33 cylindric\n")
@@ -132,6 +137,17 @@ def main():
     p = run(cli, "segment", flat, "--labels-out", os.path.join(work, "flat_labels.pcd"), code=2)
     expect("organized" in p.stderr, p.stderr)
     expect(not os.path.exists(os.path.join(work, "flat_labels.pcd")), "nothing written")
+    run_out = os.path.join(work, "run_labels")
+    p = run(cli, "run", "--source", "pcd:" + dataset_frames, "--labels-out", run_out, "--rate", "max")
+    expect("labels: 3 frame(s) written" in p.stdout, p.stdout)
+    for k, name in enumerate(("learn0", "learn17", "learn33")):
+        single = os.path.join(work, name + "_labels.pcd")
+        run(cli, "segment", os.path.join(dataset_frames, name + ".pcd"), "--graph", "tabletop",
+            "--labels-out", single)
+        ours, _ = labels_of(cli, single, work)
+        theirs, h = labels_of(cli, os.path.join(run_out, "frame_%06d.pcd" % k), work)
+        expect(h == 480, "run's labels file stays organized")
+        expect(ours == theirs, f"{name}: run and segment label the frame differently")
     print("ok")
 
 

@@ -13,11 +13,17 @@
 #include <thread>
 #include <vector>
 
+#include <unistd.h>
+
+#include "formats/pcd_io.hpp"
+#include "graphs/labels_writer.hpp"
+#include "kernels/frame_labels.hpp"
 #include "tabletop_run.hpp"
 
 #include "tests/support/counting_new.hpp"  // the one TU of this binary that replaces operator new
 
 using orthoflow::test::g_allocations;
+using orthoflow::test::g_counted_thread;
 using orthoflow::test::g_counting;
 
 namespace orthoflow::graphs {
@@ -81,6 +87,57 @@ TEST(TabletopAllocations, SteadyStateAllocatesNothingPerFrame) {
   EXPECT_GT(log.summary().object_views, 100U);
   EXPECT_GT(log.summary().recognitions, 100U);
   EXPECT_EQ(g_allocations.load(), 0U);
+}
+
+TEST(LabelsWriterAllocations, OfferingAFrameAllocatesNothing) {
+  // --labels-out on the frame path: copying a frame into a writer cloud and labelling it allocates
+  // nothing (the writer thread's encoding does, off the frame path, and is not counted here).
+  const std::uint32_t w = 64, h = 48;
+  std::vector<float> x(w * h), y(w * h), z(w * h, 1.0F);
+  std::vector<std::int32_t> cluster_of(w * h, -1);
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    x[i] = float(i % w) * 0.002F, y[i] = float(i / w) * 0.002F;
+    if (i % w < 10) cluster_of[i] = 0;
+  }
+  const std::vector<std::int32_t> slot_of{0};
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("orthoflow_labels_" + std::to_string(::getpid()));
+  {
+    auto writer = LabelsWriter::open(dir, w * h, 2);
+    ASSERT_TRUE(writer) << writer.error();
+    const kernels::CloudView cloud{{x, y, z}, w, h};
+    const kernels::Plane plane{{0.0F, 0.0F, -1.0F}, 1.0F};
+    ASSERT_TRUE((*writer)->offer(0, cloud, plane, 0.02F, {}, cluster_of, slot_of));  // warm-up
+    (*writer)->flush();
+    g_counted_thread.store(std::this_thread::get_id());
+    g_allocations = 0;
+    g_counting = true;
+    const bool a = (*writer)->offer(1, cloud, plane, 0.02F, {}, cluster_of, slot_of);
+    (*writer)->offer(2, cloud, plane, 0.02F, {}, {}, {});  // no table: all 0 (may be dropped)
+    g_counting = false;
+    g_counted_thread.store(std::thread::id{});
+    EXPECT_TRUE(a);
+    EXPECT_EQ(g_allocations.load(), 0U);
+    // An unorganized frame has no per-point labels: dropped, counted.
+    EXPECT_FALSE((*writer)->offer(3, kernels::CloudView{{x, y, z}, w * h, 1}, plane, 0.02F, {},
+                                  cluster_of, slot_of));
+    (*writer)->flush();
+    EXPECT_GE((*writer)->written(), 2U);
+    EXPECT_GE((*writer)->dropped(), 1U);
+    EXPECT_TRUE((*writer)->first_error().empty()) << (*writer)->first_error();
+  }
+  auto back = formats::read_pcd(dir / "frame_000001.pcd");
+  ASSERT_TRUE(back) << back.error().to_string();
+  ASSERT_EQ(back->width(), w);
+  ASSERT_EQ(back->height(), h);
+  std::size_t objects = 0, table = 0;
+  for (const std::uint32_t l : back->label()) {
+    objects += l == kernels::FIRST_OBJECT_LABEL ? 1U : 0U;
+    table += l == kernels::TABLE_LABEL ? 1U : 0U;
+  }
+  EXPECT_EQ(objects, std::size_t{10} * h);
+  EXPECT_EQ(table, std::size_t{w - 10} * h);
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

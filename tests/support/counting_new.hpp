@@ -9,14 +9,21 @@
 #include <cstdint>
 #include <cstdlib>
 #include <new>
+#include <thread>
 
 namespace orthoflow::test {
 inline std::atomic<bool> g_counting{false};
 inline std::atomic<std::uint64_t> g_allocations{0};
+/// When set (not the default id), only this thread's allocations count: a frame-path caller
+/// beside a background thread that allocates by design (a file writer).
+inline std::atomic<std::thread::id> g_counted_thread{};
 
 inline void* counted_alloc(std::size_t size, std::size_t align) noexcept {
-  if (g_counting.load(std::memory_order_relaxed))
-    g_allocations.fetch_add(1, std::memory_order_relaxed);
+  if (g_counting.load(std::memory_order_relaxed)) {
+    const std::thread::id only = g_counted_thread.load(std::memory_order_relaxed);
+    if (only == std::thread::id{} || only == std::this_thread::get_id())
+      g_allocations.fetch_add(1, std::memory_order_relaxed);
+  }
   if (size == 0) size = 1;
   return align > alignof(std::max_align_t)
              ? std::aligned_alloc(align, (size + align - 1) / align * align)
