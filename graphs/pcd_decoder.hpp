@@ -1,0 +1,56 @@
+#pragma once
+/// @file
+/// @brief PcdDecoder: the pcd_source's decode-ahead. A background thread reads and decodes the
+/// folder's files in order into a few slots, so that reading a binary_compressed PCD (about 8 ms
+/// for a 640x480 frame) runs beside the graph instead of on its critical path; the source takes
+/// the next decoded file and gives the slot back. The decoder thread allocates (the reader does);
+/// the frame path only copies out of a slot.
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <filesystem>
+#include <thread>
+#include <vector>
+
+#include "core/spsc_ring.hpp"
+#include "formats/io_error.hpp"
+#include "kernels/point_cloud.hpp"
+
+namespace orthoflow::graphs {
+
+class PcdDecoder {
+ public:
+  /// @brief One decoded file: its cloud, or why it could not be read; @p end after the last file
+  /// (never with loop).
+  struct Slot {
+    kernels::PointCloud cloud;
+    bool ok = false;
+    formats::IoError error{};
+    bool end = false;
+  };
+  /// @brief Starts decoding @p files (in this order, again from the first with @p loop) into
+  /// @p depth slots. @pre !files.empty(), depth >= 1.
+  PcdDecoder(std::vector<std::filesystem::path> files, bool loop, std::size_t depth = 3);
+  ~PcdDecoder();  ///< stops the thread (a file being read is finished first)
+  PcdDecoder(const PcdDecoder&) = delete;
+  PcdDecoder& operator=(const PcdDecoder&) = delete;
+
+  /// @brief The next decoded file, waiting at most @p timeout for it (nullptr: not ready in time).
+  /// Single consumer. Until release(), the slot is the caller's. Never allocates.
+  [[nodiscard]] Slot* next(std::chrono::milliseconds timeout) noexcept;
+  /// @brief Gives the slot of the last next() back to the decoder.
+  void release() noexcept;
+
+ private:
+  void loop() noexcept;
+  std::vector<std::filesystem::path> files_;
+  bool loop_;
+  std::vector<Slot> slots_;
+  core::SpscRing<std::uint32_t> free_, ready_;  // slot indices: to the decoder, to the source
+  std::uint32_t held_ = 0;
+  bool holding_ = false;
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
+}  // namespace orthoflow::graphs
