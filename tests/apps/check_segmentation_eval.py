@@ -18,21 +18,9 @@ import json
 import os
 import shutil
 import struct
-import subprocess
 import sys
 
-
-def run(cli, *args, code=0):
-    p = subprocess.run([cli, *map(str, args)], capture_output=True, text=True)
-    if code is not None and p.returncode != code:
-        sys.exit(f"FAIL: {' '.join(map(str, args))}: exit {p.returncode}, wanted {code}\n"
-                 f"stdout: {p.stdout}\nstderr: {p.stderr}")
-    return p
-
-
-def expect(condition, what):
-    if not condition:
-        sys.exit(f"FAIL: {what}")
+from cli_check import expect, run
 
 
 def labels_of(cli, path, work):

@@ -20,20 +20,9 @@ import shutil
 import subprocess
 import sys
 
+from cli_check import expect, run
+
 NY, NZ = -math.sin(math.radians(50)), -math.cos(math.radians(50))
-
-
-def run(cli, *args, code=0):
-    p = subprocess.run([cli, *map(str, args)], capture_output=True, text=True)
-    if code is not None and p.returncode != code:
-        sys.exit(f"FAIL: {' '.join(map(str, args))}: exit {p.returncode}, wanted {code}\n"
-                 f"stdout: {p.stdout}\nstderr: {p.stderr}")
-    return p
-
-
-def expect(condition, what):
-    if not condition:
-        sys.exit(f"FAIL: {what}")
 
 
 def write_pcd(path, points, width, height):
