@@ -1,0 +1,233 @@
+// The crowded-scene mode and the table-plane check (issue 17) through the product's chain (the
+// embedded tabletop graph's parameters): stacked and touching synthetic objects against plain
+// Euclidean clustering, a real stack from the mOSD learn split (allocation-free when warm), the
+// unorganized fallback, a misleading face parallel to the table, the floor below a wide view.
+// Hundreds of synthetic 640x480 frames: qemu_heavy (the aarch64 stage compares the kernels
+// instead).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "engine/graph.hpp"
+#include "evaluation/segmentation_eval.hpp"
+#include "formats/pcd_io.hpp"
+#include "graphs/embedded_graphs.hpp"
+#include "graphs/segment_params.hpp"
+#include "kernels/segmentation_chain.hpp"
+#include "seg_quality.hpp"
+#include "simulation/synthetic_scene.hpp"
+#include "tests/support/counting_new.hpp"  // the one TU of this binary that replaces operator new
+
+namespace ok = orthoflow::kernels;
+using orthoflow::test::g_allocations;
+using orthoflow::test::g_counting;
+
+namespace {
+
+/// The tabletop graph's segmentation (graphs/tabletop.yaml, the product's chain), in either
+/// clustering mode (Euclidean with the footprint merge it had before the crowded mode: 30 %).
+orthoflow::graphs::TabletopSegmentation tabletop(ok::ClusterMode mode) {
+  auto spec = orthoflow::engine::parse_graph(
+      std::string(orthoflow::graphs::embedded_tabletop_yaml()), "tabletop.yaml");
+  EXPECT_TRUE(spec);
+  auto seg = orthoflow::graphs::segmentation_of_graph(*spec);
+  EXPECT_TRUE(seg);
+  EXPECT_EQ(seg->stages.cluster_mode, ok::ClusterMode::CROWDED);  // the default
+  seg->stages.cluster_mode = mode;
+  if (mode == ok::ClusterMode::EUCLIDEAN) seg->stages.merge_overlap = 0.3F;
+  return *seg;
+}
+
+ok::SegmentationParams tabletop_params(ok::ClusterMode mode) { return tabletop(mode).stages; }
+
+/// The product's objects (the candidates, as frame labels) scored against @p truth.
+orthoflow::testing::Quality score_product(const ok::PointCloud& cloud,
+                                          std::span<const std::uint32_t> truth,
+                                          ok::ClusterMode mode) {
+  const auto seg = tabletop(mode);
+  const auto out = orthoflow::evaluation::make_chain_segmenter(seg.stages, seg.candidates)(cloud);
+  EXPECT_TRUE(out.error.empty()) << out.error;
+  if (!out.error.empty()) return {};
+  const auto c = orthoflow::evaluation::score_objects(truth, out.labels);
+  return {c.truth, c.predicted, c.matched, c.over, c.under};
+}
+
+/// Ground truth of a synthetic frame in the mOSD convention (object id k as label 10 (k + 2)).
+std::vector<std::uint32_t> mosd_truth(const ok::PointCloud& cloud) {
+  std::vector<std::uint32_t> truth;
+  for (const std::uint32_t l : cloud.label()) {
+    const int object = orthoflow::simulation::object_of_label(l);
+    truth.push_back(object >= 0 ? static_cast<std::uint32_t>(object + 2) * 10U : 0U);
+  }
+  return truth;
+}
+
+orthoflow::testing::Quality segment_synthetic(const orthoflow::simulation::SceneConfig& config,
+                                              std::uint64_t seed, ok::ClusterMode mode,
+                                              std::size_t* placed = nullptr) {
+  const auto scene = orthoflow::simulation::make_scene(config, seed);
+  orthoflow::core::Rng rng(seed);
+  ok::PointCloud cloud;
+  orthoflow::simulation::render_scene(scene, {}, rng, cloud);
+  if (placed != nullptr) *placed = scene.objects.size();
+  return score_product(cloud, mosd_truth(cloud), mode);
+}
+
+}  // namespace
+
+TEST(CrowdedMode, SeparatesStackedBoxesThatEuclideanClusteringMerges) {
+  // Boxes in stacks of two (the generator's stacked mode): over ten scenes the crowded mode finds
+  // more boxes than plain Euclidean clustering, which merges a box with the one it lies on, and
+  // merges fewer. (A stack whose faces are flush leaves no crease: docs/SEGMENTATION.md.)
+  orthoflow::simulation::SceneConfig config;
+  config.objects = 6;
+  config.stacked = true;
+  std::size_t truth = 0, crowded = 0, euclidean = 0, under_crowded = 0, under_euclidean = 0;
+  for (std::uint64_t seed = 1; seed <= 10; ++seed) {
+    const auto c = segment_synthetic(config, seed, ok::ClusterMode::CROWDED);
+    const auto e = segment_synthetic(config, seed, ok::ClusterMode::EUCLIDEAN);
+    truth += c.gt_objects, crowded += c.matched, euclidean += e.matched;
+    under_crowded += c.under, under_euclidean += e.under;
+  }
+  std::printf("stacked boxes: %zu objects, crowded %zu matched (%zu under), euclidean %zu (%zu)\n",
+              truth, crowded, under_crowded, euclidean, under_euclidean);
+  EXPECT_GE(double(crowded), 0.6 * double(truth));
+  EXPECT_GE(crowded, euclidean + truth / 10);
+  EXPECT_LT(under_crowded, under_euclidean);
+}
+
+TEST(CrowdedMode, TouchingObjectsAndSingleObjectsStayRight) {
+  // Touching pairs (the generator's touching mode) and scenes of separate objects: the crowded
+  // mode finds at least as many as Euclidean clustering and splits no more objects in two than it
+  // does (a mug's handle stays on its mug, a bowl's inside on its outside).
+  for (const bool touching : {true, false}) {
+    orthoflow::simulation::SceneConfig config;
+    config.objects = 8;
+    config.touching = touching;
+    std::size_t truth = 0, crowded = 0, euclidean = 0, over = 0, over_euclidean = 0;
+    for (std::uint64_t seed = 20; seed < 30; ++seed) {
+      const auto c = segment_synthetic(config, seed, ok::ClusterMode::CROWDED);
+      const auto e = segment_synthetic(config, seed, ok::ClusterMode::EUCLIDEAN);
+      truth += c.gt_objects, crowded += c.matched, euclidean += e.matched, over += c.over;
+      over_euclidean += e.over;
+    }
+    std::printf("%s: %zu objects, crowded %zu matched (%zu over), euclidean %zu (%zu over)\n",
+                touching ? "touching" : "apart", truth, crowded, over, euclidean, over_euclidean);
+    EXPECT_GE(crowded, euclidean) << (touching ? "touching" : "apart");
+    EXPECT_LE(over, over_euclidean) << (touching ? "touching" : "apart");
+  }
+}
+
+TEST(CrowdedMode, SplitsARealStackAndAllocatesNothingWhenWarm) {
+  // mOSD learn21: two boxes on a third: Euclidean clustering gives at most one right object, the
+  // crowded mode at least two; a second run of the same frame allocates nothing and repeats
+  // itself.
+  auto cloud = orthoflow::formats::read_pcd(std::string(ORTHOFLOW_SHARED_DIR) +
+                                            "/data/mosd_learn/learn21.pcd");
+  ASSERT_TRUE(cloud) << cloud.error().to_string();
+  const auto qa = score_product(*cloud, cloud->label(), ok::ClusterMode::CROWDED);
+  const auto qb = score_product(*cloud, cloud->label(), ok::ClusterMode::EUCLIDEAN);
+  EXPECT_EQ(qa.gt_objects, 3U);
+  EXPECT_GE(qa.matched, 2U);
+  EXPECT_LE(qb.matched, 1U);
+  ok::SegmentationChain crowded(cloud->size(), tabletop_params(ok::ClusterMode::CROWDED));
+  auto a = crowded.run(cloud->view());
+  ASSERT_TRUE(a);
+  const std::vector<std::int32_t> first(a->labels.begin(), a->labels.end());
+  g_allocations = 0;
+  g_counting = true;
+  auto again = crowded.run(cloud->view());
+  g_counting = false;
+  EXPECT_EQ(g_allocations.load(), 0U);
+  ASSERT_TRUE(again);
+  EXPECT_TRUE(std::equal(first.begin(), first.end(), again->labels.begin()));
+}
+
+TEST(CrowdedMode, UnorganizedCloudsFallBackToEuclidean) {
+  auto cloud = orthoflow::formats::read_pcd(std::string(ORTHOFLOW_SHARED_DIR) +
+                                            "/data/mosd_learn/learn0.pcd");
+  ASSERT_TRUE(cloud);
+  ok::PointCloud flat;
+  for (std::size_t i = 0; i < cloud->size(); ++i) {
+    if (!std::isfinite(cloud->z()[i])) continue;
+    flat.resize_unorganized(flat.size() + 1);
+    flat.x().back() = cloud->x()[i], flat.y().back() = cloud->y()[i],
+    flat.z().back() = cloud->z()[i];
+  }
+  ok::SegmentationChain a(flat.size(), tabletop_params(ok::ClusterMode::CROWDED));
+  ok::SegmentationChain b(flat.size(), tabletop_params(ok::ClusterMode::EUCLIDEAN));
+  auto ra = a.run(flat.view());
+  auto rb = b.run(flat.view());
+  ASSERT_TRUE(ra && rb);
+  ASSERT_EQ(ra->clusters.size(), rb->clusters.size());
+  EXPECT_TRUE(std::equal(ra->labels.begin(), ra->labels.end(), rb->labels.begin()));
+}
+
+namespace {
+
+/// A 320 x 240 view of a table 1 m away, tilted 50 degrees, whose pixels inside a rectangle
+/// covering @p share of them see the top of a large box 8 cm above it instead (a face parallel to
+/// the table: the misleading sample of issue 17).
+ok::PointCloud table_with_plateau(double share) {
+  const double tilt = 50.0 * 3.14159265358979 / 180.0;
+  const double ny = -std::cos(tilt), nz = -std::sin(tilt);  // normal toward the sensor
+  const double d_table = 1.0 * std::sin(tilt);              // table through (0, 0, 1)
+  ok::PointCloud cloud;
+  cloud.resize(320, 240);
+  const double side = std::sqrt(share);
+  for (std::uint32_t r = 0; r < 240; ++r) {
+    for (std::uint32_t c = 0; c < 320; ++c) {
+      const bool on_box = std::fabs(double(c) - 160.0) < 160.0 * side &&
+                          std::fabs(double(r) - 120.0) < 120.0 * side;
+      const double d = on_box ? d_table - 0.08 : d_table;  // the box top: 8 cm toward the sensor
+      const double rx = (double(c) - 160.0) / 262.5, ry = (double(r) - 120.0) / 262.5;
+      const double t = -d / (ny * ry + nz);
+      const std::size_t i = std::size_t{r} * 320 + c;
+      cloud.x()[i] = float(rx * t), cloud.y()[i] = float(ry * t), cloud.z()[i] = float(t);
+    }
+  }
+  return cloud;
+}
+
+}  // namespace
+
+TEST(TablePlane, ALargeFaceParallelToTheTableStillGivesTheTable) {
+  // The box top holds 60 % of the pixels, so RANSAC's best plane is the box top; the table stage
+  // finds the level 8 cm below it among the other points and takes it (PlaneCheck::switched).
+  const ok::PointCloud cloud = table_with_plateau(0.6);
+  ok::SegmentationChain chain(cloud.size(), tabletop_params(ok::ClusterMode::CROWDED));
+  auto seg = chain.run(cloud.view());
+  ASSERT_TRUE(seg) << seg.error().to_string();
+  const double d_table = std::sin(50.0 * 3.14159265358979 / 180.0);
+  EXPECT_NEAR(seg->plane.plane.d, d_table, 0.003);
+  EXPECT_TRUE(seg->plane_check.switched);
+  EXPECT_GT(seg->plane_check.near_share, 0.99F);
+  // A box top of 20 % is not the dominant plane: the table comes first and stays.
+  const ok::PointCloud small = table_with_plateau(0.2);
+  auto seg_small = chain.run(small.view());
+  ASSERT_TRUE(seg_small);
+  EXPECT_NEAR(seg_small->plane.plane.d, d_table, 0.003);
+  EXPECT_FALSE(seg_small->plane_check.switched);
+}
+
+TEST(TablePlane, TheFloorBelowALargeViewOfItIsNotTheTable) {
+  // Synthetic seed 22 (8 objects apart, table 1.2 m away at 34 degrees): the floor 0.69 m below
+  // fills more of the view than the table; the table stage takes the table above it.
+  orthoflow::simulation::SceneConfig config;
+  config.objects = 8;
+  const auto scene = orthoflow::simulation::make_scene(config, 22);
+  orthoflow::core::Rng rng(22);
+  ok::PointCloud cloud;
+  orthoflow::simulation::render_scene(scene, {}, rng, cloud);
+  ok::SegmentationChain chain(cloud.size(), tabletop_params(ok::ClusterMode::CROWDED));
+  auto seg = chain.run(cloud.view());
+  ASSERT_TRUE(seg) << seg.error().to_string();
+  const auto frame = orthoflow::simulation::table_frame(scene.table);
+  EXPECT_NEAR(seg->plane.plane.d, frame.d, 0.01);
+  EXPECT_TRUE(seg->plane_check.switched);
+  EXPECT_GE(seg->candidates.size(), 6U);
+}
