@@ -16,6 +16,7 @@
 #include <string>
 
 #include "apps/commands.hpp"
+#include "apps/graph_overrides.hpp"
 #include "apps/graph_run.hpp"
 #include "apps/scene_snapshot_png.hpp"
 #include "engine/engine.hpp"
@@ -62,34 +63,9 @@ struct RunOptions {
   throw CLI::RuntimeError(code);
 }
 
-engine::NodeSpec* find_kind(engine::GraphSpec& spec, std::string_view kind) {
-  for (auto& node : spec.nodes) {
-    if (node.kind == kind) return &node;
-  }
-  return nullptr;
-}
-
-// Applies --source, --frames and --rate to the graph's source node.
+// Applies --source and --frames to the graph's source node (apps/graph_overrides.hpp).
 void override_source(engine::GraphSpec& spec, const RunOptions& o) {
-  engine::NodeSpec* src = find_kind(spec, "synthetic_source");
-  if (src == nullptr) src = find_kind(spec, "pcd_source");
-  if (src == nullptr) {
-    if (!o.source.empty())
-      fail("--source needs a graph whose source is synthetic_source or pcd_source", EXIT_USAGE);
-    return;
-  }
-  if (o.source.rfind("pcd:", 0) == 0) {
-    src->kind = "pcd_source";
-    src->params = {};
-    src->params.assign("dir", o.source.substr(4));
-  } else if (o.source.rfind("synthetic:", 0) == 0) {
-    src->kind = "synthetic_source";
-    src->params.assign("seed", o.source.substr(10));
-  } else if (!o.source.empty()) {
-    fail("--source must be synthetic:SEED or pcd:DIR, not '" + o.source + "'", EXIT_USAGE);
-  }
-  if (o.frames > 0 && src->kind == "synthetic_source")
-    src->params.assign("frames", std::to_string(o.frames));
+  if (auto ok = apply_source(spec, o.source, o.frames); !ok) fail(ok.error(), EXIT_USAGE);
 }
 
 // --publish-objects: an ipc_publish node on the objects_output node's objects port, topic
@@ -108,12 +84,6 @@ void add_objects_publisher(engine::GraphSpec& spec) {
   publish.params.assign("max_bytes", std::to_string(sizeof(engine::ObjectListPayload)));
   spec.edges.push_back(engine::EdgeSpec{output->name, "objects", publish.name, "in", 0});
   spec.nodes.push_back(std::move(publish));
-}
-
-// --rate: the engine paces the source at the graph period, which is also each frame's deadline.
-void override_rate(engine::GraphSpec& spec, const std::string& rate) {
-  if (rate.empty()) return;
-  spec.period_ns = rate == "max" ? 0 : static_cast<std::int64_t>(1e9 / std::stod(rate));
 }
 
 graphs::LearningSettings learning_settings(const engine::GraphSpec& spec, const RunOptions& o) {
@@ -246,7 +216,7 @@ void run(const RunOptions& o) {
                               : engine::load_graph_file(o.graph);
   if (!spec) fail(engine::to_string(spec.error()), EXIT_BAD_INPUT);
   override_source(*spec, o);
-  override_rate(*spec, o.rate);
+  apply_rate(*spec, o.rate);
   if (o.publish_objects) add_objects_publisher(*spec);
   auto learning = graphs::LearningService::open(learning_settings(*spec, o));
   if (!learning) fail(learning.error(), EXIT_FAILURE_GENERIC);
@@ -312,18 +282,7 @@ void add_run_command(CLI::App& app) {
   cmd->add_option("--frames", o->frames, "stop after N frames (synthetic: session length)");
   cmd->add_option("--rate", o->rate,
                   "source rate in Hz, or max (no pacing, no deadline); default: the graph's period")
-      ->check([](const std::string& v) {
-        // The whole text is the number ("5abc" is not 5), and the period 1e9 / rate must stay a
-        // sane int64 of nanoseconds: 0.01 Hz (100 s) to 1000 Hz.
-        if (v == "max") return std::string();
-        char* end = nullptr;
-        const double hz = std::strtod(v.c_str(), &end);
-        if (v.empty() || end != v.c_str() + v.size() || !std::isfinite(hz)) {
-          return std::string("rate must be a number of Hz or max, not '" + v + "'");
-        }
-        return hz >= 0.01 && hz <= 1000.0 ? std::string()
-                                          : std::string("rate must be in [0.01, 1000] Hz or max");
-      });
+      ->check(check_rate);
   cmd->add_option("--db", o->db,
                   "perceptual memory directory (LevelDB); default: learn in memory only");
   cmd->add_option("--learner", o->learner, "instance or bayes")

@@ -51,4 +51,6 @@ void add_evaluate_command(CLI::App& app);
 void add_derive_views_command(CLI::App& app);
 /// @brief `evaluate-segmentation --dataset DIR`: the chain scored on labelled frames (mOSD labels).
 void add_evaluate_segmentation_command(CLI::App& app);
+/// @brief `bench latency`: frame-to-labels latency of a graph on the user's machine, with stress.
+void add_bench_command(CLI::App& app);
 }  // namespace orthoflow::apps

@@ -1,0 +1,61 @@
+#include "apps/graph_overrides.hpp"
+
+#include <cmath>
+#include <cstdlib>
+#include <string_view>
+
+namespace orthoflow::apps {
+
+namespace {
+engine::NodeSpec* find_kind(engine::GraphSpec& spec, std::string_view kind) {
+  for (auto& node : spec.nodes) {
+    if (node.kind == kind) return &node;
+  }
+  return nullptr;
+}
+}  // namespace
+
+Result<void, std::string> apply_source(engine::GraphSpec& spec, const std::string& source,
+                                       std::uint64_t frames) {
+  engine::NodeSpec* src = find_kind(spec, "synthetic_source");
+  if (src == nullptr) src = find_kind(spec, "pcd_source");
+  if (src == nullptr) {
+    if (!source.empty())
+      return err(
+          std::string("--source needs a graph whose source is synthetic_source or pcd_source"));
+    return {};
+  }
+  if (source.rfind("pcd:", 0) == 0) {
+    src->kind = "pcd_source";
+    src->params = {};
+    src->params.assign("dir", source.substr(4));
+  } else if (source.rfind("synthetic:", 0) == 0) {
+    src->kind = "synthetic_source";
+    src->params.assign("seed", source.substr(10));
+  } else if (!source.empty()) {
+    return err("--source must be synthetic:SEED or pcd:DIR, not '" + source + "'");
+  }
+  if (frames > 0 && src->kind == "synthetic_source")
+    src->params.assign("frames", std::to_string(frames));
+  return {};
+}
+
+std::string check_rate(const std::string& v) {
+  // The whole text is the number ("5abc" is not 5), and the period 1e9 / rate must stay a sane
+  // int64 of nanoseconds: 0.01 Hz (100 s) to 1000 Hz.
+  if (v == "max") return std::string();
+  char* end = nullptr;
+  const double hz = std::strtod(v.c_str(), &end);
+  if (v.empty() || end != v.c_str() + v.size() || !std::isfinite(hz)) {
+    return std::string("rate must be a number of Hz or max, not '" + v + "'");
+  }
+  return hz >= 0.01 && hz <= 1000.0 ? std::string()
+                                    : std::string("rate must be in [0.01, 1000] Hz or max");
+}
+
+void apply_rate(engine::GraphSpec& spec, const std::string& rate) {
+  if (rate.empty()) return;
+  spec.period_ns = rate == "max" ? 0 : static_cast<std::int64_t>(1e9 / std::stod(rate));
+}
+
+}  // namespace orthoflow::apps
