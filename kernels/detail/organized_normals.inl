@@ -1,6 +1,8 @@
 #pragma once
-// SIMD body of organized_normals(): one row at a time, lanes across columns; the rule of
-// normals_range() lane-wise (NaN neighbours fail the depth test, so they need no branch).
+// SIMD body of organized_normals(): one row at a time, lanes across columns; the depth test and the
+// cross product of normals_range() lane-wise (NaN neighbours fail the depth test, so they need no
+// branch), the normalisation per lane through the scalar finish_normal() (xsimd's NEON float sqrt
+// and division are estimates), so every variant equals the scalar twin bit for bit.
 #include "kernels/detail/organized_normals_kernel.hpp"
 
 namespace orthoflow::kernels::detail {
@@ -14,7 +16,6 @@ std::size_t OrganizedNormalsRowKernel::operator()(Arch /*arch*/, CloudView cloud
   constexpr std::size_t LANES = batch::size;
   const PointsView p = cloud.points;
   const std::size_t w = cloud.width, s = prm.offset;
-  const batch nan(std::numeric_limits<float>::quiet_NaN());
   std::size_t written = 0;
   std::size_t c = begin;
   auto load = [](std::span<const float> a, std::size_t i) { return batch::load_unaligned(&a[i]); };
@@ -31,19 +32,19 @@ std::size_t OrganizedNormalsRowKernel::operator()(Arch /*arch*/, CloudView cloud
                 vz = zd - zu;
     const batch hx = load(p.x, right) - load(p.x, left), hy = load(p.y, right) - load(p.y, left),
                 hz = zr - zl;
-    batch nx = vy * hz - vz * hy, ny = vz * hx - vx * hz, nz = vx * hy - vy * hx;
-    const batch len = xsimd::sqrt(nx * nx + ny * ny + nz * nz);
-    const batch facing = nx * load(p.x, i) + ny * load(p.y, i) + nz * z;
-    const batch scale = xsimd::select(facing > batch(0.0F), batch(-1.0F), batch(1.0F)) / len;
-    nx = nx * scale, ny = ny * scale, nz = nz * scale;
-    const auto good = ok && (len > batch(0.0F)) && xsimd::isfinite(nx) && xsimd::isfinite(ny) &&
-                      xsimd::isfinite(nz);
-    xsimd::select(good, nx, nan).store_unaligned(&out.x[i]);
-    xsimd::select(good, ny, nan).store_unaligned(&out.y[i]);
-    xsimd::select(good, nz, nan).store_unaligned(&out.z[i]);
-    alignas(64) float flags[LANES];
-    xsimd::select(good, batch(1.0F), batch(0.0F)).store_aligned(flags);
-    for (std::size_t l = 0; l < LANES; ++l) written += flags[l] != 0.0F ? 1U : 0U;
+    // The cross product lane-wise (exact IEEE operations); the rest per lane, scalar.
+    alignas(64) float nx[LANES], ny[LANES], nz[LANES], flags[LANES];
+    (vy * hz - vz * hy).store_aligned(nx);
+    (vz * hx - vx * hz).store_aligned(ny);
+    (vx * hy - vy * hx).store_aligned(nz);
+    xsimd::select(ok, batch(1.0F), batch(0.0F)).store_aligned(flags);
+    for (std::size_t l = 0; l < LANES; ++l) {
+      if (flags[l] != 0.0F) {
+        written += finish_normal(p, i + l, nx[l], ny[l], nz[l], out) ? 1U : 0U;
+      } else {
+        set_nan(out, i + l);
+      }
+    }
   }
   return written + normals_range(cloud, prm, r, c, end, out);
 }
