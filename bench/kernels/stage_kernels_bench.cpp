@@ -3,10 +3,12 @@
 // the scalar twin). Points: a noisy 1 m plane with 30 % clutter above it; clusters: 16 equal blobs.
 #include <benchmark/benchmark.h>
 
+#include <cmath>
 #include <random>
 #include <vector>
 
 #include "kernels/cluster_stats.hpp"
+#include "kernels/organized_normals.hpp"
 #include "kernels/pca_frame.hpp"
 #include "kernels/ransac_plane.hpp"
 
@@ -78,3 +80,44 @@ BENCHMARK(BM_ClusterStats)->RangeMultiplier(8)->Range(512, 1 << 18);
 BENCHMARK(BM_PcaFrame<false>)->RangeMultiplier(8)->Range(64, 1 << 16);
 BENCHMARK(BM_PcaFrame<true>)->RangeMultiplier(8)->Range(64, 1 << 16);
 BENCHMARK_MAIN();
+
+namespace {
+
+// organized_normals (the crowded mode): a 640 x H tilted plane with a bump, SIMD vs the scalar
+// twin on the same grid in the same run (rows = state.range(0)).
+struct NormalsGrid {
+  std::vector<float> x, y, z, nx, ny, nz;
+  std::uint32_t w = 640, h = 0;
+};
+
+NormalsGrid normals_grid(std::uint32_t rows) {
+  NormalsGrid g;
+  g.h = rows;
+  for (std::uint32_t r = 0; r < rows; ++r) {
+    for (std::uint32_t c = 0; c < g.w; ++c) {
+      const float z = 1.0F + 0.0005F * float(r) + 0.01F * std::sin(0.05F * float(c));
+      g.x.push_back((float(c) - 320.0F) * z / 525.0F);
+      g.y.push_back((float(r) - float(rows) / 2) * z / 525.0F);
+      g.z.push_back(z);
+    }
+  }
+  g.nx.resize(g.x.size()), g.ny.resize(g.x.size()), g.nz.resize(g.x.size());
+  return g;
+}
+
+template <bool Simd>
+void BM_OrganizedNormals(benchmark::State& state) {
+  NormalsGrid g = normals_grid(static_cast<std::uint32_t>(state.range(0)));
+  const orthoflow::kernels::CloudView cloud{{g.x, g.y, g.z}, g.w, g.h};
+  const orthoflow::kernels::PointsSpan out{g.nx, g.ny, g.nz};
+  for (auto _ : state) {
+    const std::size_t n = Simd ? orthoflow::kernels::organized_normals(cloud, {}, out)
+                               : orthoflow::kernels::organized_normals_scalar(cloud, {}, out);
+    benchmark::DoNotOptimize(n);
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(g.x.size()));
+}
+BENCHMARK(BM_OrganizedNormals<false>)->Arg(120)->Arg(480);
+BENCHMARK(BM_OrganizedNormals<true>)->Arg(120)->Arg(480);
+
+}  // namespace
