@@ -203,7 +203,9 @@ void add_bench_command(CLI::App& app) {
       "latency",
       "Frame-to-labels latency of a graph on a source, optionally beside a CPU stress load");
   cmd->add_option("--graph", a->graph, "graph file (default: the embedded graphs/tabletop.yaml)");
-  cmd->add_option("--source", a->source, "synthetic:SEED or pcd:DIR (default: the graph's source)");
+  cmd->add_option("--source", a->source,
+                  "synthetic:SEED, pcd:DIR, kinect[:SERIAL] (the camera over USB) or "
+                  "kinect-sim[:SEED] (the simulated camera) (default: the graph's source)");
   cmd->add_option("--frames", a->frames, "frames to run (default 300)")
       ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{100000000}));
   cmd->add_option("--rate", a->rate,

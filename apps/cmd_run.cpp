@@ -38,7 +38,7 @@ extern "C" void on_run_signal(int /*signal*/) { g_run_stop.store(true, std::memo
 
 struct RunOptions {
   std::string graph;   // empty: the embedded tabletop graph
-  std::string source;  // synthetic:SEED | pcd:DIR
+  std::string source;  // synthetic:SEED | pcd:DIR | kinect[:SERIAL] | kinect-sim[:SEED]
   std::uint64_t frames = 0;
   std::string rate;  // empty: the graph's period (30 Hz for tabletop.yaml)
   std::string db;
@@ -278,7 +278,9 @@ void add_run_command(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "run", "Run the tabletop graph (default: the embedded synthetic session) and summarise");
   cmd->add_option("--graph", o->graph, "graph file (default: the embedded graphs/tabletop.yaml)");
-  cmd->add_option("--source", o->source, "synthetic:SEED or pcd:DIR (default: the graph's source)");
+  cmd->add_option("--source", o->source,
+                  "synthetic:SEED, pcd:DIR, kinect[:SERIAL] (the camera over USB) or "
+                  "kinect-sim[:SEED] (the simulated camera) (default: the graph's source)");
   cmd->add_option("--frames", o->frames, "stop after N frames (synthetic: session length)");
   cmd->add_option("--rate", o->rate,
                   "source rate in Hz, or max (no pacing, no deadline); default: the graph's period")

@@ -53,4 +53,8 @@ void add_derive_views_command(CLI::App& app);
 void add_evaluate_segmentation_command(CLI::App& app);
 /// @brief `bench latency`: frame-to-labels latency of a graph on the user's machine, with stress.
 void add_bench_command(CLI::App& app);
+/// @brief `kinect list|info|stream [--sim]`: the Kinect v1 camera through orthoflow's driver.
+void add_kinect_command(CLI::App& app);
+/// @brief `kinect record DIR`: the camera in libfreenect's fakenect format (on the kinect command).
+void add_kinect_record_command(CLI::App& kinect_command);
 }  // namespace orthoflow::apps

@@ -19,10 +19,13 @@ Result<void, std::string> apply_source(engine::GraphSpec& spec, const std::strin
                                        std::uint64_t frames) {
   engine::NodeSpec* src = find_kind(spec, "synthetic_source");
   if (src == nullptr) src = find_kind(spec, "pcd_source");
+  if (src == nullptr) src = find_kind(spec, "kinect_source");
+  if (src == nullptr) src = find_kind(spec, "replay_source");
   if (src == nullptr) {
     if (!source.empty())
       return err(
-          std::string("--source needs a graph whose source is synthetic_source or pcd_source"));
+          std::string("--source needs a graph whose source is synthetic_source, pcd_source, "
+                      "kinect_source or replay_source"));
     return {};
   }
   if (source.rfind("pcd:", 0) == 0) {
@@ -32,8 +35,26 @@ Result<void, std::string> apply_source(engine::GraphSpec& spec, const std::strin
   } else if (source.rfind("synthetic:", 0) == 0) {
     src->kind = "synthetic_source";
     src->params.assign("seed", source.substr(10));
+  } else if (source == "kinect" || source.rfind("kinect:", 0) == 0) {
+    src->kind = "kinect_source";
+    src->params = {};
+    src->params.assign("device", "usb");
+    if (source.size() > 7) src->params.assign("serial", source.substr(7));
+  } else if (source == "kinect-sim" || source.rfind("kinect-sim:", 0) == 0) {
+    src->kind = "kinect_source";
+    src->params = {};
+    src->params.assign("device", "sim");
+    if (source.size() > 11) src->params.assign("sim_seed", source.substr(11));
+  } else if (source.rfind("replay:", 0) == 0) {
+    src->kind = "replay_source";
+    src->params = {};
+    src->params.assign("dir", source.substr(7));
+    spec.period_ns = 0;  // the recording's own pace (replay_source pace=recorded) unless --rate
   } else if (!source.empty()) {
-    return err("--source must be synthetic:SEED or pcd:DIR, not '" + source + "'");
+    return err(
+        "--source must be synthetic:SEED, pcd:DIR, kinect[:SERIAL], kinect-sim[:SEED] or "
+        "replay:DIR, not '" +
+        source + "'");
   }
   if (frames > 0 && src->kind == "synthetic_source")
     src->params.assign("frames", std::to_string(frames));
@@ -55,6 +76,9 @@ std::string check_rate(const std::string& v) {
 
 void apply_rate(engine::GraphSpec& spec, const std::string& rate) {
   if (rate.empty()) return;
+  // A replay at a given rate (or max) is paced by the engine, not by the recorded times.
+  if (engine::NodeSpec* replay = find_kind(spec, "replay_source"))
+    replay->params.assign("pace", "max");
   spec.period_ns = rate == "max" ? 0 : static_cast<std::int64_t>(1e9 / std::stod(rate));
 }
 

@@ -10,8 +10,10 @@
 
 namespace orthoflow::apps {
 
-/// @brief --source synthetic:SEED | pcd:DIR and --frames (synthetic sources; 0: the graph's) on
-/// the graph's synthetic_source or pcd_source node. Errors say what is wrong (usage errors).
+/// @brief --source synthetic:SEED | pcd:DIR | kinect[:SERIAL] | kinect-sim[:SEED] | replay:DIR
+/// (a fakenect recording, at its recorded pace) and --frames
+/// (synthetic sources; 0: the graph's) on
+/// the graph's synthetic_source, pcd_source or kinect_source node. Errors say what is wrong.
 [[nodiscard]] Result<void, std::string> apply_source(engine::GraphSpec& spec,
                                                      const std::string& source,
                                                      std::uint64_t frames);

@@ -152,7 +152,8 @@ install(FILES ${PROJECT_BINARY_DIR}/orthoflowConfig.cmake ${PROJECT_BINARY_DIR}/
 # shared library the orthoflow binary links (readelf -d apps/orthoflow; check it when a library is added).
 file(GLOB ORTHOFLOW_GRAPH_FILES ${PROJECT_SOURCE_DIR}/graphs/*.yaml)
 install(FILES ${ORTHOFLOW_GRAPH_FILES} DESTINATION ${CMAKE_INSTALL_DATADIR}/orthoflow/graphs)
-install(FILES ${PROJECT_SOURCE_DIR}/deploy/orthoflow.service DESTINATION ${CMAKE_INSTALL_DATADIR}/orthoflow/deploy)
+install(FILES ${PROJECT_SOURCE_DIR}/deploy/orthoflow.service ${PROJECT_SOURCE_DIR}/deploy/60-orthoflow-kinect.rules
+  DESTINATION ${CMAKE_INSTALL_DATADIR}/orthoflow/deploy)
 
 set(CPACK_GENERATOR DEB)
 set(CPACK_PACKAGE_NAME orthoflow)

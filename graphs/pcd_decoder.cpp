@@ -8,8 +8,14 @@ namespace {
 constexpr auto POLL = std::chrono::microseconds(200);
 }  // namespace
 
-PcdDecoder::PcdDecoder(std::vector<std::filesystem::path> files, bool loop, std::size_t depth)
-    : files_(std::move(files)), loop_(loop), slots_(depth), free_(depth), ready_(depth) {
+PcdDecoder::PcdDecoder(std::vector<std::filesystem::path> files, bool loop, std::size_t depth,
+                       Decode decode)
+    : files_(std::move(files)),
+      loop_(loop),
+      decode_(std::move(decode)),
+      slots_(depth),
+      free_(depth),
+      ready_(depth) {
   for (std::size_t k = 0; k < depth; ++k) (void)free_.try_push(static_cast<std::uint32_t>(k));
   thread_ = std::thread([this] { this->loop(); });
 }
@@ -35,6 +41,12 @@ void PcdDecoder::loop() noexcept {
       ended = true;
     } else {
       try {
+        if (decode_) {
+          slot.end = false;
+          decode_(next++, slot);
+          (void)ready_.try_push(k);
+          continue;
+        }
         auto cloud = formats::read_pcd(files_[next++]);
         slot.end = false;
         slot.ok = static_cast<bool>(cloud);

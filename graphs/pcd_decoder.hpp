@@ -4,11 +4,13 @@
 /// folder's files in order into a few slots, so that reading a binary_compressed PCD (about 8 ms
 /// for a 640x480 frame) runs beside the graph instead of on its critical path; the source takes
 /// the next decoded file and gives the slot back. The decoder thread allocates (the reader does);
-/// the frame path only copies out of a slot.
+/// the frame path only copies out of a slot. The decoding step is a hook: PCD files by default,
+/// fakenect depth records for replay_source (graphs/replay_source.cpp).
 #include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <thread>
 #include <vector>
 
@@ -27,10 +29,16 @@ class PcdDecoder {
     bool ok = false;
     formats::IoError error{};
     bool end = false;
+    std::int64_t schedule_ns = 0;  ///< when the file is due, for a paced replay (0 = unpaced)
   };
+  /// @brief Decodes file @p index of the list into @p slot (sets ok / error / cloud). Runs on the
+  /// decoder thread; may allocate and block; must not throw.
+  using Decode = std::function<void(std::size_t index, Slot& slot)>;
   /// @brief Starts decoding @p files (in this order, again from the first with @p loop) into
   /// @p depth slots. @pre !files.empty(), depth >= 1.
-  PcdDecoder(std::vector<std::filesystem::path> files, bool loop, std::size_t depth = 3);
+  /// @p decode replaces the PCD reader (empty: formats::read_pcd).
+  PcdDecoder(std::vector<std::filesystem::path> files, bool loop, std::size_t depth = 3,
+             Decode decode = {});
   ~PcdDecoder();  ///< stops the thread (a file being read is finished first)
   PcdDecoder(const PcdDecoder&) = delete;
   PcdDecoder& operator=(const PcdDecoder&) = delete;
@@ -45,6 +53,7 @@ class PcdDecoder {
   void loop() noexcept;
   std::vector<std::filesystem::path> files_;
   bool loop_;
+  Decode decode_;
   std::vector<Slot> slots_;
   core::SpscRing<std::uint32_t> free_, ready_;  // slot indices: to the decoder, to the source
   std::uint32_t held_ = 0;

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "formats/pcd_io.hpp"
+#include "graphs/frame_source.hpp"
 #include "graphs/node_support.hpp"
 #include "graphs/pcd_decoder.hpp"
 #include "graphs/session_script.hpp"
@@ -19,47 +20,6 @@ namespace {
 using engine::Message;
 using engine::ParamMap;
 using Clock = std::chrono::steady_clock;
-
-const engine::PortSpec SOURCE_OUT[] = {FRAME_OUT};
-
-/// Base of the sources: one output port, capacity, the block of each frame. Pacing is the engine's
-/// (the graph period); a source produces as soon as it is asked.
-class FrameSource : public engine::Node {
- public:
-  FrameSource(std::size_t capacity, const engine::NodeContext& context)
-      : capacity_(capacity), pool_(context.pool), name_(context.name) {}
-  std::span<const engine::PortSpec> inputs() const noexcept override { return {}; }
-  std::span<const engine::PortSpec> outputs() const noexcept override { return SOURCE_OUT; }
-  bool stateful() const noexcept override { return true; }
-  void process(const Message& /*in*/, engine::Emitter& /*out*/) noexcept override {}
-
- protected:
-  /// Takes a pool block for the next frame; false (frame skipped, counted by the engine as a source
-  /// drop) if the pool is exhausted.
-  bool take_block(Message& out) noexcept {
-    auto block = pool_->acquire(name_, pool_->block_bytes());
-    if (!block) {
-      out.skipped = true;
-      return false;
-    }
-    out.payload = std::move(*block);
-    return true;
-  }
-  /// Writes @p cloud into the message's block and clears the per-frame state.
-  bool emit_cloud(Message& out, const kernels::PointCloud& cloud) noexcept {
-    const FrameBlock block = block_of(out, capacity_);
-    new (&block.state()) FrameState{};  // value-initialised in place: no temporary on the stack
-    if (cloud.size() > capacity_ || !engine::write_frame(block.raw(), cloud)) {
-      block.state().error.set(FrameError::Code::FRAME_TOO_LARGE, name_, 0,
-                              static_cast<double>(cloud.size()));
-      return false;
-    }
-    return true;
-  }
-  std::size_t capacity_;
-  memory_pool::BlockPool* pool_;
-  std::string_view name_;
-};
 
 class SyntheticSource final : public FrameSource {
  public:

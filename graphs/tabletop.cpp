@@ -1,8 +1,10 @@
 #include "graphs/tabletop.hpp"
 
 #include "engine/ipc_nodes.hpp"
+#include "graphs/kinect_source.hpp"
 #include "graphs/objects_output.hpp"
 #include "graphs/recognise_node.hpp"
+#include "graphs/replay_source.hpp"
 #include "graphs/segment_nodes.hpp"
 #include "graphs/source_nodes.hpp"
 #include "graphs/track_describe_nodes.hpp"
@@ -15,6 +17,8 @@ engine::NodeRegistry make_tabletop_registry(LearningService& learning, SessionLo
   engine::add_generic_nodes(registry);
   engine::add_ipc_nodes(registry);  // ipc_subscribe / ipc_publish: graphs split across processes
   add_source_nodes(registry);
+  add_kinect_source(registry);
+  add_replay_source(registry);
   add_segment_nodes(registry, labels);
   add_track_describe_nodes(registry);
   add_recognise_node(registry, learning);

@@ -11,6 +11,7 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   clang-14 libclang-rt-14-dev clang-format-14
   libpcl-dev
+  libfreenect-dev libfreenect-bin  # test-only: libfreenect against the simulated Kinect (tests/support/sim_libusb)
 )
 
 missing=()

@@ -1,0 +1,223 @@
+#pragma once
+/// @file
+/// @brief SimKinectDevice: one simulated Kinect v1 (camera, 1414 motor, audio stub) implementing
+/// the documented protocol of specs/KINECT_V1.md (sections 1, 2, 4, 5, 6, 7, 11) on simulated time,
+/// for testing the driver on a machine without USB. It is transport-independent: a host
+/// (SimUsbTransport, or later a libusb-compatible shim) routes control requests and iso microframes
+/// to it and owns bus addresses, claims and kernel-driver state. It has never been compared with a
+/// real Kinect: it is exactly as right as the brief it implements.
+///
+/// Camera (EP0): "GM" commands as OUT 0x40/0/0/0, "RB" replies read with IN 0xC0/0/0/0 (0 bytes
+/// while no reply is pending). Opcodes 0x02 GET_PARAM, 0x03 SET_PARAM, 0x04 GET_FIXED_PARAMS,
+/// 0x16 ALGORITHM_PARAMS (0x00, 0x40, 0x41), 0x95 CMOS register access; anything else is answered
+/// with status 1. A malformed command (setup not 0x40/0/0/0, no "GM", length mismatch, odd or
+/// longer than 1016 bytes of payload) is refused (PIPE) and leaves no reply.
+/// Streams: reg 0x06 <- 2 starts depth on 0x82 (format reg 0x12: 3 = 11-bit, 2 = 10-bit, anything
+/// else starts nothing), reg 0x05 <- 1 Bayer, <- 3 IR 640x488 on 0x81; 0 stops. The first frame
+/// starts in the microframe after the write. Mirror registers (0x17, 0x47, 0x48) are stored only.
+/// Motor (1414 only): tilt 0x40/0x31, LED 0x40/0x06, state 0xC0/0x32 (10 bytes), probe 0xC0/0x10.
+/// Audio: enumerates (0x02AD; 0x02BE on K4W) and refuses every request (firmware not simulated).
+/// Thread safety: none; one host thread drives it. Determinism: given the call sequence and times,
+/// every byte is a function of the config (its seed and sources).
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <optional>
+#include <span>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/rng.hpp"
+#include "drivers/usb_transport.hpp"
+#include "simulation/kinect_depth_model.hpp"
+#include "simulation/sim_kinect_stream.hpp"
+
+namespace orthoflow::simulation {
+
+/// @brief Kinect models (KINECT_V1.md 1): 1414 has a motor function, 1473 and K4W do not.
+enum class KinectModel : std::uint8_t { K1414, K1473, K4W };
+/// @brief The USB functions behind a Kinect's internal hub.
+enum class KinectFunction : std::uint8_t { CAMERA, MOTOR, AUDIO };
+
+inline constexpr std::uint16_t KINECT_VENDOR = 0x045E;
+inline constexpr std::uint16_t KINECT_CAMERA_PID = 0x02AE;
+inline constexpr std::uint16_t KINECT_K4W_CAMERA_PID = 0x02BF;
+inline constexpr std::uint16_t KINECT_MOTOR_PID = 0x02B0;
+inline constexpr std::uint16_t KINECT_AUDIO_PID = 0x02AD;
+inline constexpr std::uint16_t KINECT_K4W_AUDIO_PID = 0x02BE;
+inline constexpr std::uint8_t KINECT_VIDEO_ENDPOINT = 0x81;
+inline constexpr std::uint8_t KINECT_DEPTH_ENDPOINT = 0x82;
+
+/// @brief 640x480 raw disparity (11 bits, 2047 = no reading) of frame @p frame since stream start.
+using SimDepthSource = std::function<void(std::uint64_t frame, std::span<std::uint16_t> raw)>;
+/// @brief 640x480 8-bit GRBG Bayer mosaic of frame @p frame.
+using SimBayerSource = std::function<void(std::uint64_t frame, std::span<std::uint8_t> bayer)>;
+/// @brief 640x488 10-bit IR of frame @p frame.
+using SimIrSource = std::function<void(std::uint64_t frame, std::span<std::uint16_t> ir)>;
+
+/// @brief Fault knobs; all off by default. Rates are per packet; counts and one-shots are consumed
+/// as they fire (faults() shows what is left). Times are simulated ns; the host applies them.
+struct SimKinectFaults {
+  SimPacketFaults packets{};         ///< drop / duplicate / corrupt / reorder rates, both streams
+  std::uint32_t junk_replies = 0;    ///< per GM command: 512-byte junk IN replies first (USB 3)
+  std::uint32_t empty_replies = 0;   ///< per GM command: then 0-byte IN replies
+  std::uint32_t control_stalls = 0;  ///< the next N control transfers (any function) time out
+  bool wrong_tag_once = false;       ///< the next GM reply carries tag + 1
+  bool wrong_magic_once = false;     ///< the next GM reply starts "RC" instead of "RB"
+  std::optional<std::int64_t> disconnect_at_ns{};  ///< unplug: NO_DEVICE, gone from enumerate
+  std::optional<std::int64_t> reconnect_at_ns{};   ///< replug (after disconnect) at new addresses
+  std::optional<std::int64_t> cancel_at_ns{};      ///< in-flight iso transfers come back CANCELLED
+};
+
+/// @brief Device calibration answered by opcodes 0x04 and 0x16 (not real calibration data).
+struct SimKinectCalibration {
+  double dcmos_rcmos_dist_cm = 2.3;  ///< fixed params float 2 (the others: KinectDepthParams)
+  std::uint16_t pad_start_lines = 0;
+  std::uint16_t pad_end_lines = 0;
+  std::uint16_t pad_cropping_lines = 0;
+  std::array<std::int32_t, 29> registration{};  ///< 0x16/0x40 words; all 0 = built-in pattern
+};
+
+/// @brief One simulated Kinect. Plain data with defaults; validated by the constructor.
+struct SimKinectConfig {
+  KinectModel model = KinectModel::K1414;
+  std::string serial = "A00364A11700045A";  ///< 16 chars; the 1414 camera's (1473/K4W: audio's)
+  std::uint8_t bus = 1;
+  std::vector<std::uint8_t> hub_ports{1};  ///< port path of the Kinect's internal hub
+  bool with_audio = true;                  ///< list the audio function
+  KinectDepthParams depth{};  ///< fixed params floats, const shift, default scene conversion
+  SimKinectCalibration calibration{};
+  SimDepthSource depth_source{};  ///< empty: a seeded synthetic tabletop, rendered once
+  SimBayerSource bayer_source{};  ///< empty: that scene's colours as GRBG
+  SimIrSource ir_source{};        ///< empty: an intensity falling with depth squared
+  std::uint64_t scene_seed = 42;
+  double motor_slew_deg_per_s = 15.0;
+  std::uint64_t fault_seed = 1;  ///< seeds the core::Rng of every random fault
+  SimKinectFaults faults{};
+};
+
+/// @brief How the device answered a control request.
+enum class SimControlOutcome : std::uint8_t { OK, PIPE, TIMEOUT };
+struct SimControlReply {
+  SimControlOutcome outcome = SimControlOutcome::OK;
+  std::size_t bytes = 0;  ///< bytes moved (IN: written to the buffer)
+};
+
+/// @brief One simulated Kinect: identity, EP0 protocols, iso microframes, motor.
+/// @note Not copyable or movable (its streams call back into it). Allocates in the constructor
+/// and once for the default scene; nothing per packet or per frame.
+class SimKinectDevice {
+ public:
+  /// @pre serial is 16 chars for model 1414; hub_ports has 1..6 entries; slew > 0 (OF_ENFORCE).
+  explicit SimKinectDevice(SimKinectConfig config);
+  SimKinectDevice(const SimKinectDevice&) = delete;
+  SimKinectDevice& operator=(const SimKinectDevice&) = delete;
+
+  [[nodiscard]] const SimKinectConfig& config() const noexcept { return config_; }
+  [[nodiscard]] KinectModel model() const noexcept { return config_.model; }
+  /// @brief True if this model has @p function (MOTOR: 1414 only; AUDIO: if with_audio).
+  [[nodiscard]] bool has_function(KinectFunction function) const noexcept;
+  /// @brief The enumeration record of @p function at the addresses the host assigned (camera at
+  /// first_address, motor + 1, audio + 2). @pre has_function(function).
+  [[nodiscard]] drivers::UsbDeviceInfo info(KinectFunction function) const noexcept;
+  /// @brief The host assigns addresses on (re)connection. @pre address <= 125.
+  void set_first_address(std::uint8_t address) noexcept { first_address_ = address; }
+  /// @brief Power-on state: registers, pending reply, streams; the motor keeps its angle.
+  void power_cycle() noexcept;
+
+  /// @brief A control transfer to @p function at simulated time @p now_ns. @p data is the OUT
+  /// payload or the IN buffer (wLength = data.size()).
+  SimControlReply control(KinectFunction function, const drivers::UsbControlSetup& setup,
+                          std::span<std::byte> data, std::int64_t now_ns) noexcept;
+  /// @brief The camera's packet in microframe @p microframe on @p endpoint (0x81 / 0x82) into @p
+  /// out; returns its length (0 = idle). Call per endpoint with increasing microframes.
+  /// @pre out.size() >= KINECT_ISO_MAX_PACKET_BYTES.
+  std::size_t iso_packet(std::uint8_t endpoint, std::int64_t microframe,
+                         std::span<std::byte> out) noexcept;
+
+  /// @brief The raw disparity image the depth stream sends as frame @p frame (frames count from 0
+  /// at every stream start). In 10-bit mode each pixel is sent as min(raw, 1023).
+  /// @pre raw.size() == 640 * 480.
+  void depth_raw_image(std::uint64_t frame, std::span<std::uint16_t> raw);
+  /// @brief The Bayer frame @p frame. @pre bayer.size() == 640 * 480.
+  void bayer_image(std::uint64_t frame, std::span<std::uint8_t> bayer);
+  /// @brief The IR frame @p frame. @pre ir.size() == 640 * 488.
+  void ir_image(std::uint64_t frame, std::span<std::uint16_t> ir);
+
+  /// @brief A camera register's value (nullopt if never written).
+  [[nodiscard]] std::optional<std::uint16_t> reg(std::uint16_t address) const;
+  /// @brief Every SET_PARAM (reg, value) in arrival order.
+  [[nodiscard]] const std::vector<std::pair<std::uint16_t, std::uint16_t>>& register_writes()
+      const noexcept {
+    return writes_;
+  }
+  [[nodiscard]] SimStreamMode depth_mode() const noexcept { return depth_.mode(); }
+  [[nodiscard]] SimStreamMode video_mode() const noexcept { return video_.mode(); }
+  [[nodiscard]] const SimStreamCounters& depth_counters() const noexcept {
+    return depth_.counters();
+  }
+  [[nodiscard]] const SimStreamCounters& video_counters() const noexcept {
+    return video_.counters();
+  }
+  /// @brief GM commands accepted (malformed ones excluded).
+  [[nodiscard]] std::uint64_t commands() const noexcept { return commands_; }
+
+  /// @brief Motor angle at @p now_ns (degrees, slewing toward target_tilt_deg()).
+  [[nodiscard]] double tilt_deg(std::int64_t now_ns) noexcept;
+  [[nodiscard]] double target_tilt_deg() const noexcept { return motor_.target_deg; }
+  [[nodiscard]] std::uint8_t led() const noexcept { return motor_.led; }
+
+  [[nodiscard]] const SimKinectFaults& faults() const noexcept { return faults_; }
+  /// @brief Replaces the fault knobs (e.g. to arm a one-shot mid-test).
+  void set_faults(const SimKinectFaults& faults) noexcept { faults_ = faults; }
+
+ private:
+  struct Motor {
+    double angle_deg = 0.0;
+    double target_deg = 0.0;
+    bool clamped = false;
+    std::int64_t updated_ns = 0;
+    std::uint8_t led = 0;
+  };
+
+  SimControlReply camera_control(const drivers::UsbControlSetup& setup, std::span<std::byte> data,
+                                 std::int64_t now_ns) noexcept;
+  SimControlReply read_reply(std::span<std::byte> data) noexcept;
+  bool gm_command(std::span<const std::byte> data, std::int64_t now_ns) noexcept;
+  void answer(std::uint16_t cmd, std::uint16_t tag, std::span<const std::uint8_t> payload,
+              std::int64_t now_ns) noexcept;
+  std::size_t algorithm_params(std::uint16_t param_id, std::span<std::uint8_t> out) const noexcept;
+  std::size_t fixed_params(std::span<std::uint8_t> out) const noexcept;
+  void write_register(std::uint16_t address, std::uint16_t value, std::int64_t now_ns) noexcept;
+  SimControlReply motor_control(const drivers::UsbControlSetup& setup, std::span<std::byte> data,
+                                std::int64_t now_ns) noexcept;
+  void fill_frame(SimStreamMode mode, std::uint64_t frame, std::span<std::uint8_t> packed);
+  void ensure_default_scene();
+
+  SimKinectConfig config_;
+  SimKinectFaults faults_;
+  core::Rng rng_;
+  std::uint8_t first_address_ = 0;
+  std::map<std::uint16_t, std::uint16_t> registers_;
+  std::map<std::uint16_t, std::uint16_t> cmos_registers_;
+  std::vector<std::pair<std::uint16_t, std::uint16_t>> writes_;
+  std::array<std::uint8_t, 512> reply_{};
+  std::size_t reply_bytes_ = 0;
+  bool reply_pending_ = false;
+  std::uint32_t junk_left_ = 0;
+  std::uint32_t empty_left_ = 0;
+  std::uint64_t commands_ = 0;
+  SimIsoStreamGenerator depth_;
+  SimIsoStreamGenerator video_;
+  std::vector<std::uint16_t> scratch16_;  // 640 x 488: a frame before packing
+  std::vector<std::uint8_t> scratch8_;
+  std::vector<std::uint16_t> scene_raw_;  // the default scene, rendered on first use
+  std::vector<std::uint8_t> scene_bayer_;
+  std::vector<std::uint16_t> scene_ir_;
+  Motor motor_{};
+};
+
+}  // namespace orthoflow::simulation

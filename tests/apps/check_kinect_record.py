@@ -1,0 +1,58 @@
+"""`orthoflow kinect record DIR` and `orthoflow run --source replay:DIR` (issue 18): a recording of
+the simulated camera in fakenect's format, replayed through the same conversion as the live camera;
+an existing recording is never overwritten; a damaged record is a frame error naming the file."""
+import json
+import os
+import shutil
+import struct
+import sys
+
+from cli_check import expect, run
+
+cli, work = sys.argv[1], sys.argv[2]
+shutil.rmtree(work, ignore_errors=True)
+os.makedirs(work)
+rec = os.path.join(work, "rec")
+
+p = run(cli, "kinect", "record", rec, "--sim", "--frames", "15")
+expect("recorded 15 depth and 15 colour frames" in p.stdout, f"record: {p.stdout}")
+index = open(os.path.join(rec, "INDEX.txt")).read().split()
+depth = [n for n in index if n.startswith("d-")]
+colour = [n for n in index if n.startswith("r-")]
+expect(len(depth) == 15 and len(colour) == 15, f"index: {index[:4]}")
+with open(os.path.join(rec, depth[0]), "rb") as f:
+    data = f.read()
+expect(data.startswith(b"P5 640 480 65535\n") and len(data) == 17 + 640 * 480 * 2, "d- record")
+values = struct.unpack("<%dH" % (640 * 480), data[17:])
+expect(max(values) <= 2047 and values.count(2047) < len(values), "d-: 11-bit disparities")
+with open(os.path.join(rec, colour[0]), "rb") as f:
+    expect(f.read(15) == b"P6 640 480 255\n", "r- record")
+device = json.load(open(os.path.join(rec, "device.json")))
+expect(abs(device["reg_info"]["zero_plane_info"]["reference_pixel_size"] - 0.1042) < 1e-6 and
+       device["const_shift"] == 200 and len(device["reg_info"]) == 26, f"device.json: {device}")
+# Device timestamps: 60 MHz, one frame apart (2,000,000 ticks at 30 Hz).
+ticks = [int(n.split("-")[2].split(".")[0]) for n in depth]
+expect(all(b - a == 2000000 for a, b in zip(ticks, ticks[1:])), f"timestamps: {ticks[:4]}")
+
+# Never over an existing recording.
+p = run(cli, "kinect", "record", rec, "--sim", "--frames", "2", code=106)
+expect("already holds a recording" in p.stderr, p.stderr)
+
+# Replay at the recorded pace (15 frames ~ 0.5 s) and as fast as possible.
+p = run(cli, "run", "--source", "replay:" + rec, "--threads", "1")
+expect("15 processed" in p.stdout and "15 with a table" in p.stdout, f"replay: {p.stdout}")
+p = run(cli, "run", "--source", "replay:" + rec, "--rate", "max", "--threads", "1")
+expect("15 processed" in p.stdout, f"replay max: {p.stdout}")
+
+# A truncated record: that frame is an error naming the file, the others run.
+bad = os.path.join(work, "bad")
+shutil.copytree(rec, bad)
+with open(os.path.join(bad, depth[3]), "r+b") as f:
+    f.truncate(1000)
+p = run(cli, "run", "--source", "replay:" + bad, "--rate", "max", "--threads", "1", code=None)
+expect("15 processed" in p.stdout and "1 with an error" in p.stdout, f"bad replay: {p.stdout}")
+expect(depth[3] in p.stderr, f"bad replay names the file: {p.stderr}")
+# A directory without a recording.
+p = run(cli, "run", "--source", "replay:" + work, code=None)
+expect(p.returncode != 0 and "INDEX.txt" in p.stderr, f"no index: {p.stderr}")
+print("ok")
