@@ -14,12 +14,11 @@
 #include <vector>
 
 #include "apps/commands.hpp"
+#include "apps/kinect_cli.hpp"
 #include "drivers/kinect_device.hpp"
-#include "drivers/libusb_transport.hpp"
 #include "formats/fakenect.hpp"
 #include "graphs/fakenect_calibration.hpp"
 #include "kernels/bayer_demosaic.hpp"
-#include "simulation/sim_usb_transport.hpp"
 
 namespace orthoflow::apps {
 namespace {
@@ -36,8 +35,7 @@ struct RecordArgs {
 };
 
 [[noreturn]] void fail(const std::string& what, int code = EXIT_FAILURE_GENERIC) {
-  std::cerr << "orthoflow kinect record: " << what << '\n';
-  throw CLI::RuntimeError(code);
+  kinect_cli::fail("record: " + what, code);
 }
 
 double wall_seconds() {
@@ -52,18 +50,10 @@ void record(const RecordArgs& a) {
   std::filesystem::create_directories(dir, ec);
   if (ec) fail("cannot create " + a.dir + ": " + ec.message());
 
-  std::unique_ptr<drivers::UsbTransport> transport;
-  if (a.sim) {
-    auto sim = std::make_unique<simulation::SimUsbTransport>();
-    simulation::SimKinectConfig config;
-    config.faults.packets.drop_rate = a.sim_drop;
-    sim->add_kinect(std::move(config));
-    transport = std::move(sim);
-  } else {
-    auto usb = drivers::LibusbTransport::create();
-    if (!usb.has_value()) fail("cannot start libusb: " + drivers::to_string(usb.error()));
-    transport = std::move(usb.value());
-  }
+  kinect_cli::KinectArgs transport_args;
+  transport_args.sim = a.sim;
+  transport_args.sim_drop = a.sim_drop;
+  auto transport = kinect_cli::make_transport(transport_args);
   kinect::DeviceOptions options;
   options.camera.serial = a.serial;
   options.camera.colour = !a.no_colour;

@@ -7,50 +7,23 @@
 
 namespace orthoflow::graphs {
 
-const std::array<const char*, 24> FAKENECT_REG_KEYS = {"ax",
-                                                       "bx",
-                                                       "cx",
-                                                       "dx",
-                                                       "ay",
-                                                       "by",
-                                                       "cy",
-                                                       "dy",
-                                                       "dx_start",
-                                                       "dy_start",
-                                                       "dx_beta_start",
-                                                       "dy_beta_start",
-                                                       "dx_beta_inc",
-                                                       "dy_beta_inc",
-                                                       "dxdx_start",
-                                                       "dxdy_start",
-                                                       "dydx_start",
-                                                       "dydy_start",
-                                                       "dxdxdx_start",
-                                                       "dydxdx_start",
-                                                       "dxdxdy_start",
-                                                       "dydxdy_start",
-                                                       "dydydx_start",
-                                                       "dydydy_start"};
-
 namespace {
 
 using formats::IoError;
 
-/// Index of fakenect key @p key in the device's 29-word order (reg_info_name), or 29.
-std::size_t device_index(std::string_view key) {
-  for (std::size_t i = 0; i < 29; ++i) {
-    if (key == drivers::kinect::reg_info_name(i)) return i;
-  }
-  return 29;
+/// fakenect stores every registration word but these five (the mapping does not use them).
+bool stored_by_fakenect(std::string_view name) {
+  return name != "dx_center" && name != "rollout_blank" && name != "rollout_size" &&
+         name != "back_comp1" && name != "back_comp2";
 }
 
 }  // namespace
 
 std::string fakenect_device_json(const drivers::kinect::Calibration& c) {
   nlohmann::ordered_json reg;
-  for (const char* key : FAKENECT_REG_KEYS) {
-    const std::size_t i = device_index(key);
-    reg[key] = i < 29 ? c.reg.words[i] : 0;
+  for (std::size_t i = 0; i < c.reg.words.size(); ++i) {
+    const char* key = drivers::kinect::reg_info_name(i);
+    if (stored_by_fakenect(key)) reg[key] = c.reg.words[i];
   }
   reg["pad_info"] = {{"start_lines", c.pad.start_lines},
                      {"end_lines", c.pad.end_lines},
@@ -97,10 +70,11 @@ Result<drivers::kinect::Calibration, IoError> parse_fakenect_device(std::string_
   if (!reg.is_object()) return err(bad(IoError::Code::BAD_HEADER, "missing object 'reg_info'"));
   drivers::kinect::Calibration c;
   c.reg.words.fill(0);
-  for (const char* key : FAKENECT_REG_KEYS) {
+  for (std::size_t i = 0; i < c.reg.words.size(); ++i) {
+    const char* key = drivers::kinect::reg_info_name(i);
+    if (!stored_by_fakenect(key)) continue;
     if (auto ok = number(reg, key, -2147483648.0, 2147483647.0); !ok) return err(ok.error());
-    const std::size_t i = device_index(key);
-    if (i < 29) c.reg.words[i] = static_cast<std::int32_t>(v);
+    c.reg.words[i] = static_cast<std::int32_t>(v);
   }
   const nlohmann::json& pad = member(reg, "pad_info");
   std::uint16_t* pads[] = {&c.pad.start_lines, &c.pad.end_lines, &c.pad.cropping_lines};

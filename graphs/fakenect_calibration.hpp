@@ -18,9 +18,6 @@
 
 namespace orthoflow::graphs {
 
-/// @brief The reg_info keys fakenect writes, in its order ("ax", "bx", ..., "dydydy_start").
-extern const std::array<const char*, 24> FAKENECT_REG_KEYS;
-
 /// @brief device.json's text for @p calibration.
 [[nodiscard]] std::string fakenect_device_json(const drivers::kinect::Calibration& calibration);
 /// @brief Writes device.json (atomically).

@@ -89,6 +89,34 @@ TEST(TabletopAllocations, SteadyStateAllocatesNothingPerFrame) {
   EXPECT_EQ(g_allocations.load(), 0U);
 }
 
+TEST(TabletopAllocations, KinectSourceSteadyStateAllocatesNothingPerFrame) {
+  // The graph fed by the Kinect driver (kinect_source on the simulated camera, paced to the wall
+  // clock): the USB thread (packets, assembly, unpack, publication) and the graph's threads.
+  auto learning = test::in_memory_learning();
+  auto json = LineWriter::open("/dev/null");
+  ASSERT_TRUE(json);
+  SessionLog log(std::move(*json));
+  const auto registry = make_tabletop_registry(*learning, log, nullptr);
+  auto spec = test::tabletop_spec({{"source", {{"kind", "kinect_source"}, {"device", "sim"}}},
+                                   {"recognise", {{"instructor", "0"}}}});
+  auto graph = engine::build_graph(spec, registry);
+  ASSERT_TRUE(graph) << engine::to_string(graph.error());
+  engine::Engine engine(**graph, {2});
+  std::atomic<bool> stop{false};
+  std::thread arm([&] {
+    while (log.summary().frames < 15 && !stop.load())
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    g_counting.store(true);
+  });
+  engine.run({45, nullptr});  // 1.5 s of camera time; counted over the last 30 frames
+  g_counting.store(false);
+  stop.store(true);
+  arm.join();
+  EXPECT_EQ(log.summary().frames, 45U);
+  EXPECT_EQ(log.summary().frames_with_table, 45U);
+  EXPECT_EQ(g_allocations.load(), 0U);
+}
+
 TEST(LabelsWriterAllocations, OfferingAFrameAllocatesNothing) {
   // --labels-out on the frame path: copying a frame into a writer cloud and labelling it allocates
   // nothing (the writer thread's encoding does, off the frame path, and is not counted here).
