@@ -1,15 +1,22 @@
-// `orthoflow kinect tilt DEGREES [--wait] | led MODE | accel`: the model-1414 motor, LED and
-// accelerometer through orthoflow's driver (drivers/kinect_motor.hpp); --sim runs them on the
-// simulated motor.
+// `orthoflow kinect tilt DEGREES [--wait] | led MODE | accel`: the motor, LED and accelerometer
+// through orthoflow's driver (drivers/kinect_motor.hpp: the 1414 motor function, or on a 1473 /
+// K4W the running audio firmware); --sim runs them on the simulated Kinect.
+// `orthoflow kinect firmware [--file PATH]`: uploads the audio firmware of a 1473 / K4W
+// (drivers/kinect_audio.hpp). Without --file, audios.bin is searched in libfreenect's order. The
+// file is not redistributable and not shipped. With --sim the simulated Kinect (--sim-model 1473
+// or k4w) accepts any image with a valid header, so --file must name a synthetic image; the
+// simulated upload lives only as long as the command (a later `kinect tilt --sim` starts afresh).
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 
 #include "apps/kinect_cli.hpp"
+#include "drivers/kinect_audio.hpp"
 #include "drivers/kinect_camera.hpp"
 #include "drivers/kinect_motor.hpp"
 
@@ -99,11 +106,62 @@ void run_accel(const KinectArgs& a) {
   print_state(state.value(), a.json);
 }
 
+// ---- kinect firmware: the 1473 / K4W audio firmware upload (drivers/kinect_audio.hpp) ----
+
+std::string find_firmware_file(const std::string& given) {
+  if (!given.empty()) return given;
+  for (const std::string& dir : kinect::firmware_search_paths()) {
+    const std::filesystem::path candidate =
+        std::filesystem::path(dir) / std::string(kinect::AUDIO_FIRMWARE_FILE);
+    std::error_code ec;
+    if (std::filesystem::is_regular_file(candidate, ec)) return candidate.string();
+  }
+  std::string where;
+  for (const std::string& dir : kinect::firmware_search_paths()) where += " " + dir;
+  fail("no audios.bin found (searched:" + where +
+           "); extract it with libfreenect's fwfetcher.py and pass --file PATH",
+       EXIT_USAGE);
+}
+
+void run_firmware(const KinectArgs& a, const std::string& file) {
+  const std::string path = find_firmware_file(file);
+  auto image = kinect::read_firmware_file(path);
+  if (!image.has_value()) fail("cannot read " + path + ": " + kinect::to_string(image.error()));
+  auto transport = make_transport(a);
+  kinect::FirmwareLoader loader(*transport);
+  auto audio = loader.find_audio(find_camera(*transport, a));
+  if (!audio.has_value()) fail("cannot find the audio device: " + kinect::to_string(audio.error()));
+  const bool was_running =
+      kinect::audio_firmware_state(audio.value()) == kinect::AudioFirmware::RUNNING;
+  auto running = loader.upload(audio.value(), image.value());
+  if (!running.has_value())
+    fail("audio firmware upload failed: " + kinect::to_string(running.error()));
+  const drivers::UsbDeviceInfo& d = running.value();
+  const char* state = was_running ? "already_running" : "uploaded";
+  if (a.json) {
+    const nlohmann::json out = {{"state", state},
+                                {"file", path},
+                                {"bus", d.bus},
+                                {"address", d.address},
+                                {"interfaces", d.interface_count},
+                                {"serial", std::string(d.serial.view())},
+                                {"chunks", loader.stats().chunks},
+                                {"bytes", loader.stats().bytes}};
+    std::cout << out.dump(2) << '\n';
+    return;
+  }
+  std::cout << "audio firmware " << state << " (" << loader.stats().bytes << " bytes in "
+            << loader.stats().chunks << " chunks); audio device " << int{d.bus} << ':'
+            << int{d.address} << ", " << int{d.interface_count} << " interfaces\n";
+}
+
 }  // namespace
 
 void add_motor_commands(CLI::App* cmd, const std::shared_ptr<KinectArgs>& a) {
   auto common = [a](CLI::App* sub) { add_common_options(sub, a); };
-  auto* tilt = cmd->add_subcommand("tilt", "tilt the head (1414 motor), degrees from the horizon");
+  auto* tilt = cmd->add_subcommand(
+      "tilt",
+      "tilt the head (1414 motor; 1473 / K4W after kinect firmware), degrees from the horizon");
   common(tilt);
   tilt->add_option("--serial", a->serial, "which Kinect (default: the first)");
   tilt->add_option("degrees", a->tilt, "target angle, -31 to 31 (half-degree steps)")
@@ -111,7 +169,8 @@ void add_motor_commands(CLI::App* cmd, const std::shared_ptr<KinectArgs>& a) {
       ->required();
   tilt->add_flag("--wait", a->wait, "wait (up to 10 s) until the motor stops, then report");
   tilt->callback([a] { run_tilt(*a); });
-  auto* led = cmd->add_subcommand("led", "set the LED (1414 motor function)");
+  auto* led = cmd->add_subcommand(
+      "led", "set the LED (1414 motor function; 1473 / K4W after kinect firmware)");
   common(led);
   led->add_option("--serial", a->serial, "which Kinect (default: the first)");
   led->add_option("mode", a->led,
@@ -123,6 +182,15 @@ void add_motor_commands(CLI::App* cmd, const std::shared_ptr<KinectArgs>& a) {
   common(accel);
   accel->add_option("--serial", a->serial, "which Kinect (default: the first)");
   accel->callback([a] { run_accel(*a); });
+  auto file = std::make_shared<std::string>();
+  auto* firmware = cmd->add_subcommand(
+      "firmware", "upload the 1473 / K4W audio firmware (needed before tilt, led, accel)");
+  common(firmware);
+  firmware->add_option("--serial", a->serial, "which Kinect (default: the first)");
+  firmware->add_option("--file", *file,
+                       "audios.bin (default: searched as libfreenect does; with --sim: a "
+                       "synthetic image with a valid header)");
+  firmware->callback([a, file] { run_firmware(*a, *file); });
 }
 
 }  // namespace orthoflow::apps::kinect_cli

@@ -68,7 +68,8 @@ KinectError usb_failure(std::uint16_t opcode, const UsbError& usb) noexcept {
 
 Result<std::size_t, KinectError> KinectControl::attempt(std::uint16_t opcode,
                                                         std::span<const std::byte> frame,
-                                                        std::span<std::byte> reply) {
+                                                        std::span<std::byte> reply,
+                                                        std::int64_t deadline_ns) {
   // The command buffer is const for the caller; libusb's OUT transfer does not write it.
   std::array<std::byte, HEADER_BYTES + MAX_COMMAND_PAYLOAD> out{};
   std::memcpy(out.data(), frame.data(), frame.size());
@@ -82,7 +83,8 @@ Result<std::size_t, KinectError> KinectControl::attempt(std::uint16_t opcode,
   KinectError last;
   last.code = KinectError::Code::NOT_READY;
   last.opcode = opcode;
-  for (std::uint32_t poll = 0; poll < policy_.max_polls; ++poll) {
+  for (std::uint32_t poll = 0;
+       poll < policy_.max_polls && transport_->clock().now_ns() < deadline_ns; ++poll) {
     auto got = transport_->control(*camera_, REPLY_IN, in, policy_.transfer_timeout);
     if (!got.has_value()) {
       if (got.error().code == UsbError::Code::TIMEOUT) {
@@ -128,9 +130,15 @@ Result<std::size_t, KinectError> KinectControl::command(std::uint16_t opcode,
     return err(e);
   }
   KinectError last;
-  for (std::uint32_t attempt_no = 0; attempt_no <= policy_.retries; ++attempt_no) {
+  const std::int64_t deadline_ns =
+      transport_->clock().now_ns() +
+      std::chrono::duration_cast<std::chrono::nanoseconds>(policy_.command_deadline).count();
+  for (std::uint32_t attempt_no = 0;
+       attempt_no <= policy_.retries &&
+       (attempt_no == 0 || transport_->clock().now_ns() < deadline_ns);
+       ++attempt_no) {
     if (attempt_no > 0) ++stats_.retries;
-    auto done = attempt(opcode, frame->view(), reply);
+    auto done = attempt(opcode, frame->view(), reply, deadline_ns);
     if (done.has_value()) {
       ++stats_.commands;
       tag_ = static_cast<std::uint16_t>(tag_ + 1);  // wraps at 16 bits, as the device expects

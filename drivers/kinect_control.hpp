@@ -6,9 +6,9 @@
 /// calibration reads of section 5.3.
 ///
 /// Unlike libfreenect (no timeout, unbounded polling), every exchange is bounded: at most
-/// ControlPolicy::max_polls reply reads of transfer_timeout each, then at most `retries` resends.
-/// A wedged device therefore costs at most (retries + 1) x (1 + max_polls) x timeout, and the
-/// error names the opcode and the last reply check.
+/// ControlPolicy::max_polls reply reads of transfer_timeout each, at most `retries` resends, and
+/// never longer than command_deadline in all; the error names the opcode and the last reply check.
+#include <chrono>
 #include <cstdint>
 #include <span>
 #include <string>
@@ -24,6 +24,9 @@ struct ControlPolicy {
   UsbTimeout transfer_timeout{500};  ///< per control transfer (the kernel driver's 500 ms)
   std::uint32_t max_polls = 100;     ///< reply reads per attempt before giving up (NOT_READY)
   std::uint32_t retries = 2;         ///< resends after a bad reply, a timeout or a poll limit
+  /// Whatever the polls and retries, one command gives up after this long (transport clock): a
+  /// stalled device costs the USB thread at most this, plus one transfer timeout.
+  std::chrono::milliseconds command_deadline{2000};
 };
 
 /// @brief Counters of the control exchange (STYLE rule 16: every retry is data).
@@ -94,7 +97,8 @@ class KinectControl {
  private:
   [[nodiscard]] Result<std::size_t, KinectError> attempt(std::uint16_t opcode,
                                                          std::span<const std::byte> frame,
-                                                         std::span<std::byte> reply);
+                                                         std::span<std::byte> reply,
+                                                         std::int64_t deadline_ns);
   [[nodiscard]] Result<std::size_t, KinectError> algorithm_param(std::uint16_t param_id,
                                                                  std::uint16_t resolution,
                                                                  std::span<std::byte> reply);

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <vector>
 
+#include "drivers/kinect_audio.hpp"
 #include "drivers/kinect_protocol.hpp"
 #include "drivers/kinect_siblings.hpp"
 
@@ -115,14 +116,37 @@ KinectMotor::KinectMotor(UsbTransport& transport, UsbDeviceHandle handle, const 
                          MotorOptions options) noexcept
     : transport_(&transport), handle_(std::move(handle)), info_(info), options_(options) {}
 
+KinectMotor::KinectMotor(UsbTransport& transport, std::unique_ptr<AudioMotor> audio,
+                         MotorOptions options) noexcept
+    : transport_(&transport), info_(audio->info()), options_(options), audio_(std::move(audio)) {}
+
+KinectMotor::~KinectMotor() = default;
+
+void KinectMotor::count(const KinectError* failure) noexcept {
+  if (failure == nullptr) {
+    ++stats_.requests;
+    return;
+  }
+  ++stats_.failures;
+  if (failure->code == KinectError::Code::USB && failure->usb.code == UsbError::Code::TIMEOUT)
+    ++stats_.timeouts;
+  if (failure->code == KinectError::Code::BAD_REPLY) ++stats_.bad_replies;
+}
+
 Result<std::unique_ptr<KinectMotor>, KinectError> KinectMotor::open(UsbTransport& transport,
                                                                     const CameraInfo& camera,
                                                                     MotorOptions options) {
-  if (camera.model != Model::K1414)
-    return err(refusal(UsbError::Code::NOT_SUPPORTED,
-                       "kinect motor: 1473/K4W motor via the audio firmware (not implemented)"));
   if (options.transfer_timeout.count() <= 0 || options.poll_interval.count() <= 0)
     return err(refusal(UsbError::Code::INVALID_PARAM, "kinect motor: timeouts must be > 0"));
+  if (camera.model != Model::K1414) {
+    // NOT_SUPPORTED ("upload the audio firmware first") while the audio device is a bootloader.
+    AudioMotorOptions audio_options;
+    audio_options.reset_at_open = options.reset_audio_at_open;
+    auto audio = AudioMotor::open(transport, camera, audio_options);
+    if (!audio) return err(audio.error());
+    return std::unique_ptr<KinectMotor>(
+        new KinectMotor(transport, std::move(audio.value()), options));
+  }
   auto found = transport.enumerate(VENDOR_MICROSOFT, PID_MOTOR);
   if (!found.has_value()) return err(usb_failure(found.error()));
   std::vector<const UsbDeviceInfo*> motors;
@@ -165,6 +189,12 @@ Result<void, KinectError> KinectMotor::set_tilt(double degrees) {
     e.opcode = MOTOR_SET_TILT.request;
     return err(e);
   }
+  if (audio_) {
+    auto done = audio_->set_tilt(degrees);
+    count(done ? nullptr : &done.error());
+    if (done) audio_target_ = static_cast<std::int32_t>(std::lround(degrees));
+    return done;
+  }
   UsbControlSetup setup = MOTOR_SET_TILT;
   setup.value = encode_tilt(degrees);
   if (auto sent = transfer(setup, {}); !sent.has_value()) return err(sent.error());
@@ -172,6 +202,11 @@ Result<void, KinectError> KinectMotor::set_tilt(double degrees) {
 }
 
 Result<void, KinectError> KinectMotor::set_led(LedMode mode) {
+  if (audio_) {
+    auto done = audio_->set_led(mode);
+    count(done ? nullptr : &done.error());
+    return done;
+  }
   UsbControlSetup setup = MOTOR_SET_LED;
   setup.value = static_cast<std::uint16_t>(mode);
   if (auto sent = transfer(setup, {}); !sent.has_value()) return err(sent.error());
@@ -179,6 +214,12 @@ Result<void, KinectError> KinectMotor::set_led(LedMode mode) {
 }
 
 Result<MotorState, KinectError> KinectMotor::read_state() {
+  if (audio_) {
+    auto state = audio_->read_state();
+    count(state ? nullptr : &state.error());
+    if (!state) return err(state.error());
+    return to_motor_state(state.value());
+  }
   std::array<std::byte, MOTOR_STATE_BYTES> reply{};
   auto got = transfer(MOTOR_READ_STATE, reply);
   if (!got.has_value()) return err(got.error());
@@ -202,7 +243,16 @@ Result<MotorState, KinectError> KinectMotor::wait_until_still(UsbTimeout timeout
   for (;;) {
     ++stats_.polls;
     auto state = read_state();
-    if (!state.has_value() || state.value().status != TiltStatus::MOVING) return state;
+    if (!state.has_value()) return state;
+    if (audio_) {
+      if (!audio_target_) return state;
+      if (state.value().tilt_deg == static_cast<double>(*audio_target_)) {
+        state.value().status = TiltStatus::STOPPED;  // inferred: see the header
+        return state;
+      }
+    } else if (state.value().status != TiltStatus::MOVING) {
+      return state;
+    }
     const std::int64_t now = clock.now_ns();
     if (now >= deadline)
       return err(usb_failure(UsbError{UsbError::Code::TIMEOUT, 0, "kinect motor wait_until_still"},

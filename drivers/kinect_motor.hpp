@@ -6,8 +6,9 @@
 /// with a finite timeout.
 ///
 /// Models 1473 and K4W have no 0x02B0 function: their motor and LED are driven through the audio
-/// device once its firmware is uploaded (KINECT_V1.md 12). That path is not implemented here, and
-/// KinectMotor::open() refuses those models with a NOT_SUPPORTED error.
+/// device once its firmware is uploaded (KINECT_V1.md 12). KinectMotor::open() then uses the
+/// AudioMotor backend of kinect_audio.hpp when the audio firmware runs, and refuses with a
+/// NOT_SUPPORTED error telling the user to upload the firmware first while it does not.
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -89,6 +90,10 @@ struct MotorState {
 struct MotorOptions {
   UsbTimeout transfer_timeout{500};  ///< per control transfer; never 0 (infinite)
   UsbTimeout poll_interval{50};      ///< wait_until_still: one state read this often
+  /// 1473/K4W only: port-reset the audio device at open (KINECT_V1.md 13, row 9: libfreenect does
+  /// it to avoid hangs, issue #543 says it hurts). Off by default. The audio backend uses its own
+  /// 100 / 250 ms bulk timeouts (AudioMotorOptions), not transfer_timeout.
+  bool reset_audio_at_open = false;
 };
 
 /// @brief Counters of the motor's control transfers (STYLE rule 16).
@@ -100,21 +105,26 @@ struct MotorStats {
   std::uint64_t polls = 0;        ///< state reads made by wait_until_still
 };
 
-/// @brief The open motor/LED/accelerometer function of one 1414 Kinect.
+class AudioMotor;  // kinect_audio.hpp: the 1473/K4W backend
+
+/// @brief The open motor/LED/accelerometer function of one Kinect: the 0x02B0 function of a 1414,
+/// or the running audio firmware of a 1473 / K4W (AudioMotor backend).
 /// @note Belongs to the transport's thread, like the transport. Not copyable or movable. Never
 /// allocates after open().
 class KinectMotor {
  public:
   /// @brief Finds the PID 0x02B0 sibling of @p camera (same parent hub; else the only one on the
-  /// same bus; else the only one), opens it and claims interface 0.
-  /// @return USB / NOT_SUPPORTED for a 1473 or K4W camera (motor through the audio firmware is not
-  /// implemented); USB / NOT_FOUND when no motor matches; USB errors of open and claim.
+  /// same bus; else the only one), opens it and claims interface 0. For a 1473 or K4W camera, opens
+  /// the audio sibling through AudioMotor::open instead.
+  /// @return USB / NOT_SUPPORTED for a 1473 or K4W camera whose audio firmware is not running (the
+  /// message says to upload it first); USB / NOT_FOUND when no motor matches; USB errors of open
+  /// and claim.
   /// @pre @p transport outlives the motor.
   [[nodiscard]] static Result<std::unique_ptr<KinectMotor>, KinectError> open(
       UsbTransport& transport, const CameraInfo& camera, MotorOptions options = {});
   KinectMotor(const KinectMotor&) = delete;
   KinectMotor& operator=(const KinectMotor&) = delete;
-  ~KinectMotor() = default;
+  ~KinectMotor();
 
   /// @brief Asks the firmware to servo to @p degrees from the horizon (not from the base). The
   /// device resolves half degrees: the value sent is encode_tilt(degrees).
@@ -124,14 +134,19 @@ class KinectMotor {
   /// @brief Sets the LED. @pre none.
   [[nodiscard]] Result<void, KinectError> set_led(LedMode mode);
   /// @brief Reads and decodes the 10-byte state. @return BAD_REPLY / TOO_SHORT if fewer bytes came.
+  /// 1473/K4W: the 104-byte block converted by to_motor_state() (status UNKNOWN: the block has no
+  /// motion status).
   [[nodiscard]] Result<MotorState, KinectError> read_state();
   /// @brief Reads the state every poll_interval on the transport's clock, pumping the transport's
   /// events in between (handle_events, never a busy loop), until the status is not MOVING.
   /// @return that state (STOPPED, AT_LIMIT or UNKNOWN: the caller judges); USB / TIMEOUT if it
   /// was still moving after @p timeout; the first failed read's error.
+  /// 1473/K4W (no status in the block): "still" is inferred as reading the whole-degree angle last
+  /// sent by set_tilt; that state is returned with status STOPPED (status_raw 0). A head held back
+  /// from its target therefore times out. Before any set_tilt the first reading is returned.
   [[nodiscard]] Result<MotorState, KinectError> wait_until_still(UsbTimeout timeout);
 
-  /// @brief The motor function opened. @pre none.
+  /// @brief The motor function opened (the audio function on a 1473 / K4W). @pre none.
   [[nodiscard]] const UsbDeviceInfo& info() const noexcept { return info_; }
   /// @brief The counters so far. @pre none.
   [[nodiscard]] const MotorStats& stats() const noexcept { return stats_; }
@@ -139,6 +154,9 @@ class KinectMotor {
  private:
   KinectMotor(UsbTransport& transport, UsbDeviceHandle handle, const UsbDeviceInfo& info,
               MotorOptions options) noexcept;
+  KinectMotor(UsbTransport& transport, std::unique_ptr<AudioMotor> audio,
+              MotorOptions options) noexcept;
+  void count(const KinectError* failure) noexcept;
   [[nodiscard]] Result<std::size_t, KinectError> transfer(const UsbControlSetup& setup,
                                                           std::span<std::byte> data);
 
@@ -147,6 +165,8 @@ class KinectMotor {
   UsbDeviceInfo info_;
   MotorOptions options_;
   MotorStats stats_{};
+  std::unique_ptr<AudioMotor> audio_;           // set for 1473 / K4W
+  std::optional<std::int32_t> audio_target_{};  // the last tilt sent to the audio backend
 };
 
 }  // namespace orthoflow::drivers::kinect

@@ -1,11 +1,12 @@
 #pragma once
 /// @file
-/// @brief SimKinectDevice: one simulated Kinect v1 (camera, 1414 motor, audio stub) implementing
-/// the documented protocol of specs/KINECT_V1.md (sections 1, 2, 4, 5, 6, 7, 11) on simulated time,
-/// for testing the driver on a machine without USB. It is transport-independent: a host
-/// (SimUsbTransport, or later a libusb-compatible shim) routes control requests and iso microframes
-/// to it and owns bus addresses, claims and kernel-driver state. It has never been compared with a
-/// real Kinect: it is exactly as right as the brief it implements.
+/// @brief SimKinectDevice: one simulated Kinect v1 (camera, 1414 motor, audio bootloader and
+/// firmware) implementing the documented protocol of specs/KINECT_V1.md (sections 1, 2, 4, 5, 6,
+/// 7, 11, 12) on simulated time, for testing the driver on a machine without USB. It is
+/// transport-independent: a host (SimUsbTransport, or later a libusb-compatible shim) routes
+/// control requests, bulk transfers and iso microframes to it and owns bus addresses, claims and
+/// kernel-driver state. It has never been compared with a real Kinect: it is exactly as right as
+/// the brief it implements.
 ///
 /// Camera (EP0): "GM" commands as OUT 0x40/0/0/0, "RB" replies read with IN 0xC0/0/0/0 (0 bytes
 /// while no reply is pending). Opcodes 0x02 GET_PARAM, 0x03 SET_PARAM, 0x04 GET_FIXED_PARAMS,
@@ -16,7 +17,22 @@
 /// else starts nothing), reg 0x05 <- 1 Bayer, <- 3 IR 640x488 on 0x81; 0 stops. The first frame
 /// starts in the microframe after the write. Mirror registers (0x17, 0x47, 0x48) are stored only.
 /// Motor (1414 only): tilt 0x40/0x31, LED 0x40/0x06, state 0xC0/0x32 (10 bytes), probe 0xC0/0x10.
-/// Audio: enumerates (0x02AD; 0x02BE on K4W) and refuses every request (firmware not simulated).
+/// Audio (0x02AD; 0x02BE on K4W; KINECT_V1.md 12), bulk 0x01 OUT / 0x81 IN, no control requests:
+/// - bootloader state (1 interface): 24-byte commands (magic 0x06022009; a malformed one is refused
+///   with PIPE). Write (cmd 3): bytes 1..0x4000, then bulk OUT data writes of 1..512 bytes (longer
+///   ones, or more than announced: PIPE), then the 12-byte status (magic 0x0A6FE000, tag echo).
+///   A nonzero status answers a tag that is not the previous + 1 (the first may be anything), a
+///   bad length, an address that does not continue from base_addr, a first chunk whose header
+///   (0xCA77F00D, base_addr = the write's address) is wrong, and the fault chunk. Accepted chunks
+///   are kept (audio_image()). Execute (cmd 4, bytes 0, addr = entry_addr, after exactly `size`
+///   bytes): status 0, then the function disconnects when that status is read and reappears after
+///   audio_reenumerate_delay_ns with the same serial, a new address and 2 interfaces.
+/// - running state: 20-byte commands LED (cmd 0x10, arg2 1..4), tilt (0x803B, signed degrees,
+///   clamped to +-31 by the simulated firmware, slewing like the 1414 motor), state (0x8032, arg1
+///   0x68, 16 bytes are enough): the 104-byte block (int32 x, y, z at 16, 20, 24 from the same
+///   gravity model as the 1414, 819 counts/g; int32 degrees at 28), then the status. An unknown
+///   command or argument gets status 1.
+/// - an IN with nothing to send times out; unplug / replug returns it to the bootloader.
 /// Thread safety: none; one host thread drives it. Determinism: given the call sequence and times,
 /// every byte is a function of the config (its seed and sources).
 #include <array>
@@ -70,6 +86,11 @@ struct SimKinectFaults {
   std::optional<std::int64_t> disconnect_at_ns{};  ///< unplug: NO_DEVICE, gone from enumerate
   std::optional<std::int64_t> reconnect_at_ns{};   ///< replug (after disconnect) at new addresses
   std::optional<std::int64_t> cancel_at_ns{};      ///< in-flight iso transfers come back CANCELLED
+  std::optional<std::uint32_t> audio_bad_status_chunk{};  ///< this write (0-based) gets status 5
+  std::uint32_t audio_bulk_stalls = 0;    ///< the next N audio bulk transfers time out (no effect)
+  bool audio_no_reenumeration = false;    ///< after execute the audio function never comes back
+  bool audio_back_as_bootloader = false;  ///< it comes back, still with 1 interface
+  bool audio_wrong_tag_once = false;      ///< the next audio status carries tag + 1
 };
 
 /// @brief Device calibration answered by opcodes 0x04 and 0x16 (not real calibration data).
@@ -95,7 +116,9 @@ struct SimKinectConfig {
   SimIrSource ir_source{};        ///< empty: an intensity falling with depth squared
   std::uint64_t scene_seed = 42;
   double motor_slew_deg_per_s = 15.0;
-  std::uint64_t fault_seed = 1;  ///< seeds the core::Rng of every random fault
+  std::int64_t audio_reenumerate_delay_ns = 1'500'000'000;  ///< execute -> reappearance
+  bool audio_firmware_running = false;  ///< start (and replug) with the firmware already running
+  std::uint64_t fault_seed = 1;         ///< seeds the core::Rng of every random fault
   SimKinectFaults faults{};
 };
 
@@ -104,6 +127,18 @@ enum class SimControlOutcome : std::uint8_t { OK, PIPE, TIMEOUT };
 struct SimControlReply {
   SimControlOutcome outcome = SimControlOutcome::OK;
   std::size_t bytes = 0;  ///< bytes moved (IN: written to the buffer)
+};
+
+/// @brief The audio function's state (KINECT_V1.md 12.1).
+enum class SimAudioState : std::uint8_t { BOOTLOADER, GONE, RUNNING };
+
+/// @brief One audio command as the simulated device received it (bootloader or firmware).
+struct SimAudioCommand {
+  std::uint32_t tag = 0;
+  std::uint32_t cmd = 0;
+  std::uint32_t word2 = 0;   ///< bootloader: bytes; firmware: arg1
+  std::uint32_t word4 = 0;   ///< bootloader: addr; firmware: arg2 (0 if not sent)
+  std::uint32_t status = 0;  ///< the status answered
 };
 
 /// @brief One simulated Kinect: identity, EP0 protocols, iso microframes, motor.
@@ -132,6 +167,35 @@ class SimKinectDevice {
   /// payload or the IN buffer (wLength = data.size()).
   SimControlReply control(KinectFunction function, const drivers::UsbControlSetup& setup,
                           std::span<std::byte> data, std::int64_t now_ns) noexcept;
+  /// @brief A bulk transfer to @p function's @p endpoint at @p now_ns (audio only: 0x01, 0x81).
+  /// @p data is the OUT payload or the IN buffer. TIMEOUT: nothing to send, or a stall fault.
+  SimControlReply bulk(KinectFunction function, std::uint8_t endpoint, std::span<std::byte> data,
+                       std::int64_t now_ns) noexcept;
+  /// @brief False while the audio function is away re-enumerating (and forever without
+  /// re-enumeration). Every other function is present when the Kinect is.
+  [[nodiscard]] bool present(KinectFunction function, std::int64_t now_ns) const noexcept;
+  /// @brief Bumped when the audio function disconnects to re-enumerate: handles opened before are
+  /// dead, and the host assigns a new address (set_audio_address) once it is back.
+  [[nodiscard]] std::uint32_t audio_generation() const noexcept { return audio_.generation; }
+  void set_audio_address(std::uint8_t address) noexcept { audio_.address = address; }
+  [[nodiscard]] SimAudioState audio_state(std::int64_t now_ns) const noexcept;
+  /// @brief Bootloader and firmware back at power-on (unplug / replug).
+  void audio_power_on() noexcept;
+  /// @brief The image bytes accepted so far, from base_addr on.
+  [[nodiscard]] const std::vector<std::uint8_t>& audio_image() const noexcept {
+    return audio_.image;
+  }
+  /// @brief Every audio command received, in order (bootloader, then firmware).
+  [[nodiscard]] const std::vector<SimAudioCommand>& audio_commands() const noexcept {
+    return audio_.commands;
+  }
+  /// @brief The length of every bootloader data write (bulk OUT after a write command), in order.
+  [[nodiscard]] const std::vector<std::size_t>& audio_data_writes() const noexcept {
+    return audio_.data_writes;
+  }
+  /// @brief The LED code last set on the running audio firmware (1 off .. 4 red; 0 never set).
+  [[nodiscard]] std::uint32_t audio_led() const noexcept { return audio_.led; }
+
   /// @brief The camera's packet in microframe @p microframe on @p endpoint (0x81 / 0x82) into @p
   /// out; returns its length (0 = idle). Call per endpoint with increasing microframes.
   /// @pre out.size() >= KINECT_ISO_MAX_PACKET_BYTES.
@@ -183,6 +247,40 @@ class SimKinectDevice {
     std::uint8_t led = 0;
   };
 
+  struct Audio {
+    enum class Phase : std::uint8_t { IDLE, DATA, STATUS, BLOCK };
+    Phase phase = Phase::IDLE;
+    bool running = false;
+    bool tag_seen = false;
+    std::uint32_t last_tag = 0;
+    std::uint32_t tag = 0;  // of the command being answered
+    std::uint32_t status = 0;
+    std::uint32_t cmd = 0;
+    std::uint32_t chunk_addr = 0;
+    std::size_t data_left = 0;
+    std::size_t chunks = 0;  // write commands received
+    bool have_header = false;
+    std::uint32_t base_addr = 0;
+    std::uint32_t size = 0;
+    std::uint32_t entry_addr = 0;
+    bool execute_pending = false;
+    std::optional<std::int64_t> gone_ns{};
+    std::optional<std::int64_t> back_ns{};  // nullopt while gone: never
+    std::uint32_t generation = 0;
+    std::optional<std::uint8_t> address{};
+    std::uint32_t led = 0;
+    std::array<std::byte, 104> block{};
+    std::vector<std::uint8_t> chunk;
+    std::vector<std::uint8_t> image;
+    std::vector<SimAudioCommand> commands;
+    std::vector<std::size_t> data_writes;
+  };
+
+  SimControlReply audio_out(std::span<const std::byte> data, std::int64_t now_ns) noexcept;
+  SimControlReply audio_in(std::span<std::byte> data, std::int64_t now_ns) noexcept;
+  void bootloader_command(std::span<const std::byte> data) noexcept;
+  void bootloader_chunk_done() noexcept;
+  void firmware_command(std::span<const std::byte> data, std::int64_t now_ns) noexcept;
   SimControlReply camera_control(const drivers::UsbControlSetup& setup, std::span<std::byte> data,
                                  std::int64_t now_ns) noexcept;
   SimControlReply read_reply(std::span<std::byte> data) noexcept;
@@ -218,6 +316,7 @@ class SimKinectDevice {
   std::vector<std::uint8_t> scene_bayer_;
   std::vector<std::uint16_t> scene_ir_;
   Motor motor_{};
+  Audio audio_{};
 };
 
 }  // namespace orthoflow::simulation

@@ -131,6 +131,8 @@ void SimUsbTransport::unplug(std::size_t index) {
   slot.present = false;
   slot.claimed_by = {};
   slot.device->power_cycle();
+  slot.device->audio_power_on();
+  slot.audio_generation = slot.device->audio_generation();
 }
 
 void SimUsbTransport::replug(std::size_t index) {
@@ -143,6 +145,8 @@ void SimUsbTransport::replug(std::size_t index) {
   slot.gspca_bound = true;  // the kernel binds gspca_kinect again at plug-in
   slot.claimed_by = {};
   slot.device->power_cycle();
+  slot.device->audio_power_on();
+  slot.audio_generation = slot.device->audio_generation();
   assign_addresses(slot);
 }
 

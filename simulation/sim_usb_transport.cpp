@@ -52,10 +52,25 @@ void SimUsbTransport::assign_addresses(Slot& slot) {
   next = static_cast<std::uint8_t>(next + 4);
 }
 
+void SimUsbTransport::refresh_audio(Slot& slot) {
+  SimKinectDevice& d = *slot.device;
+  if (!slot.present || d.audio_generation() == slot.audio_generation ||
+      !d.present(KinectFunction::AUDIO, clock_->now_ns()))
+    return;
+  // Back from a re-enumeration: a new address, and the old claim is gone with the old device.
+  std::uint8_t& next = next_address_[d.config().bus];
+  OF_ENFORCE(next <= 125, "SimUsbTransport: the simulated bus ran out of addresses");
+  d.set_audio_address(next);
+  next = static_cast<std::uint8_t>(next + 1);
+  slot.audio_generation = d.audio_generation();
+  slot.claimed_by[function_index(KinectFunction::AUDIO)] = 0;
+}
+
 std::size_t SimUsbTransport::add_kinect(SimKinectConfig config) {
   enforce_not_in_callback();
   auto slot = std::make_unique<Slot>();
   slot->device = std::make_unique<SimKinectDevice>(std::move(config));
+  slot->audio_generation = slot->device->audio_generation();
   assign_addresses(*slot);
   slots_.push_back(std::move(slot));
   return slots_.size() - 1;
@@ -78,8 +93,9 @@ Result<std::vector<drivers::UsbDeviceInfo>, UsbError> SimUsbTransport::enumerate
   std::vector<drivers::UsbDeviceInfo> found;
   for (const auto& slot : slots_) {
     if (!slot->present) continue;
+    refresh_audio(*slot);
     for (const KinectFunction f : FUNCTIONS) {
-      if (!slot->device->has_function(f)) continue;
+      if (!slot->device->present(f, clock_->now_ns())) continue;
       const drivers::UsbDeviceInfo info = slot->device->info(f);
       if (info.vendor == vendor && (!product || info.product == *product)) found.push_back(info);
     }
@@ -92,10 +108,11 @@ Result<drivers::UsbDeviceHandle, UsbError> SimUsbTransport::open(
   enforce_not_in_callback();
   run_until(clock_->now_ns());
   for (std::size_t k = 0; k < slots_.size(); ++k) {
-    const Slot& slot = *slots_[k];
+    Slot& slot = *slots_[k];
     if (!slot.present) continue;
+    refresh_audio(slot);
     for (const KinectFunction f : FUNCTIONS) {
-      if (!slot.device->has_function(f)) continue;
+      if (!slot.device->present(f, clock_->now_ns())) continue;
       const drivers::UsbDeviceInfo info = slot.device->info(f);
       if (info.bus != device.bus || info.address != device.address ||
           info.vendor != device.vendor || info.product != device.product)
@@ -105,6 +122,7 @@ Result<drivers::UsbDeviceHandle, UsbError> SimUsbTransport::open(
       h->kinect = k;
       h->function = f;
       h->epoch = slot.epoch;
+      h->audio_generation = slot.device->audio_generation();
       handles_.push_back(std::move(h));
       return make_handle(handles_.back()->id);
     }
@@ -122,6 +140,10 @@ Result<SimUsbTransport::Handle*, UsbError> SimUsbTransport::lookup(
   Handle* h = it->get();
   const Slot& slot = *slots_[h->kinect];
   if (need_device && (!slot.present || slot.epoch != h->epoch))
+    return refused(UsbError::Code::NO_DEVICE, operation);
+  if (need_device && h->function == KinectFunction::AUDIO &&
+      (h->audio_generation != slot.device->audio_generation() ||
+       !slot.device->present(KinectFunction::AUDIO, clock_->now_ns())))
     return refused(UsbError::Code::NO_DEVICE, operation);
   return h;
 }
@@ -235,8 +257,10 @@ Result<void, UsbError> SimUsbTransport::clear_halt(const drivers::UsbDeviceHandl
   if (!h_result) return orthoflow::err(h_result.error());
   const Handle& h = **h_result;
   const bool exists =
-      endpoint == 0 || (h.function == KinectFunction::CAMERA &&
-                        (endpoint == KINECT_VIDEO_ENDPOINT || endpoint == KINECT_DEPTH_ENDPOINT));
+      endpoint == 0 ||
+      (h.function == KinectFunction::CAMERA &&
+       (endpoint == KINECT_VIDEO_ENDPOINT || endpoint == KINECT_DEPTH_ENDPOINT)) ||
+      (h.function == KinectFunction::AUDIO && (endpoint == 0x01 || endpoint == 0x81));
   if (!exists) return refused(UsbError::Code::NOT_FOUND, "clear_halt");
   if (find_stream(h.id, endpoint) != nullptr) return refused(UsbError::Code::BUSY, "clear_halt");
   return {};
@@ -273,15 +297,27 @@ Result<std::size_t, UsbError> SimUsbTransport::control(const drivers::UsbDeviceH
 Result<std::size_t, UsbError> SimUsbTransport::bulk(const drivers::UsbDeviceHandle& handle,
                                                     std::uint8_t endpoint,
                                                     std::span<std::byte> data,
-                                                    drivers::UsbTimeout) {
+                                                    drivers::UsbTimeout timeout) {
   auto h_result = lookup(handle, "bulk", true);
   if (!h_result) return orthoflow::err(h_result.error());
   if (data.size() > INT_MAX) return refused(UsbError::Code::INVALID_PARAM, "bulk");
-  const Handle& h = **h_result;
+  const Handle h = **h_result;
   const bool audio_bulk =
       h.function == KinectFunction::AUDIO && (endpoint == 0x01 || endpoint == 0x81);
   if (!audio_bulk || !h.claimed) return refused(UsbError::Code::NOT_FOUND, "bulk");
-  return refused(UsbError::Code::NOT_SUPPORTED, "bulk");
+  run_until(clock_->now_ns());
+  sync_streams(clock_->now_ns());
+  Slot& slot = *slots_[h.kinect];
+  const SimControlReply reply = slot.device->bulk(h.function, endpoint, data, clock_->now_ns());
+  if (reply.outcome == SimControlOutcome::TIMEOUT) {
+    const auto wait = timeout.count() == 0 ? config_.infinite_wait : timeout;
+    run_until(clock_->now_ns() + std::chrono::nanoseconds(wait).count());
+    return refused(UsbError::Code::TIMEOUT, "bulk");
+  }
+  run_until(clock_->now_ns() + config_.control_latency.count());
+  if (!slot.present || slot.epoch != h.epoch) return refused(UsbError::Code::NO_DEVICE, "bulk");
+  if (reply.outcome == SimControlOutcome::PIPE) return refused(UsbError::Code::PIPE, "bulk");
+  return reply.bytes;
 }
 
 Result<std::size_t, UsbError> SimUsbTransport::interrupt(const drivers::UsbDeviceHandle& handle,

@@ -28,8 +28,12 @@
 /// - start_iso: NOT_FOUND for an endpoint the function lacks, an unclaimed interface, or a K4W
 ///   camera not in alternate setting 1; BUSY if any handle streams that endpoint;
 /// - detach_kernel_driver: NOT_FOUND if none is attached; attach: BUSY if attached or claimed;
-/// - bulk: NOT_SUPPORTED on the audio endpoints (firmware not simulated), else NOT_FOUND;
-///   interrupt: NOT_FOUND;
+/// - bulk: only the audio function's 0x01 / 0x81 on a claimed interface (else NOT_FOUND); it takes
+///   control_latency; the device's TIMEOUT (an IN with nothing to send, a stall fault) waits the
+///   whole timeout; interrupt: NOT_FOUND;
+/// - the audio function re-enumerates on its own after a firmware execute (sim_kinect_device.hpp):
+///   while away it is not enumerated and its handles answer NO_DEVICE; it comes back at a new
+///   address (handed out when first seen by enumerate / open);
 /// - a handle of a device that was unplugged answers NO_DEVICE, even after the Kinect is back
 ///   (at new addresses: enumerate and open again); stop_iso, iso_stats and close still work on it.
 /// Threading: one thread, like every UsbTransport. Determinism: same calls, same bytes and times.
@@ -140,6 +144,7 @@ class SimUsbTransport final : public drivers::UsbTransport {
   [[nodiscard]] bool streaming(const Handle& h) const noexcept;
   [[nodiscard]] Stream* find_stream(std::uint32_t handle_id, std::uint8_t endpoint) const noexcept;
   void assign_addresses(Slot& slot);
+  void refresh_audio(Slot& slot);
   void run_until(std::int64_t target_ns);
   [[nodiscard]] std::int64_t next_event_ns() const noexcept;
   bool run_next_event(std::int64_t limit_ns);

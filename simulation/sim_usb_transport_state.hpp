@@ -21,6 +21,7 @@ struct SimUsbTransport::Slot {
   bool disconnect_done = false;
   bool reconnect_done = false;
   bool cancel_done = false;
+  std::uint32_t audio_generation = 0;  // of the audio function's last address assignment
 };
 
 struct SimUsbTransport::Handle {
@@ -31,6 +32,7 @@ struct SimUsbTransport::Handle {
   bool claimed = false;
   bool detached = false;  // this handle detached the kernel driver: re-attach on close
   std::uint8_t alt = 0;
+  std::uint32_t audio_generation = 0;  // audio handles die when the function re-enumerates
 };
 
 struct SimUsbTransport::Stream {

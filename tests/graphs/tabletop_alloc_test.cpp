@@ -97,8 +97,9 @@ TEST(TabletopAllocations, KinectSourceSteadyStateAllocatesNothingPerFrame) {
   ASSERT_TRUE(json);
   SessionLog log(std::move(*json));
   const auto registry = make_tabletop_registry(*learning, log, nullptr);
-  auto spec = test::tabletop_spec({{"source", {{"kind", "kinect_source"}, {"device", "sim"}}},
-                                   {"recognise", {{"instructor", "0"}}}});
+  auto spec = test::tabletop_spec(
+      {{"source", {{"kind", "kinect_source"}, {"device", "sim"}, {"wait_ms", "3000"}}},
+       {"recognise", {{"instructor", "0"}}}});
   auto graph = engine::build_graph(spec, registry);
   ASSERT_TRUE(graph) << engine::to_string(graph.error());
   engine::Engine engine(**graph, {2});

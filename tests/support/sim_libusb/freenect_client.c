@@ -3,7 +3,8 @@
  * the simulator. Linked against libfreenect (which links libusb-1.0); run with LD_LIBRARY_PATH
  * pointing at the sim_libusb shim, it talks to the simulated Kinect.
  *
- * usage: freenect_client 11bit|mm FRAMES OUTDIR
+ * usage: freenect_client 11bit|mm|registered FRAMES OUTDIR
+ * (registered: FREENECT_DEPTH_REGISTERED, millimetres re-projected into the RGB image)
  * writes OUTDIR/<mode>-<i>.raw (640 x 480 host-order u16, i from 0), OUTDIR/<mode>-index.txt (one
  * "<i> <timestamp>" line per frame) and OUTDIR/devices.txt ("count <n>" and one "serial <s>" line
  * per device libfreenect lists). Exit status 0 only if FRAMES frames arrived within 20 s.
@@ -99,16 +100,19 @@ static int list_devices(freenect_context* ctx) {
 }
 
 int main(int argc, char** argv) {
-  if (argc != 4 || (strcmp(argv[1], "11bit") != 0 && strcmp(argv[1], "mm") != 0)) {
-    fprintf(stderr, "usage: freenect_client 11bit|mm FRAMES OUTDIR\n");
+  if (argc != 4 || (strcmp(argv[1], "11bit") != 0 && strcmp(argv[1], "mm") != 0 &&
+                    strcmp(argv[1], "registered") != 0)) {
+    fprintf(stderr, "usage: freenect_client 11bit|mm|registered FRAMES OUTDIR\n");
     return 2;
   }
   g_mode_name = argv[1];
   g_wanted = atoi(argv[2]);
   g_outdir = argv[3];
   g_stream = strcmp(g_outdir, "-") == 0;
-  const freenect_depth_format format =
-      strcmp(argv[1], "mm") == 0 ? FREENECT_DEPTH_MM : FREENECT_DEPTH_11BIT;
+  const freenect_depth_format format = strcmp(argv[1], "mm") == 0 ? FREENECT_DEPTH_MM
+                                       : strcmp(argv[1], "registered") == 0
+                                           ? FREENECT_DEPTH_REGISTERED
+                                           : FREENECT_DEPTH_11BIT;
 
   char path[4096];
   snprintf(path, sizeof path, "%s/%s-index.txt", g_outdir, g_mode_name);
