@@ -105,6 +105,9 @@ struct Engine::Impl {
       rt->stats = &stats.nodes.emplace_back();
       rt->stats->name = gr.spec.nodes[i].name;
       rt->stats->sink = rt->node->outputs().empty();
+      rt->stats->device = [node = rt->node](std::span<DeviceCounter> out) {
+        return node->device_counters(out);
+      };
       rt->policy = gr.spec.nodes[i].policy;
       rt->deadline_ns =
           gr.spec.nodes[i].deadline_ns > 0 ? gr.spec.nodes[i].deadline_ns : gr.spec.period_ns;

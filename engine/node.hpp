@@ -6,6 +6,7 @@
 #include <string_view>
 
 #include "engine/message.hpp"
+#include "engine/telemetry.hpp"
 #include "memory_pool/block_pool.hpp"
 
 namespace orthoflow::engine {
@@ -63,6 +64,13 @@ class Node {
   /// @brief Sources only: fills the next frame's payload/value (the engine sets id and stamp).
   /// @pre inputs().empty(). Called serially.
   virtual SourceStatus produce(Message& /*out*/) noexcept { return SourceStatus::END; }
+  /// @brief Nodes in front of a device (a camera) report its counters into @p out (at most
+  /// out.size()); the telemetry shows them under the node. @return how many. @note Any thread, at
+  /// any time while the graph lives: read snapshots, never block.
+  [[nodiscard]] virtual std::size_t device_counters(std::span<DeviceCounter> out) const noexcept {
+    (void)out;
+    return 0;
+  }
 };
 
 }  // namespace orthoflow::engine

@@ -1,5 +1,7 @@
 #include "engine/telemetry.hpp"
 
+#include <algorithm>
+#include <array>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
@@ -57,6 +59,16 @@ std::string format_table(const GraphStats& stats) {
   table += row("[graph " + stats.name + "]", stats.frame_latency, stats.frames_done.load(),
                per_second(stats.frames_done.load(), elapsed), stats.total_drops(),
                stats.deadline_misses.load(), nullptr);
+  for (const auto& n : stats.nodes) {
+    std::array<DeviceCounter, MAX_DEVICE_COUNTERS> counters{};
+    const std::size_t k = n.device ? std::min(n.device(counters), counters.size()) : 0;
+    if (k == 0) continue;
+    table += n.name + " device:";
+    for (std::size_t i = 0; i < k; ++i)
+      table += std::string(i == 0 ? " " : ", ") + counters[i].name + " " +
+               std::to_string(counters[i].value);
+    table += '\n';
+  }
   return table;
 }
 
@@ -73,6 +85,13 @@ std::string to_json(const GraphStats& stats) {
                            {"max_concurrency", n.max_running.load()},
                            {"latency", histogram_json(n.service)}};
     if (n.sink) node["frame_age"] = histogram_json(n.age);
+    std::array<DeviceCounter, MAX_DEVICE_COUNTERS> counters{};
+    const std::size_t k = n.device ? std::min(n.device(counters), counters.size()) : 0;
+    if (k > 0) {
+      nlohmann::json device = nlohmann::json::object();
+      for (std::size_t i = 0; i < k; ++i) device[counters[i].name] = counters[i].value;
+      node["device"] = std::move(device);
+    }
     nodes.push_back(std::move(node));
   }
   nlohmann::json graph = {{"name", stats.name},

@@ -5,11 +5,23 @@
 #include <atomic>
 #include <cstdint>
 #include <deque>
+#include <functional>
+#include <span>
 #include <string>
 
 #include "engine/histogram.hpp"
 
 namespace orthoflow::engine {
+
+/// @brief One named counter a node reports about the device behind it (a camera's lost packets,
+/// resyncs, reopens...): the device's own account beside the graph's counters. @p name is a string
+/// with static storage.
+struct DeviceCounter {
+  const char* name = "";
+  std::uint64_t value = 0;
+};
+/// @brief Most device counters one node reports.
+inline constexpr std::size_t MAX_DEVICE_COUNTERS = 24;
 
 /// @brief Counters of one node. All fields are atomics written with relaxed ordering.
 struct NodeStats {
@@ -23,6 +35,9 @@ struct NodeStats {
   std::atomic<std::uint64_t> deadline_misses{0};  ///< process() took longer than the node deadline
   std::atomic<std::uint32_t> running{0};          ///< process() calls in progress right now
   std::atomic<std::uint32_t> max_running{0};      ///< most process() calls ever seen at once
+  /// Reads the node's device counters into the span, returns how many (set at start-up for every
+  /// node; empty in hand-made stats). Any thread, while the graph lives.
+  std::function<std::size_t(std::span<DeviceCounter>)> device;
 };
 
 /// @brief Whole-graph counters plus one NodeStats per node (stable addresses: a deque).

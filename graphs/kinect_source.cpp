@@ -1,8 +1,8 @@
 #include "graphs/kinect_source.hpp"
 
+#include <algorithm>
 #include <chrono>
-#include <cstdio>
-#include <string>
+#include <iterator>
 #include <thread>
 
 #include "drivers/kinect_depth.hpp"
@@ -34,24 +34,33 @@ class KinectSource final : public FrameSource {
     camera_ = kinect::depth_camera(device_->calibration());
     cloud_.resize(kinect::DEPTH_WIDTH, kinect::DEPTH_HEIGHT);
   }
-  ~KinectSource() override {
-    // The driver's own account of the run (telemetry counts the graph's side: source drops).
+  std::size_t device_counters(std::span<engine::DeviceCounter> out) const noexcept override {
+    // The driver's own account (KinectCamera::health(), a spin-locked snapshot).
     const kinect::CameraHealth h = device_->health();
-    std::fprintf(stderr,
-                 "kinect_source: camera %s %s: %llu frames delivered (%llu degraded, %llu dropped, "
-                 "%llu not taken), lost packets %llu, resyncs %llu, watchdog restarts %llu, "
-                 "unplugs %llu, reopens %llu\n",
-                 kinect::to_string(device_->info().model),
-                 std::string(device_->info().serial.view()).c_str(),
-                 static_cast<unsigned long long>(h.frames_delivered),
-                 static_cast<unsigned long long>(h.frames_degraded),
-                 static_cast<unsigned long long>(h.frames_dropped),
-                 static_cast<unsigned long long>(h.frames_overwritten),
-                 static_cast<unsigned long long>(h.depth.lost_packets),
-                 static_cast<unsigned long long>(h.depth.resyncs),
-                 static_cast<unsigned long long>(h.watchdog_restarts),
-                 static_cast<unsigned long long>(h.unplugs),
-                 static_cast<unsigned long long>(h.reopens));
+    const engine::DeviceCounter all[] = {
+        {"frames_delivered", h.frames_delivered},
+        {"frames_degraded", h.frames_degraded},
+        {"frames_dropped", h.frames_dropped},
+        {"frames_not_taken", h.frames_overwritten},
+        {"frames_abandoned", h.depth.frames_abandoned},
+        {"packets", h.depth.packets},
+        {"lost_packets", h.depth.lost_packets},
+        {"late_packets", h.depth.late_packets},
+        {"duplicate_packets", h.depth.duplicates},
+        {"bad_packets", h.depth.bad_magic + h.depth.short_header + h.depth.bad_size_field +
+                            h.depth.wrong_stream + h.depth.oversize},
+        {"resyncs", h.depth.resyncs},
+        {"iso_errors", h.iso_errors},
+        {"control_retries", h.control.retries},
+        {"control_timeouts", h.control.timeouts},
+        {"watchdog_restarts", h.watchdog_restarts},
+        {"unplugs", h.unplugs},
+        {"reopens", h.reopens},
+        {"streaming", h.streaming ? 1U : 0U},
+        {"device_lost", h.device_lost ? 1U : 0U}};
+    const std::size_t k = std::min(out.size(), std::size(all));
+    std::copy_n(all, k, out.begin());
+    return k;
   }
   engine::SourceStatus produce(Message& out) noexcept override {
     const kinect::DepthFrame* frame = device_->latest_depth();

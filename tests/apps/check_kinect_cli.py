@@ -55,8 +55,17 @@ p = run(cli, "kinect", "led", "red", "--sim", "--serial", "NOPE", code=1)
 expect("no camera with serial NOPE" in p.stderr, f"led --serial: {p.stderr}")
 
 # The tabletop graph fed by the simulated camera through the driver: 30 frames, tables found.
-p = run(cli, "run", "--source", "kinect-sim", "--frames", "30", "--threads", "1")
+import os
+import tempfile
+tele = os.path.join(tempfile.mkdtemp(), "telemetry.json")
+p = run(cli, "run", "--source", "kinect-sim", "--frames", "30", "--threads", "1",
+        "--telemetry-json", tele)
 expect("30 processed" in p.stdout and "30 with a table" in p.stdout, f"run: {p.stdout}")
+# The driver's own counters, in the table and in the telemetry, under the source node.
+expect("source device: frames_delivered " in p.stdout, f"run: no device line: {p.stdout}")
+device = json.load(open(tele))["nodes"][0]["device"]
+expect(device["frames_delivered"] >= 30 and device["lost_packets"] == 0 and device["streaming"] == 1,
+       f"telemetry device counters: {device}")
 p = run(cli, "run", "--source", "kinect-sim:abc", "--frames", "3", code=None)
 expect(p.returncode != 0 and "sim_seed" in p.stderr, f"run kinect-sim:abc: {p.stderr}")
 print("ok")

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <span>
 #include <thread>
 #include <vector>
 
@@ -86,6 +87,32 @@ TEST(Telemetry, TableAndJsonCarryTheCounters) {
   const std::string table = format_table(stats);
   EXPECT_NE(table.find("worker"), std::string::npos);
   EXPECT_NE(table.find("p99.9"), std::string::npos);
+  EXPECT_EQ(table.find("device:"), std::string::npos);  // no device behind this node
+  EXPECT_FALSE(json["nodes"][0].contains("device"));
+}
+
+TEST(Telemetry, DeviceCountersAppearUnderTheirNode) {
+  GraphStats stats;
+  stats.name = "g";
+  auto& node = stats.nodes.emplace_back();
+  node.name = "source";
+  std::uint64_t lost = 7;
+  node.device = [&lost](std::span<DeviceCounter> out) {
+    const DeviceCounter all[] = {{"lost_packets", lost}, {"reopens", 1}};
+    std::size_t k = 0;
+    for (const auto& c : all) {
+      if (k < out.size()) out[k++] = c;
+    }
+    return k;
+  };
+  auto json = nlohmann::json::parse(to_json(stats));
+  EXPECT_EQ(json["nodes"][0]["device"]["lost_packets"], 7);
+  EXPECT_EQ(json["nodes"][0]["device"]["reopens"], 1);
+  lost = 9;  // read at export time: a live count
+  json = nlohmann::json::parse(to_json(stats));
+  EXPECT_EQ(json["nodes"][0]["device"]["lost_packets"], 9);
+  EXPECT_NE(format_table(stats).find("source device: lost_packets 9, reopens 1"),
+            std::string::npos);
 }
 
 }  // namespace
