@@ -179,8 +179,10 @@ Result<FakenectTilt, IoError> read_fakenect_tilt(const std::filesystem::path& pa
   t.accel_y = get16(2);
   t.accel_z = get16(4);
   t.tilt_half_degrees = static_cast<std::int8_t>(p[6]);
-  t.status = static_cast<std::int32_t>(static_cast<std::uint32_t>(p[8]) | (p[9] << 8) |
-                                       (p[10] << 16) | (static_cast<std::uint32_t>(p[11]) << 24));
+  const auto byte = [&](std::size_t at, unsigned shift) {
+    return static_cast<std::uint32_t>(p[at]) << shift;
+  };
+  t.status = static_cast<std::int32_t>(byte(8, 0) | byte(9, 8) | byte(10, 16) | byte(11, 24));
   return t;
 }
 
