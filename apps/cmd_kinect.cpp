@@ -157,25 +157,10 @@ void run_info(const KinectArgs& a) {
 }
 
 nlohmann::json health_json(const kinect::CameraHealth& h) {
-  return {{"frames_delivered", h.frames_delivered},
-          {"frames_whole", h.frames_delivered - h.frames_degraded},
-          {"frames_degraded", h.frames_degraded},
-          {"frames_dropped", h.frames_dropped},
-          {"frames_overwritten", h.frames_overwritten},
-          {"packets", h.depth.packets},
-          {"lost_packets", h.depth.lost_packets},
-          {"late_packets", h.depth.late_packets},
-          {"duplicates", h.depth.duplicates},
-          {"bad_packets", h.depth.bad_magic + h.depth.short_header + h.depth.bad_size_field +
-                              h.depth.wrong_stream + h.depth.oversize},
-          {"resyncs", h.depth.resyncs},
-          {"frames_abandoned", h.depth.frames_abandoned},
-          {"control_retries", h.control.retries},
-          {"watchdog_restarts", h.watchdog_restarts},
-          {"unplugs", h.unplugs},
-          {"reopens", h.reopens},
-          {"streaming", h.streaming},
-          {"device_lost", h.device_lost}};
+  nlohmann::json out = nlohmann::json::object();
+  for (const auto& c : kinect::health_counters(h)) out[c.name] = c.value;
+  out["frames_whole"] = h.frames_delivered - h.frames_degraded;
+  return out;
 }
 
 void run_stream(const KinectArgs& a) {

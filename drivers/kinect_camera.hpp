@@ -109,6 +109,17 @@ struct CameraHealth {
 void decode_depth(const AssembledFrame& frame, const StreamGeometry& geometry, DepthFormat format,
                   std::span<std::uint16_t> raw, bool scalar = false) noexcept;
 
+/// @brief One named counter of CameraHealth (name: static storage).
+struct HealthCounter {
+  const char* name = "";
+  std::uint64_t value = 0;
+};
+inline constexpr std::size_t HEALTH_COUNTERS = 19;
+/// @brief The counters of @p health that people read (CLI, telemetry), named once, here.
+/// @note Never allocates.
+[[nodiscard]] std::array<HealthCounter, HEALTH_COUNTERS> health_counters(
+    const CameraHealth& health) noexcept;
+
 /// @brief One open camera. Create with open(); not copyable or movable (callbacks point at it).
 class KinectCamera {
  public:

@@ -82,7 +82,7 @@ std::int64_t tick_gap(std::uint64_t a, std::uint64_t b) noexcept {
 
 void KinectCamera::attach_colour(DepthFrame& slot, std::size_t ring_index) noexcept {
   ColourSlot& c = colour_ring_[ring_index];
-  std::memcpy(slot.bayer.data(), c.bayer.data(), c.bayer.size());
+  slot.bayer.swap(c.bayer);  // same sizes: the ring slot, now used, takes the old buffer
   slot.has_colour = true;
   slot.colour_ticks = c.ticks;
   slot.colour_complete = c.complete;
@@ -150,6 +150,30 @@ void KinectCamera::publish_depth() noexcept {
   back_ = previous & 0x3U;
   ++local_.frames_delivered;
   local_.last_frame_host_ns = slot.host_ns;
+}
+
+std::array<HealthCounter, HEALTH_COUNTERS> health_counters(const CameraHealth& h) noexcept {
+  const AssemblerStats& d = h.depth;
+  return {{{"frames_delivered", h.frames_delivered},
+           {"frames_degraded", h.frames_degraded},
+           {"frames_dropped", h.frames_dropped},
+           {"frames_not_taken", h.frames_overwritten},
+           {"frames_abandoned", d.frames_abandoned},
+           {"packets", d.packets},
+           {"lost_packets", d.lost_packets},
+           {"late_packets", d.late_packets},
+           {"duplicate_packets", d.duplicates},
+           {"bad_packets",
+            d.bad_magic + d.short_header + d.bad_size_field + d.wrong_stream + d.oversize},
+           {"resyncs", d.resyncs},
+           {"iso_errors", h.iso_errors},
+           {"control_retries", h.control.retries},
+           {"control_timeouts", h.control.timeouts},
+           {"watchdog_restarts", h.watchdog_restarts},
+           {"unplugs", h.unplugs},
+           {"reopens", h.reopens},
+           {"streaming", h.streaming ? 1U : 0U},
+           {"device_lost", h.device_lost ? 1U : 0U}}};
 }
 
 const DepthFrame* KinectCamera::latest_depth() noexcept {

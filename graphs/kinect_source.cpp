@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <iterator>
 #include <thread>
 
 #include "drivers/kinect_depth.hpp"
@@ -36,30 +35,9 @@ class KinectSource final : public FrameSource {
   }
   std::size_t device_counters(std::span<engine::DeviceCounter> out) const noexcept override {
     // The driver's own account (KinectCamera::health(), a spin-locked snapshot).
-    const kinect::CameraHealth h = device_->health();
-    const engine::DeviceCounter all[] = {
-        {"frames_delivered", h.frames_delivered},
-        {"frames_degraded", h.frames_degraded},
-        {"frames_dropped", h.frames_dropped},
-        {"frames_not_taken", h.frames_overwritten},
-        {"frames_abandoned", h.depth.frames_abandoned},
-        {"packets", h.depth.packets},
-        {"lost_packets", h.depth.lost_packets},
-        {"late_packets", h.depth.late_packets},
-        {"duplicate_packets", h.depth.duplicates},
-        {"bad_packets", h.depth.bad_magic + h.depth.short_header + h.depth.bad_size_field +
-                            h.depth.wrong_stream + h.depth.oversize},
-        {"resyncs", h.depth.resyncs},
-        {"iso_errors", h.iso_errors},
-        {"control_retries", h.control.retries},
-        {"control_timeouts", h.control.timeouts},
-        {"watchdog_restarts", h.watchdog_restarts},
-        {"unplugs", h.unplugs},
-        {"reopens", h.reopens},
-        {"streaming", h.streaming ? 1U : 0U},
-        {"device_lost", h.device_lost ? 1U : 0U}};
-    const std::size_t k = std::min(out.size(), std::size(all));
-    std::copy_n(all, k, out.begin());
+    const auto all = kinect::health_counters(device_->health());
+    const std::size_t k = std::min(out.size(), all.size());
+    for (std::size_t i = 0; i < k; ++i) out[i] = {all[i].name, all[i].value};
     return k;
   }
   engine::SourceStatus produce(Message& out) noexcept override {
