@@ -57,4 +57,7 @@ void add_bench_command(CLI::App& app);
 void add_kinect_command(CLI::App& app);
 /// @brief `kinect record DIR`: the camera in libfreenect's fakenect format (on the kinect command).
 void add_kinect_record_command(CLI::App& kinect_command);
+/// @brief `arm list|info|state|home|retract|move|fingers|stop [--sim]`: the Kinova JACO through
+/// orthoflow's driver.
+void add_arm_command(CLI::App& app);
 }  // namespace orthoflow::apps

@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
 # usage: run_fuzzers.sh SECONDS [FUZZ_BUILD_DIR | FUZZER_BINARY]...
-# Runs libFuzzer binaries that are already built (default: every fuzz_*_reader under build/fuzz, the
-# `fuzz` preset; a directory argument means every fuzzer under it, a file argument that one fuzzer)
-# for SECONDS each, on a fresh temporary corpus seeded with the committed seeds and the small PCD files
-# of the shared data. Builds nothing. Exits non-zero on any crash, leak, timeout, OOM or sanitizer report.
-# FUZZERS="pcd" (or "ply") restricts directory arguments to some kinds; KEEP_CORPUS=DIR keeps the grown
-# corpora in DIR/<kind>.
+# Runs libFuzzer binaries that are already built (default: every fuzz_*_reader and fuzz_jaco_reply
+# under build/fuzz, the `fuzz` preset; a directory argument means every fuzzer under it, a file
+# argument that one fuzzer) for SECONDS each, on a fresh temporary corpus seeded with the committed
+# seeds and the small PCD files of the shared data. Builds nothing. Exits non-zero on any crash, leak,
+# timeout, OOM or sanitizer report. FUZZERS="pcd" (or "ply", "jaco_reply") restricts directory
+# arguments to some kinds; KEEP_CORPUS=DIR keeps the grown corpora in DIR/<kind>.
 set -euo pipefail
 if [ $# -lt 1 ]; then
   echo "usage: $0 SECONDS [FUZZ_BUILD_DIR | FUZZER_BINARY]..." >&2
@@ -19,10 +19,10 @@ shared="${ORTHOFLOW_SHARED_DIR:-$here/../../../shared}"  # the shared data besid
 fuzzers=()
 for arg in "$@"; do
   if [ -d "$arg" ]; then
-    for kind in ${FUZZERS:-pcd ply}; do
-      found=$(find "$arg" -type f -perm -u+x -name "fuzz_${kind}_reader" | head -1)
+    for kind in ${FUZZERS:-pcd ply jaco_reply}; do
+      found=$(find "$arg" -type f -perm -u+x \( -name "fuzz_${kind}_reader" -o -name "fuzz_${kind}" \) | head -1)
       if [ -z "$found" ]; then
-        echo "fuzz: fuzz_${kind}_reader not found under $arg (build the fuzz preset first)" >&2
+        echo "fuzz: fuzz_${kind}[_reader] not found under $arg (build the fuzz preset first)" >&2
         exit 1
       fi
       fuzzers+=("$found")
