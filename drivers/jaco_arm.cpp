@@ -1,5 +1,6 @@
 #include "drivers/jaco_arm.hpp"
 
+#include <algorithm>
 #include <chrono>
 
 namespace orthoflow::drivers::jaco {
@@ -26,7 +27,7 @@ JacoArm::~JacoArm() {
 void JacoArm::run() noexcept {
   const MonotonicClock& clock = transport_->clock();
   const std::int64_t clock_start = clock.now_ns();
-  const auto wall_start = std::chrono::steady_clock::now();
+  auto wall_start = std::chrono::steady_clock::now();
   std::int64_t next = clock_start;
   while (!stop_.load(std::memory_order_acquire)) {
     controller_->cycle();
@@ -43,8 +44,15 @@ void JacoArm::run() noexcept {
       (void)transport_->handle_events(UsbTimeout(std::max<std::int64_t>(left_ms, 1)));
     }
     if (options_.pace_to_wall_clock) {
-      std::this_thread::sleep_until(wall_start +
-                                    std::chrono::nanoseconds(clock.now_ns() - clock_start));
+      // Keep simulated time no faster than wall time. After a stall (the process was descheduled)
+      // move the origin instead of running cycles back to back to catch up.
+      const auto due = wall_start + std::chrono::nanoseconds(clock.now_ns() - clock_start);
+      const auto wall_now = std::chrono::steady_clock::now();
+      if (wall_now - due > std::chrono::nanoseconds(ARM_PERIOD_NS)) {
+        wall_start += wall_now - due;
+      } else {
+        std::this_thread::sleep_until(due);
+      }
     }
   }
 }

@@ -82,6 +82,8 @@ Result<void, JacoError> JacoController::start_up(const UsbDeviceInfo& device) {
   auto identity = link_->read_identity();
   if (!identity) return err(identity.error());
   identity_ = identity.value();
+  options_.limits.geometry =
+      identity_.model == Model::JACO_V1 ? &jaco_v1_geometry() : &jaco2_geometry();
   options_.limits.max_finger =
       std::min(options_.limits.max_finger, static_cast<double>(finger_closed(identity_.model)));
   // Take control, then make sure nothing latched or queued by an earlier session moves the arm.
@@ -174,31 +176,53 @@ Result<void, JacoError> JacoController::validate(const ArmCommand& command,
   }
 }
 
-Result<void, JacoError> JacoController::submit(const ArmCommand& command) {
-  std::lock_guard lock(mutex_);
-  auto ok = validate(command, published_);
-  if (!ok) {
-    ++published_.refused;
-    return ok;
-  }
+Result<ArmCommand, JacoError> JacoController::check_command(const ArmCommand& command,
+                                                            const ArmSnapshot& now) const {
+  auto ok = validate(command, now);
+  if (!ok) return err(ok.error());
   ArmCommand accepted = command;
   if (command.kind == ArmCommand::Kind::MOVE_POSE) {
-    // Solve here, on the caller's thread, so an unreachable pose is refused to the caller.
-    auto solution =
-        inverse_kinematics(to_transform(command.pose), published_.joints, options_.limits.joints);
+    // Solved on the caller's thread, so an unreachable pose is refused to the caller.
+    auto solution = inverse_kinematics(to_transform(command.pose), now.joints,
+                                       options_.limits.joints, {}, *options_.limits.geometry);
     if (!solution) {
-      ++published_.refused;
       SafetyViolation v;
       v.limit = SafetyViolation::Limit::UNREACHABLE;
       return refused(v);
     }
-    auto path = check_joint_move(options_.limits, published_.joints, solution.value());
-    if (!path) {
-      ++published_.refused;
-      return refused(path.error());
-    }
+    auto path = check_joint_move(options_.limits, now.joints, solution.value());
+    if (!path) return refused(path.error());
     accepted.kind = ArmCommand::Kind::MOVE_JOINTS;
     accepted.joints = solution.value();
+  }
+  return accepted;
+}
+
+Result<void, JacoError> JacoController::submit(const ArmCommand& command) {
+  // Check on a copy, without the lock: the path check and the IK take microseconds to a
+  // millisecond, and the USB thread must never wait for them.
+  ArmSnapshot now;
+  {
+    std::lock_guard lock(mutex_);
+    now = published_;
+  }
+  auto checked = check_command(command, now);
+  std::lock_guard lock(mutex_);
+  if (!checked) {
+    ++published_.refused;
+    return err(checked.error());
+  }
+  const ArmCommand& accepted = checked.value();
+  // The latch or a fault may have come while the command was checked.
+  if (command.kind != ArmCommand::Kind::STOP && command.kind != ArmCommand::Kind::KEEP_ALIVE) {
+    if (published_.estop || estop_.load(std::memory_order_acquire)) {
+      ++published_.refused;
+      return error_of(JacoError::Code::ESTOP);
+    }
+    if (published_.fault) {
+      ++published_.refused;
+      return error_of(JacoError::Code::FAULT);
+    }
   }
   last_client_ns_.store(clock_->now_ns(), std::memory_order_release);
   switch (command.kind) {

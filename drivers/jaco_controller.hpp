@@ -151,6 +151,8 @@ class JacoController {
   JacoController(UsbTransport& transport, ControllerOptions options) noexcept;
   Result<void, JacoError> start_up(const UsbDeviceInfo& device);
   Result<void, JacoError> validate(const ArmCommand& command, const ArmSnapshot& now) const;
+  Result<ArmCommand, JacoError> check_command(const ArmCommand& command,
+                                              const ArmSnapshot& now) const;
   void read_state() noexcept;
   void run_motion(std::int64_t now) noexcept;
   void run_homing(std::int64_t now) noexcept;

@@ -97,7 +97,7 @@ void JacoController::read_state() noexcept {
   have_previous_ = true;
   state_.joints = q;
   for (std::size_t f = 0; f < FINGERS; ++f) state_.fingers[f] = joints.value().fingers[f];
-  state_.pose = to_pose(forward_kinematics(q));
+  state_.pose = to_pose(forward_kinematics(q, *options_.limits.geometry));
   state_.stamp_ns = now;
   // One slow read per cycle at most, so a cycle stays a few exchanges long.
   const std::uint64_t slot = state_.cycle % 100;

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <numbers>
 #include <tuple>
 
@@ -19,9 +18,8 @@ constexpr double DEG = PI / 180.0;
 
 Vector6d vec(const JointAngles& a) noexcept { return Eigen::Map<const Vector6d>(a.data()); }
 
-// Levenberg-Marquardt settings. The orientation error is weighted by a length, about the wrist-to-
-// tool distance, so that a radian at the tool weighs like the displacement it causes there.
-constexpr double ORIENTATION_WEIGHT_M = 0.2;
+// Levenberg-Marquardt settings. A radian at the tool weighs like the displacement it causes there.
+constexpr double ORIENTATION_WEIGHT_M = 0.2;  // m: about the wrist-to-tool distance
 constexpr int MAX_ITERATIONS = 64;
 constexpr double LAMBDA_START = 1e-3;  // m^2: about 3 cm of damping on a 0.5 m lever
 constexpr double LAMBDA_MIN = 1e-12;
@@ -69,8 +67,7 @@ Chain chain(const ArmGeometry& g, const Vector6d& q_rad) noexcept {
   return c;
 }
 
-// [position error; orientation error], the latter the rotation vector of R_target R^T (log map,
-// base frame), so that it is exact for large errors and the Jacobian's angular rows match it.
+// [position; rotation vector of R_target R^T (log map, base frame)]: exact for large errors.
 Vector6d pose_error(const Eigen::Isometry3d& target, const Eigen::Isometry3d& current) noexcept {
   const Eigen::AngleAxisd delta(target.linear() * current.linear().transpose());
   Vector6d e;
@@ -81,8 +78,7 @@ Vector6d pose_error(const Eigen::Isometry3d& target, const Eigen::Isometry3d& cu
 bool within(const Vector6d& e, const IkTolerance& tol) noexcept {
   return e.head<3>().norm() <= tol.position_m && e.tail<3>().norm() <= tol.orientation_rad;
 }
-// The least-squares residual: both halves in metres.
-Vector6d weighted(Vector6d e) noexcept {
+Vector6d weighted(Vector6d e) noexcept {  // the least-squares residual: both halves in metres
   e.tail<3>() *= ORIENTATION_WEIGHT_M;
   return e;
 }
@@ -106,9 +102,8 @@ Vector6d clamp(const Vector6d& q, const RadLimits& lim) noexcept {
   return q.cwiseMax(lim.lower).cwiseMin(lim.upper);
 }
 
-// One damped least-squares step (largest joint step bounded) within the limits by an active set: a
-// joint pushed past a limit goes to it and is held, the others are solved again for the residual
-// left. Clamping the whole step instead bends its direction and stalls the descent at a limit.
+// A damped least-squares step (largest joint step bounded) with an active set: a joint pushed past
+// a limit is held at it and the others solved again (clamping the step bends it and stalls there).
 Vector6d limited_step(const Matrix6d& j, const Vector6d& r, double lambda, const Vector6d& q,
                       const RadLimits& lim) noexcept {
   Vector6d held = Vector6d::Zero();  // 1 where a joint is held at a limit
@@ -131,8 +126,8 @@ Vector6d limited_step(const Matrix6d& j, const Vector6d& r, double lambda, const
   return step;
 }
 
-// One damped least-squares descent from @p q (updated in place); true if it reached tolerance.
-// Steps that do not lower the cost are refused and the damping raised (Levenberg-Marquardt).
+// Levenberg-Marquardt from @p q (updated); true at tolerance. A step that raises the cost is
+// refused.
 bool descend(const ArmGeometry& g, const Eigen::Isometry3d& target, const RadLimits& lim,
              const IkTolerance& tol, Vector6d& q) noexcept {
   Chain c = chain(g, q);
@@ -160,22 +155,31 @@ bool continuous(const JointLimits& limits, std::size_t i) noexcept {
   return limits.upper[i] - limits.lower[i] >= 360.0;
 }
 
-// Continuous joints shifted by whole turns to lie nearest the seed; then every joint clamped in
-// degrees, since a radian limit converted back may land an ulp outside the degree limit.
+// Radian bounds; continuous joints go free (a clamp would block answers just past their bound).
+RadLimits descent_limits(const JointLimits& limits) noexcept {
+  const Eigen::Array<bool, 6, 1> free = (vec(limits.upper) - vec(limits.lower)).array() >= 360.0;
+  return {free.select(-HUGE_VAL, vec(limits.lower).array() * DEG).matrix(),
+          free.select(HUGE_VAL, vec(limits.upper).array() * DEG).matrix()};
+}
+
+// Continuous joints turned nearest the seed, then inside their bounds; all clamped (radians: ulps).
 JointAngles wrap_near(const Vector6d& q_rad, const JointAngles& seed, const JointLimits& limits) {
   JointAngles out{};
   for (std::size_t i = 0; i < 6; ++i) {
     double v = q_rad(static_cast<Eigen::Index>(i)) / DEG;
-    if (continuous(limits, i)) v += 360.0 * std::round((seed[i] - v) / 360.0);
+    if (continuous(limits, i)) {
+      v += 360.0 * std::round((seed[i] - v) / 360.0);
+      v -= 360.0 * std::max(0.0, std::ceil((v - limits.upper[i]) / 360.0));
+      v += 360.0 * std::max(0.0, std::ceil((limits.lower[i] - v) / 360.0));
+    }
     out[i] = std::clamp(v, limits.lower[i], limits.upper[i]);
   }
   return out;
 }
 
-// The fixed restarts, degrees. The first four stay near the seed: wrist turned, joints 2 and 3
-// moved toward the middle of their ranges (a descent ending on a limit beside a near-singular
-// wrist, q5 near 0 or 180, needs both). The others cover the branches, as offsets from the seed on
-// continuous joints and absolute on joints 2 and 3: base half a turn, elbow up/down, wrist flip.
+// The fixed restarts, degrees: first near the seed, wrist turned and joints 2, 3 toward mid-range
+// (a descent ending on a limit beside a near-singular wrist, q5 near 0 or 180, needs both); then
+// the branches (base half a turn, elbow up/down, wrist flip), absolute on joints 2, 3 only.
 constexpr std::size_t NEAR_RESTARTS = 4;
 // clang-format off
 constexpr std::array<JointAngles, 12> RESTARTS = {{
@@ -213,20 +217,16 @@ Eigen::Isometry3d to_transform(const CartesianPose& pose) noexcept {
   return t;
 }
 
-// R = Rx Ry Rz has column 2 = (sy, -sx cy, cx cy): theta x from it; then theta y, z from Rx(-tx) R
-// = Ry Rz, whose row 1 is (sz, cz, 0) with unit norm, so theta z absorbs any error in theta x: the
-// round trip stays exact near gimbal lock, where theta x alone is ill-conditioned.
+// R = Rx Ry Rz: theta x from column 2 (sy, -sx cy, cx cy), then y and z from Rx(-tx) R = Ry Rz, so
+// that theta z absorbs any error of theta x: exact round trips near gimbal lock too.
 CartesianPose to_pose(const Eigen::Isometry3d& transform) noexcept {
   const Eigen::Matrix3d& r = transform.linear();
-  CartesianPose pose;
-  pose.position = transform.translation();
   const double cy_sx = -r(1, 2), cy_cx = r(2, 2);
   const double tx = std::hypot(cy_sx, cy_cx) < 1e-15 ? 0.0 : std::atan2(cy_sx, cy_cx);
   const double cx = std::cos(tx), sx = std::sin(tx);
   const double sz = cx * r(1, 0) + sx * r(2, 0), cz = cx * r(1, 1) + sx * r(2, 1);
   const double cy = std::max(0.0, -sx * r(1, 2) + cx * r(2, 2));  // >= 0 but for rounding
-  pose.theta = Eigen::Vector3d(tx, std::atan2(r(0, 2), cy), std::atan2(sz, cz));
-  return pose;
+  return {transform.translation(), {tx, std::atan2(r(0, 2), cy), std::atan2(sz, cz)}};
 }
 
 const ArmGeometry& jaco2_geometry() noexcept {
@@ -282,9 +282,9 @@ Result<JointAngles, IkError> inverse_kinematics(const Eigen::Isometry3d& target,
   if (!target.matrix().allFinite() || !vec(seed).allFinite()) return err(IkError::NOT_FINITE);
   if (beyond_reach(geometry, target.translation())) return err(IkError::UNREACHABLE);
   OF_ASSERT((vec(limits.lower).array() <= vec(limits.upper).array()).all(), "limits inverted");
-  const RadLimits lim{vec(limits.lower) * DEG, vec(limits.upper) * DEG};
+  const RadLimits lim = descent_limits(limits);
   JointAngles best{};
-  double best_distance = std::numeric_limits<double>::infinity();
+  double best_distance = HUGE_VAL;
   for (std::size_t k = 0; k <= RESTARTS.size(); ++k) {
     Vector6d q = clamp(k == 0 ? Vector6d(vec(seed) * DEG) : restart(k - 1, seed, limits), lim);
     if (!descend(geometry, target, lim, tolerance, q)) continue;

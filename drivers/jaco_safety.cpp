@@ -128,7 +128,7 @@ Result<void, SafetyViolation> check_joint_move(const SafetyLimits& limits, const
     const double t = static_cast<double>(s) / static_cast<double>(n);
     JointAngles q{};
     for (std::size_t j = 0; j < JOINTS; ++j) q[j] = from[j] + t * (to[j] - from[j]);
-    auto ok = check_point(limits, forward_kinematics(q).translation());
+    auto ok = check_point(limits, forward_kinematics(q, *limits.geometry).translation());
     if (!ok) return ok;
   }
   return {};

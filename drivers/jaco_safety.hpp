@@ -47,6 +47,8 @@ struct SafetyLimits {
   double max_joint_accel_deg_s2 = 60.0;  ///< per joint
   double max_finger = 6400.0;            ///< set from the model at open (finger_closed)
   std::size_t path_samples = 32;         ///< end-effector points checked along a move
+  /// The arm's geometry for the path checks: set from the detected model at open (static data).
+  const ArmGeometry* geometry = &jaco2_geometry();
   /// @brief Adds a keep-out box. @return false if MAX_KEEP_OUT are set already. @pre none.
   bool add_keep_out(const Box& box) noexcept;
 };

@@ -4,6 +4,7 @@
 // sends, so tests can check what reached the arm ("none outside the limits is ever sent").
 #include <chrono>
 #include <memory>
+#include <stdexcept>
 #include <vector>
 
 #include "drivers/jaco_controller.hpp"

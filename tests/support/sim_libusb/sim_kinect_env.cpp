@@ -1,5 +1,6 @@
 // The ORTHOFLOW_SIM_KINECT syntax (sim_kinect_env.hpp): Kinects split on ';', keys on ',', '='.
 #include "tests/support/sim_libusb/sim_kinect_env.hpp"
+#include "tests/support/sim_libusb/env_text.hpp"
 
 #include <algorithm>
 #include <charconv>
@@ -14,31 +15,10 @@ using simulation::KinectModel;
 using simulation::SimKinectConfig;
 using Kinects = std::vector<SimKinectConfig>;
 
-std::string_view trim(std::string_view s) noexcept {
-  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
-  while (!s.empty() && (s.back() == ' ' || s.back() == '\t')) s.remove_suffix(1);
-  return s;
-}
-
-std::vector<std::string_view> split(std::string_view s, char separator) {
-  std::vector<std::string_view> parts;
-  for (;;) {
-    const std::size_t at = s.find(separator);
-    parts.push_back(trim(s.substr(0, at)));
-    if (at == std::string_view::npos) return parts;
-    s.remove_prefix(at + 1);
-  }
-}
-
-template <class T>
-bool parse_number(std::string_view text, T& out) noexcept {
-  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), out);
-  return ec == std::errc{} && end == text.data() + text.size() && !text.empty();
-}
-
-bool parse_rate(std::string_view text, double& out) noexcept {
-  return parse_number(text, out) && out >= 0.0 && out <= 1.0;
-}
+using env_text::parse_number;
+using env_text::parse_rate;
+using env_text::split;
+using env_text::trim;
 
 std::string default_serial(std::size_t index) {
   if (index == 0) return "A00364A11700045A";
@@ -131,6 +111,7 @@ Result<Kinects, std::string> parse_kinects(std::string_view text) {
       kinects.emplace_back();
       return kinects;
     }
+    if (text == "none") return kinects;  // no Kinect at all (e.g. an ORTHOFLOW_SIM_JACO arm alone)
     const std::vector<std::string_view> entries = split(text, ';');
     for (std::size_t k = 0; k < entries.size(); ++k) {
       SimKinectConfig c;

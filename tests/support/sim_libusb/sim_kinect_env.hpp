@@ -5,8 +5,9 @@
 /// same SimKinectDevice from the same string).
 ///
 /// ORTHOFLOW_SIM_KINECT: unset or empty = one default Kinect (model 1414, the SimKinectConfig
-/// defaults). Otherwise Kinects separated by ';', each a ','-separated list of key=value
-/// (whitespace around tokens is ignored; an empty entry between ';' is a default Kinect):
+/// defaults); "none" = no Kinect (the bus then holds only the ORTHOFLOW_SIM_JACO arms of
+/// sim_jaco_env.hpp, if any). Otherwise Kinects separated by ';', each a ','-separated list of
+/// key=value (whitespace around tokens is ignored; an empty entry between ';' is a default Kinect):
 ///   model=1414|1473|k4w   serial=<16 chars>   seed=<u64 scene seed>   bus=<1..255>
 ///   ports=<p>[.<p>...]    (the internal hub's port path from the root hub, 1..6 ports of 1..15)
 ///   audio=0|1             (list the audio function)

@@ -1,6 +1,7 @@
 // A libusb-1.0 compatible shim (SONAME libusb-1.0.so.0) over simulated Kinects
-// (simulation/sim_kinect_device.hpp), so that unmodified libusb programs (libfreenect, orthoflow's
-// LibusbTransport) run against the simulator when started with LD_LIBRARY_PATH=<this lib's dir>.
+// (simulation/sim_kinect_device.hpp) and Kinova JACO arms (simulation/sim_jaco_arm.hpp), so that
+// unmodified libusb programs (libfreenect, orthoflow's LibusbTransport) run against the simulators
+// when started with LD_LIBRARY_PATH=<this lib's dir>.
 // Test support only: README.md beside this file documents the behaviour and the environment.
 //
 // Structure: one process-wide World (the simulated bus: devices, open handles, iso queues and the
@@ -25,12 +26,16 @@
 #include <string>
 #include <vector>
 
+#include "simulation/sim_jaco_arm.hpp"
 #include "simulation/sim_kinect_device.hpp"
+#include "tests/support/sim_libusb/sim_jaco_env.hpp"
 #include "tests/support/sim_libusb/sim_kinect_env.hpp"
 
 using orthoflow::simulation::KinectFunction;
 using orthoflow::simulation::KinectModel;
 using orthoflow::simulation::SimControlOutcome;
+using orthoflow::simulation::SimJacoArm;
+using orthoflow::simulation::SimJacoConfig;
 using orthoflow::simulation::SimKinectConfig;
 using orthoflow::simulation::SimKinectDevice;
 using orthoflow::simulation::USB_MICROFRAME_NS;
@@ -41,13 +46,14 @@ namespace {
 constexpr std::int64_t NEVER = std::numeric_limits<std::int64_t>::max();
 constexpr std::int64_t CONTROL_LATENCY_NS = 50'000;       // as SimUsbTransport
 constexpr std::int64_t INFINITE_WAIT_NS = 5'000'000'000;  // a stall with timeout 0 ends here
-constexpr std::int64_t MAX_LAG_NS = 100'000'000;  // realtime: catch up at most this much at once
-constexpr std::uint16_t HUB_VENDOR = 0x0409;      // NEC, the Kinect's internal hub chip
+constexpr std::int64_t MAX_LAG_NS = 100'000'000;     // realtime: catch up at most this much at once
+constexpr std::int64_t JACO_LATENCY_NS = 1'000'000;  // per transfer, as SimJacoTransport
+constexpr std::uint16_t HUB_VENDOR = 0x0409;         // NEC, the Kinect's internal hub chip
 constexpr std::uint16_t HUB_PRODUCT = 0x005A;
 constexpr std::uint16_t ROOT_HUB_VENDOR = 0x1D6B;  // Linux Foundation
 constexpr std::uint16_t ROOT_HUB_PRODUCT = 0x0002;
 
-enum class Kind : std::uint8_t { ROOT_HUB, HUB, FUNCTION };
+enum class Kind : std::uint8_t { ROOT_HUB, HUB, FUNCTION, JACO };
 
 struct EndpointSpec {
   std::uint8_t address = 0;
@@ -72,6 +78,12 @@ struct KinectSlot {
   std::array<libusb_device_handle*, 3> claimed_by{};  // interface 0, per function
 };
 
+// Per JACO arm (sim_jaco_env.hpp): the arm and the claim of its interface 0.
+struct JacoSlot {
+  std::unique_ptr<SimJacoArm> arm;
+  libusb_device_handle* claimed_by = nullptr;
+};
+
 }  // namespace
 
 struct libusb_context {
@@ -82,6 +94,7 @@ struct libusb_device {
   Kind kind = Kind::FUNCTION;
   std::size_t kinect = 0;
   KinectFunction function = KinectFunction::CAMERA;
+  std::size_t jaco = 0;  // Kind::JACO: its index in World::jacos
   std::uint8_t bus = 0;
   std::uint8_t address = 0;
   std::array<std::uint8_t, 7> ports{};
@@ -129,6 +142,7 @@ struct EndpointQueue {
 
 struct World {
   std::vector<KinectSlot> kinects;
+  std::vector<JacoSlot> jacos;
   std::vector<std::unique_ptr<libusb_device>> devices;  // stable addresses
   std::vector<EndpointQueue> queues;                    // 2 per Kinect: 0x81, 0x82
   std::vector<libusb_device_handle*> handles;
@@ -203,7 +217,8 @@ libusb_device* add_device(World& w, Kind kind, std::uint8_t bus, std::uint8_t ad
   desc.bLength = LIBUSB_DT_DEVICE_SIZE;
   desc.bDescriptorType = LIBUSB_DT_DEVICE;
   desc.bcdUSB = 0x0200;
-  desc.bDeviceClass = kind == Kind::FUNCTION ? 0 : LIBUSB_CLASS_HUB;
+  const bool hub = kind == Kind::ROOT_HUB || kind == Kind::HUB;
+  desc.bDeviceClass = hub ? LIBUSB_CLASS_HUB : 0;
   desc.bMaxPacketSize0 = 64;
   desc.idVendor = vendor;
   desc.idProduct = product;
@@ -212,22 +227,46 @@ libusb_device* add_device(World& w, Kind kind, std::uint8_t bus, std::uint8_t ad
   desc.iProduct = 2;
   desc.iSerialNumber = serial.empty() ? 0 : 3;
   desc.bNumConfigurations = 1;
-  d->strings[1] = kind == Kind::FUNCTION ? "Microsoft" : "orthoflow sim_libusb";
+  d->strings[1] = hub ? "orthoflow sim_libusb" : kind == Kind::JACO ? "Kinova inc." : "Microsoft";
   d->strings[2] = std::move(product_name);
   d->strings[3] = std::move(serial);
   w.devices.push_back(std::move(d));
   return w.devices.back().get();
 }
 
-void build_bus(World& w, std::vector<SimKinectConfig> configs) {
+// A JACO (JACO.md 1-2, as SimJacoTransport): full speed, self-powered [I], one vendor interface
+// with interrupt OUT 0x02 and IN 0x82 of 64 bytes, polled every frame; strings "Kinova inc." and
+// "Kinova Robotic Platform" [I: JACO.md has it truncated], the USB serial only if the config has
+// one.
+void add_jaco(World& w, std::uint8_t address, libusb_device* root, SimJacoConfig config) {
+  namespace jaco = orthoflow::drivers::jaco;
+  const std::string usb_serial = config.usb_serial;
+  libusb_device* d = add_device(w, Kind::JACO, config.bus, address, jaco::VENDOR_KINOVA,
+                                jaco::PID_JACO, 0x0100, "Kinova Robotic Platform", usb_serial);
+  d->jaco = w.jacos.size();
+  d->parent = root;
+  d->ports[0] = config.port;
+  d->depth = 1;
+  d->interface.alt[0] = {2,
+                         {EndpointSpec{jaco::EP_OUT, LIBUSB_TRANSFER_TYPE_INTERRUPT, 64, 1},
+                          EndpointSpec{jaco::EP_IN, LIBUSB_TRANSFER_TYPE_INTERRUPT, 64, 1}}};
+  d->config_attributes = 0xC0;
+  d->max_power = 0;
+  w.jacos.push_back({std::make_unique<SimJacoArm>(std::move(config), w.now_ns), nullptr});
+}
+
+void build_bus(World& w, std::vector<SimKinectConfig> configs, std::vector<SimJacoConfig> jacos) {
   std::array<std::uint8_t, 256> next_address{};
   next_address.fill(2);
   std::array<libusb_device*, 256> root{};
-  for (const SimKinectConfig& c : configs) {
-    if (root[c.bus] != nullptr) continue;
-    root[c.bus] = add_device(w, Kind::ROOT_HUB, c.bus, 1, ROOT_HUB_VENDOR, ROOT_HUB_PRODUCT, 0x0606,
-                             "EHCI Host Controller", "0000:00:1d.0");
-    root[c.bus]->interface = interface_of(*root[c.bus], KinectModel::K1414);
+  std::vector<std::uint8_t> buses;
+  for (const SimKinectConfig& c : configs) buses.push_back(c.bus);
+  for (const SimJacoConfig& c : jacos) buses.push_back(c.bus);
+  for (const std::uint8_t bus : buses) {
+    if (root[bus] != nullptr) continue;
+    root[bus] = add_device(w, Kind::ROOT_HUB, bus, 1, ROOT_HUB_VENDOR, ROOT_HUB_PRODUCT, 0x0606,
+                           "EHCI Host Controller", "0000:00:1d.0");
+    root[bus]->interface = interface_of(*root[bus], KinectModel::K1414);
   }
   for (std::size_t k = 0; k < configs.size(); ++k) {
     KinectSlot slot;
@@ -266,6 +305,10 @@ void build_bus(World& w, std::vector<SimKinectConfig> configs) {
     w.kinects.push_back(std::move(slot));
     w.queues.push_back({k, orthoflow::simulation::KINECT_VIDEO_ENDPOINT, {}, 0});
     w.queues.push_back({k, orthoflow::simulation::KINECT_DEPTH_ENDPOINT, {}, 0});
+  }
+  for (SimJacoConfig& c : jacos) {  // after the Kinects: the next free address of its bus
+    const std::uint8_t bus = c.bus;
+    add_jaco(w, next_address[bus]++, root[bus], std::move(c));
   }
 }
 
@@ -557,6 +600,82 @@ int handle_events(libusb_context*, const timeval* tv, int* completed) {
 }
 
 // ----------------------------------------------------------------------------------------------
+// The JACO's interrupt pipes. The arm lives in real time whatever the pace (README "JACO"): its
+// driver times its 10 ms cycle and its watchdog on the wall clock, so every JACO transfer first
+// brings the shared simulated clock up to the wall clock, and its 1 ms latency (and an IN's
+// timeout) is waited on the wall clock, with the mutex released.
+
+void catch_up_with_wall(World& w) {
+  reanchor(w);  // after a long idle spell: MAX_LAG_NS behind the wall clock, as realtime does
+  advance(w,
+          w.anchor_sim_ns + (wall_ns(std::chrono::steady_clock::now()) - wall_ns(w.anchor_wall)));
+}
+
+// Waits until the wall clock reaches `until` or `done()`; false if the handle died meanwhile.
+template <class Done>
+bool wait_wall(std::unique_lock<std::mutex>& lock, libusb_device_handle* h, SteadyTime until,
+               Done done) {
+  while (!done() && std::chrono::steady_clock::now() < until) {
+    g_cv.wait_until(lock, until);
+    if (g_world == nullptr || !handle_valid(*g_world, h)) return false;
+  }
+  return true;
+}
+
+int jaco_transfer(std::unique_lock<std::mutex>& lock, libusb_device_handle* h,
+                  unsigned char endpoint, unsigned char* data, int length, int* transferred,
+                  unsigned int timeout) {
+  namespace jaco = orthoflow::drivers::jaco;
+  const std::size_t index = h->device->jaco;
+  if (!h->claimed || (endpoint != jaco::EP_OUT && endpoint != jaco::EP_IN))
+    return LIBUSB_ERROR_NOT_FOUND;
+  if (length > 0 && data == nullptr) return LIBUSB_ERROR_INVALID_PARAM;
+  const auto arm = [&]() -> SimJacoArm& { return *g_world->jacos[index].arm; };
+  // The end of a transfer: simulated time at least `at_least` and up with the wall clock.
+  const auto finish = [&](std::int64_t at_least) {
+    catch_up_with_wall(*g_world);
+    advance(*g_world, at_least);
+    arm().step(g_world->now_ns);
+  };
+  const auto latency = std::chrono::nanoseconds(JACO_LATENCY_NS);
+  catch_up_with_wall(*g_world);
+  const std::int64_t start = g_world->now_ns;
+  const SteadyTime start_wall = std::chrono::steady_clock::now();
+  if (endpoint == jaco::EP_OUT) {  // whole packets only, as SimJacoTransport: nothing sent
+    if (length != static_cast<int>(jaco::PACKET_BYTES)) return LIBUSB_ERROR_INVALID_PARAM;
+    jaco::Packet packet{};
+    std::memcpy(packet.data(), data, packet.size());
+    if (!wait_wall(lock, h, start_wall + latency, [] { return false; }))
+      return LIBUSB_ERROR_NO_DEVICE;
+    finish(start + JACO_LATENCY_NS);
+    arm().receive(packet, g_world->now_ns);  // it reaches the arm at the end of the latency
+    g_cv.notify_all();                       // an IN may wait on another thread
+    *transferred = length;
+    return LIBUSB_SUCCESS;
+  }
+  const std::int64_t wait =
+      timeout == 0 ? INFINITE_WAIT_NS : static_cast<std::int64_t>(timeout) * 1'000'000;
+  if (!wait_wall(lock, h, start_wall + std::chrono::nanoseconds(wait),
+                 [&] { return arm().has_reply(); }))
+    return LIBUSB_ERROR_NO_DEVICE;
+  if (!arm().has_reply()) {
+    finish(start + wait);
+    return LIBUSB_ERROR_TIMEOUT;
+  }
+  catch_up_with_wall(*g_world);
+  const std::int64_t from = std::max(start, g_world->now_ns);
+  const jaco::Packet reply = arm().take_reply();  // taken now: no other reader can get it
+  if (!wait_wall(lock, h, std::chrono::steady_clock::now() + latency, [] { return false; }))
+    return LIBUSB_ERROR_NO_DEVICE;
+  finish(from + JACO_LATENCY_NS);
+  const int n = std::min(length, static_cast<int>(reply.size()));
+  std::memcpy(data, reply.data(), static_cast<std::size_t>(n));
+  *transferred = n;
+  // A buffer under 64 bytes overflows (its part of the packet is kept, the rest is lost).
+  return n < static_cast<int>(reply.size()) ? LIBUSB_ERROR_OVERFLOW : LIBUSB_SUCCESS;
+}
+
+// ----------------------------------------------------------------------------------------------
 // Start-up.
 
 int init_world(libusb_context* ctx) {
@@ -564,6 +683,12 @@ int init_world(libusb_context* ctx) {
   if (!kinects_result) {
     std::fprintf(stderr, "sim_libusb: %s: %s\n", orthoflow::sim_libusb::ENV_KINECT,
                  kinects_result.error().c_str());
+    return LIBUSB_ERROR_INVALID_PARAM;
+  }
+  auto jacos_result = orthoflow::sim_libusb::jacos_from_env(*kinects_result);
+  if (!jacos_result) {
+    std::fprintf(stderr, "sim_libusb: %s: %s\n", orthoflow::sim_libusb::ENV_JACO,
+                 jacos_result.error().c_str());
     return LIBUSB_ERROR_INVALID_PARAM;
   }
   const char* pace = std::getenv(orthoflow::sim_libusb::ENV_PACE);
@@ -580,10 +705,11 @@ int init_world(libusb_context* ctx) {
     const char* trace_env = std::getenv(orthoflow::sim_libusb::ENV_TRACE);
     w->trace = trace_env != nullptr && trace_env[0] != '\0' && trace_env[0] != '0';
     w->anchor_wall = std::chrono::steady_clock::now();
-    build_bus(*w, std::move(kinects_result).value());
+    build_bus(*w, std::move(kinects_result).value(), std::move(jacos_result).value());
     g_world = w.release();
-    trace(*g_world, "init: %zu Kinect(s), %zu devices, pace %s", g_world->kinects.size(),
-          g_world->devices.size(), g_world->realtime ? "realtime" : "max");
+    trace(*g_world, "init: %zu Kinect(s), %zu JACO(s), %zu devices, pace %s",
+          g_world->kinects.size(), g_world->jacos.size(), g_world->devices.size(),
+          g_world->realtime ? "realtime" : "max");
   }
   ++g_world->contexts;
   (void)ctx;
@@ -843,7 +969,9 @@ uint8_t LIBUSB_CALL libusb_get_device_address(libusb_device* dev) {
   return dev == nullptr ? 0 : dev->address;
 }
 
-int LIBUSB_CALL libusb_get_device_speed(libusb_device*) { return LIBUSB_SPEED_HIGH; }
+int LIBUSB_CALL libusb_get_device_speed(libusb_device* dev) {
+  return dev != nullptr && dev->kind == Kind::JACO ? LIBUSB_SPEED_FULL : LIBUSB_SPEED_HIGH;
+}
 
 int LIBUSB_CALL libusb_get_max_packet_size(libusb_device* dev, unsigned char endpoint) {
   if (dev == nullptr) return LIBUSB_ERROR_INVALID_PARAM;
@@ -920,6 +1048,7 @@ void LIBUSB_CALL libusb_close(libusb_device_handle* dev_handle) {
   std::erase_if(w.cancelled, [&](libusb_transfer* t) { return t->dev_handle == dev_handle; });
   if (d.kind == Kind::FUNCTION && dev_handle->claimed)
     w.kinects[d.kinect].claimed_by[static_cast<std::size_t>(d.function)] = nullptr;
+  if (d.kind == Kind::JACO && dev_handle->claimed) w.jacos[d.jaco].claimed_by = nullptr;
   std::erase(w.handles, dev_handle);
   --d.refs;
   trace(w, "close bus %u address %u", d.bus, d.address);
@@ -947,6 +1076,13 @@ int LIBUSB_CALL libusb_claim_interface(libusb_device_handle* dev_handle, int int
   if (interface_number != 0) return LIBUSB_ERROR_NOT_FOUND;
   if (dev_handle->claimed) return LIBUSB_SUCCESS;
   libusb_device& d = *dev_handle->device;
+  if (d.kind == Kind::JACO) {  // one claim per arm
+    libusb_device_handle*& owner = g_world->jacos[d.jaco].claimed_by;
+    if (owner != nullptr) return LIBUSB_ERROR_BUSY;
+    owner = dev_handle;
+    dev_handle->claimed = true;
+    return LIBUSB_SUCCESS;
+  }
   if (d.kind != Kind::FUNCTION) {
     dev_handle->claimed = true;
     return LIBUSB_SUCCESS;
@@ -967,6 +1103,7 @@ int LIBUSB_CALL libusb_release_interface(libusb_device_handle* dev_handle, int i
   libusb_device& d = *dev_handle->device;
   if (d.kind == Kind::FUNCTION)
     g_world->kinects[d.kinect].claimed_by[static_cast<std::size_t>(d.function)] = nullptr;
+  if (d.kind == Kind::JACO) g_world->jacos[d.jaco].claimed_by = nullptr;
   dev_handle->claimed = false;
   dev_handle->alt = 0;
   return LIBUSB_SUCCESS;
@@ -999,6 +1136,12 @@ int LIBUSB_CALL libusb_reset_device(libusb_device_handle* dev_handle) {
   if (d.kind == Kind::FUNCTION && d.function == KinectFunction::CAMERA) {
     fill_until_now(*g_world);
     g_world->kinects[d.kinect].device->power_cycle();
+  }
+  if (d.kind == Kind::JACO) {  // a port reset: the arm keeps its state, its pending replies go
+    catch_up_with_wall(*g_world);
+    SimJacoArm& arm = *g_world->jacos[d.jaco].arm;
+    arm.step(g_world->now_ns);
+    arm.reset_replies();
   }
   trace(*g_world, "reset bus %u address %u", d.bus, d.address);
   return LIBUSB_SUCCESS;
@@ -1114,13 +1257,32 @@ int LIBUSB_CALL libusb_control_transfer(libusb_device_handle* dev_handle, uint8_
 }
 
 namespace {
-int bulk_or_interrupt(libusb_device_handle* dev_handle, unsigned char endpoint, int length,
-                      int* transferred) {
-  if (transferred != nullptr) *transferred = 0;
-  std::lock_guard lock(g_mutex);
+int bulk_or_interrupt(libusb_device_handle* dev_handle, unsigned char endpoint, unsigned char* data,
+                      int length, int* transferred, unsigned int timeout) {
+  int ignored = 0;
+  if (transferred == nullptr) transferred = &ignored;  // allowed since libusb 1.0.21
+  *transferred = 0;
+  std::unique_lock lock(g_mutex);
   if (g_world == nullptr || !handle_valid(*g_world, dev_handle)) return LIBUSB_ERROR_NO_DEVICE;
   if (length < 0) return LIBUSB_ERROR_INVALID_PARAM;
   const libusb_device& d = *dev_handle->device;
+  // A JACO's pipes; bulk too: usbfs runs a bulk request on an interrupt endpoint as interrupt.
+  if (d.kind == Kind::JACO) {
+    const std::uint8_t bus = d.bus;
+    const std::uint8_t address = d.address;
+    const unsigned command = length >= 6 && (endpoint & LIBUSB_ENDPOINT_IN) == 0
+                                 ? static_cast<unsigned>(data[4] | (data[5] << 8))
+                                 : 0;
+    const int r = jaco_transfer(lock, dev_handle, endpoint, data, length, transferred, timeout);
+    if (g_world != nullptr) {
+      const unsigned reply = r == LIBUSB_SUCCESS && (endpoint & LIBUSB_ENDPOINT_IN) != 0
+                                 ? static_cast<unsigned>(data[4] | (data[5] << 8))
+                                 : command;
+      trace(*g_world, "interrupt %02x command %u len %d -> %d (bus %u address %u)", endpoint, reply,
+            length, r == LIBUSB_SUCCESS ? *transferred : r, bus, address);
+    }
+    return r;
+  }
   trace(*g_world, "bulk/interrupt on %02x refused (bus %u address %u)", endpoint, d.bus, d.address);
   // The audio function is a bootloader whose firmware protocol is not simulated: it stalls.
   if (d.kind == Kind::FUNCTION && d.function == KinectFunction::AUDIO) return LIBUSB_ERROR_PIPE;
@@ -1129,14 +1291,15 @@ int bulk_or_interrupt(libusb_device_handle* dev_handle, unsigned char endpoint, 
 }  // namespace
 
 int LIBUSB_CALL libusb_bulk_transfer(libusb_device_handle* dev_handle, unsigned char endpoint,
-                                     unsigned char*, int length, int* transferred, unsigned int) {
-  return bulk_or_interrupt(dev_handle, endpoint, length, transferred);
+                                     unsigned char* data, int length, int* transferred,
+                                     unsigned int timeout) {
+  return bulk_or_interrupt(dev_handle, endpoint, data, length, transferred, timeout);
 }
 
 int LIBUSB_CALL libusb_interrupt_transfer(libusb_device_handle* dev_handle, unsigned char endpoint,
-                                          unsigned char*, int length, int* transferred,
-                                          unsigned int) {
-  return bulk_or_interrupt(dev_handle, endpoint, length, transferred);
+                                          unsigned char* data, int length, int* transferred,
+                                          unsigned int timeout) {
+  return bulk_or_interrupt(dev_handle, endpoint, data, length, transferred, timeout);
 }
 
 int LIBUSB_CALL libusb_get_string_descriptor_ascii(libusb_device_handle* dev_handle,
