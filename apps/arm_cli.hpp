@@ -24,6 +24,7 @@ struct ArmArgs {
   std::string serial;
   bool json = false;
   bool follow = false;
+  bool publish = false;               ///< state --follow: also on iceoryx orthoflow/jaco/state
   double seconds = 0.0;               ///< state --follow: 0 = until Ctrl-C
   double timeout_s = 60.0;            ///< motion commands: give up (and stop) after this
   std::string joints;                 ///< move --joints
@@ -40,8 +41,10 @@ struct ArmArgs {
 [[nodiscard]] std::unique_ptr<drivers::UsbTransport> make_transport(const ArmArgs& a);
 /// @brief The arm asked for (--serial, else the first one). Fails when there is none.
 [[nodiscard]] drivers::UsbDeviceInfo find_arm(drivers::UsbTransport& t, const ArmArgs& a);
-/// @brief Opens and starts the arm with the limits of the options.
-[[nodiscard]] std::unique_ptr<drivers::jaco::JacoArm> start_arm(const ArmArgs& a);
+/// @brief Opens and starts the arm with the limits of the options and @p subscribers (run on the
+/// arm's USB thread after every cycle).
+[[nodiscard]] std::unique_ptr<drivers::jaco::JacoArm> start_arm(
+    const ArmArgs& a, std::vector<drivers::jaco::StateCallback> subscribers = {});
 /// @brief The snapshot as JSON (joints, pose, fingers, state, counters).
 [[nodiscard]] nlohmann::json snapshot_json(const drivers::jaco::ArmSnapshot& s);
 /// @brief A comma-separated list of exactly @p count finite numbers, or fail (EXIT_USAGE).

@@ -1,14 +1,20 @@
 // `orthoflow arm list | info | state [--follow] | stop`: the Kinova JACO through orthoflow's driver
 // (drivers/jaco_arm.hpp); --sim runs them on the simulated arm (simulation/sim_jaco_transport.hpp),
 // in real time. Motion (home, retract, move, fingers) is in cmd_arm_motion.cpp.
+#include <unistd.h>
+
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <iostream>
 #include <sstream>
 #include <thread>
 
 #include "apps/arm_cli.hpp"
 #include "drivers/libusb_transport.hpp"
+#include "engine/arm_state_payload.hpp"
+#include "engine/ipc_pubsub.hpp"
 #include "simulation/sim_jaco_transport.hpp"
 
 namespace orthoflow::apps {
@@ -92,10 +98,12 @@ jaco::Box parse_box(const std::string& text, const std::string& what, const std:
 
 }  // namespace
 
-std::unique_ptr<jaco::JacoArm> start_arm(const ArmArgs& a) {
+std::unique_ptr<jaco::JacoArm> start_arm(const ArmArgs& a,
+                                         std::vector<jaco::StateCallback> subscribers) {
   auto transport = make_transport(a);
   const auto device = find_arm(*transport, a);
   jaco::ArmOptions options;
+  options.subscribers = std::move(subscribers);
   options.pace_to_wall_clock = a.sim;  // the simulated arm moves as fast as a real one
   if (!a.workspace.empty())
     options.controller.limits.workspace = parse_box(a.workspace, "--workspace", "workspace");
@@ -150,6 +158,8 @@ void add_common_options(CLI::App* sub, const std::shared_ptr<ArmArgs>& a) {
 namespace {
 
 using namespace arm_cli;
+
+constexpr std::string_view ARM_STATE_TOPIC = "orthoflow/jaco/state";
 
 void run_list(const ArmArgs& a) {
   auto transport = make_transport(a);
@@ -216,8 +226,74 @@ void print_snapshot(const jaco::ArmSnapshot& s, bool json) {
   std::cout << line.str() << '\n';
 }
 
+/// The iceoryx side of `state --follow --publish`: topic orthoflow/jaco/state, one ArmStatePayload
+/// per control cycle, loaned and filled on the arm's USB thread (no allocation there).
+struct StatePublisher {
+  std::unique_ptr<engine::IpcPublisher> publisher;
+  std::atomic<bool> roudi_alive{true};
+  std::atomic<std::uint64_t> published{0};
+
+  void publish(const jaco::ArmSnapshot& s) noexcept {
+    if (!roudi_alive.load(std::memory_order_acquire)) {
+      publisher->count_unpublished();
+      return;
+    }
+    auto chunk = publisher->loan(sizeof(engine::ArmStatePayload));
+    if (!chunk) return;  // counted by the publisher (loan_failures)
+    engine::ArmStatePayload p;
+    p.reset();
+    p.flags = (s.estop ? engine::ARM_ESTOP : 0U) | (s.fault ? engine::ARM_FAULT : 0U);
+    p.arm_state = static_cast<std::int32_t>(s.arm_state);
+    p.cycle = s.cycle;
+    p.stamp_ns = s.stamp_ns;
+    p.control = static_cast<std::uint32_t>(s.control);
+    p.last_stop = static_cast<std::uint32_t>(s.last_stop);
+    p.watchdog_stops = s.watchdog_stops;
+    for (std::size_t j = 0; j < jaco::JOINTS; ++j) {
+      p.joints_deg[j] = s.joints[j];
+      p.velocity_deg_s[j] = s.velocity[j];
+      p.currents_a[j] = s.currents[j];
+    }
+    for (std::size_t f = 0; f < jaco::FINGERS; ++f) p.fingers[f] = s.fingers[f];
+    for (int i = 0; i < 3; ++i) {
+      p.position_m[i] = s.pose.position[i];
+      p.theta_rad[i] = s.pose.theta[i];
+    }
+    p.voltage_v = s.sensors.voltage_v;
+    std::memcpy(chunk.value().data(), &p, sizeof p);
+    if (publisher->publish(chunk.value())) published.fetch_add(1, std::memory_order_relaxed);
+  }
+};
+
+std::unique_ptr<StatePublisher> make_state_publisher() {
+  if (auto init = engine::init_ipc_runtime("orthoflow_arm_" + std::to_string(::getpid())); !init)
+    fail(to_string(init.error()), EXIT_NO_ROUDI);
+  auto pools = engine::query_roudi_pools(std::chrono::milliseconds(3000));
+  if (!pools) fail(to_string(pools.error()), EXIT_NO_ROUDI);
+  auto topic = engine::parse_topic(std::string(ARM_STATE_TOPIC));
+  engine::IpcPublisherConfig config{{engine::ARM_STATE_TYPE_ID, engine::ARM_STATE_VERSION},
+                                    sizeof(engine::ArmStatePayload),
+                                    1,
+                                    false};
+  auto publisher = engine::IpcPublisher::create(topic.value(), config, pools.value());
+  if (!publisher)
+    fail(to_string(publisher.error()),
+         publisher.error().code == engine::IpcError::Code::NO_FITTING_POOL ? EXIT_POOLS
+                                                                           : EXIT_FAILURE_GENERIC);
+  auto out = std::make_unique<StatePublisher>();
+  out->publisher = std::move(publisher).value();
+  return out;
+}
+
 void run_state(const ArmArgs& a) {
-  auto arm = start_arm(a);
+  if (a.publish && !a.follow) fail("--publish needs --follow", EXIT_USAGE);
+  std::unique_ptr<StatePublisher> ipc;
+  std::vector<jaco::StateCallback> subscribers;
+  if (a.publish) {
+    ipc = make_state_publisher();
+    subscribers.push_back([p = ipc.get()](const jaco::ArmSnapshot& s) { p->publish(s); });
+  }
+  auto arm = start_arm(a, std::move(subscribers));
   if (!a.follow) {
     print_snapshot(arm->snapshot(), a.json);
     return;
@@ -228,11 +304,20 @@ void run_state(const ArmArgs& a) {
   while (a.seconds <= 0.0 ||
          std::chrono::steady_clock::now() - start < std::chrono::duration<double>(a.seconds)) {
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    if (ipc && !engine::probe_roudi()) {
+      ipc->roudi_alive.store(false, std::memory_order_release);
+      arm.reset();  // stop the arm's thread (and with it the publishing) before leaving
+      fail("RouDi lost while publishing " + std::string(ARM_STATE_TOPIC), EXIT_ROUDI_LOST);
+    }
     const auto s = arm->snapshot();
     if (s.cycle == printed_cycle) continue;
     printed_cycle = s.cycle;
     print_snapshot(s, a.json);
     if (s.fault) fail("the arm faulted: " + jaco::to_string(s.fault_error));
+  }
+  arm.reset();
+  if (ipc) {
+    std::cerr << "published " << ipc->published.load() << " states on " << ARM_STATE_TOPIC << '\n';
   }
 }
 
@@ -269,6 +354,9 @@ void add_arm_command(CLI::App& app) {
   add_common_options(state, a);
   state->add_flag("--follow", a->follow, "keep printing until Ctrl-C or --seconds");
   state->add_option("--seconds", a->seconds, "with --follow: stop after this many seconds");
+  state->add_flag("--publish", a->publish,
+                  "with --follow: publish every 100 Hz snapshot on the iceoryx topic "
+                  "orthoflow/jaco/state (needs a running RouDi)");
   state->callback([a] { run_state(*a); });
   auto* stop = arm->add_subcommand("stop", "stop any motion: release the joystick, erase the FIFO");
   add_common_options(stop, a);

@@ -9,6 +9,7 @@
 
 #include "apps/commands.hpp"
 #include "apps/graph_run.hpp"
+#include "engine/arm_state_payload.hpp"
 #include "engine/frame_payload.hpp"
 #include "engine/ipc_nodes.hpp"
 #include "engine/object_list_payload.hpp"
@@ -152,6 +153,16 @@ void print_sample(std::span<const std::byte> bytes, std::uint64_t sequence,
               << h.sensor_stamp_ns << " host_ns " << h.host_stamp_ns << "\n";
     return;
   }
+  if (type == "arm_state") {
+    engine::ArmStatePayload arm;
+    std::memcpy(static_cast<void*>(&arm), bytes.data(), std::min(bytes.size(), sizeof(arm)));
+    std::cout << " cycle " << arm.cycle << " state " << arm.arm_state << " joints";
+    for (double q : arm.joints_deg) std::cout << ' ' << q;
+    std::cout << " xyz " << arm.position_m[0] << ' ' << arm.position_m[1] << ' '
+              << arm.position_m[2] << ((arm.flags & engine::ARM_ESTOP) != 0U ? " estop" : "")
+              << ((arm.flags & engine::ARM_FAULT) != 0U ? " fault" : "") << "\n";
+    return;
+  }
   engine::ObjectListPayload list;
   std::memcpy(static_cast<void*>(&list), bytes.data(), std::min(bytes.size(), sizeof(list)));
   const auto count = std::min(list.count, engine::OBJECT_LIST_CAPACITY);
@@ -177,7 +188,10 @@ void run_echo(const EchoArgs& a) {
   const std::uint64_t count = a.count;
   const std::int64_t timeout_ms = a.timeout_ms;
   auto topic = value_or_fail(engine::parse_topic(topic_text));
-  auto payload_type = engine::ipc_payload_type(type);
+  auto payload_type = type == "arm_state"
+                          ? Result<engine::IpcPayloadType, std::string>(engine::IpcPayloadType{
+                                engine::ARM_STATE_TYPE_ID, engine::ARM_STATE_VERSION})
+                          : engine::ipc_payload_type(type);
   if (!payload_type) fail(EXIT_USAGE, payload_type.error());
   start_runtime("echo");
   engine::IpcSubscriberConfig config{
@@ -231,8 +245,8 @@ void add_ipc_command(CLI::App& app) {
   auto* echo = ipc->add_subcommand("echo", "print what flows on TOPIC");
   static EchoArgs echo_args;
   echo->add_option("topic", echo_args.topic, "service/instance/event")->required();
-  echo->add_option("--type", echo_args.type, "frame|objects")
-      ->check(CLI::IsMember({"frame", "objects"}));
+  echo->add_option("--type", echo_args.type, "frame|objects|arm_state")
+      ->check(CLI::IsMember({"frame", "objects", "arm_state"}));
   echo->add_option("--count", echo_args.count, "stop after N samples (0 = endless)");
   echo->add_option("--timeout-ms", echo_args.timeout_ms,
                    "stop after this long without data (0 = never)");

@@ -1,0 +1,57 @@
+// The arm's state to other processes: `orthoflow arm state --sim --follow --publish` sends one
+// ArmStatePayload per 100 Hz control cycle on orthoflow/jaco/state, and `orthoflow ipc echo --type
+// arm_state` in another process reads them. Own RouDi in a private mount namespace, as in
+// ipc_cli_test.cpp.
+#include <gtest/gtest.h>
+#include <signal.h>
+
+#include <chrono>
+#include <string>
+#include <thread>
+
+#include "tests/ipc/roudi_sandbox.hpp"
+
+namespace orthoflow::tests {
+namespace {
+
+using namespace std::chrono_literals;
+
+TEST(IpcArmState, ArmStatePublishesEveryCycleToAnotherProcess) {
+  const Outcome outcome = run_isolated(
+      [](Sandbox& box) {
+        if (box.start_roudi() < 0) return;
+        const pid_t echo = box.spawn_orthoflow(
+            "echo", {"ipc", "echo", "orthoflow/jaco/state", "--type", "arm_state", "--count",
+                     "100", "--depth", "64", "--timeout-ms", "8000"});
+        const pid_t arm = box.spawn_orthoflow(
+            "arm", {"arm", "state", "--sim", "--follow", "--seconds", "3", "--publish"});
+        const ProcResult a = box.wait(arm, 20s), e = box.wait(echo, 20s);
+        box.check(a.exit_code == 0, "arm state --follow --publish exits 0", a);
+        box.check(a.err.find("published ") != std::string::npos, "it says how many it sent", a);
+        box.check(e.exit_code == 0, "echo exits 0", e);
+        box.check(e.out.find("received 100") != std::string::npos, "echo reads 100 states", e);
+        box.check(e.out.find("type arm_state cycle ") != std::string::npos,
+                  "the states carry the control cycle", e);
+        box.check(e.out.find("rejected 0") != std::string::npos,
+                  "no state is rejected (type and version match)", e);
+      },
+      40s);
+  if (outcome.skipped) GTEST_SKIP() << outcome.reason;
+  EXPECT_EQ(outcome.failures, "");
+}
+
+TEST(IpcArmState, PublishWithoutRouDiIsAClearError) {
+  const Outcome outcome = run_isolated(
+      [](Sandbox& box) {
+        const pid_t arm = box.spawn_orthoflow(
+            "arm", {"arm", "state", "--sim", "--follow", "--seconds", "1", "--publish"});
+        const ProcResult a = box.wait(arm, 20s);
+        box.check(a.exit_code == 20, "no RouDi: exit 20", a);
+      },
+      30s);
+  if (outcome.skipped) GTEST_SKIP() << outcome.reason;
+  EXPECT_EQ(outcome.failures, "");
+}
+
+}  // namespace
+}  // namespace orthoflow::tests
