@@ -21,8 +21,8 @@ TEST(IpcArmState, ArmStatePublishesEveryCycleToAnotherProcess) {
       [](Sandbox& box) {
         if (box.start_roudi() < 0) return;
         const pid_t echo = box.spawn_orthoflow(
-            "echo", {"ipc", "echo", "orthoflow/jaco/state", "--type", "arm_state", "--count",
-                     "100", "--depth", "64", "--timeout-ms", "8000"});
+            "echo", {"ipc", "echo", "orthoflow/jaco/state", "--type", "arm_state", "--count", "100",
+                     "--depth", "64", "--timeout-ms", "8000"});
         const pid_t arm = box.spawn_orthoflow(
             "arm", {"arm", "state", "--sim", "--follow", "--seconds", "3", "--publish"});
         const ProcResult a = box.wait(arm, 20s), e = box.wait(echo, 20s);
