@@ -1,12 +1,14 @@
 // `orthoflow arm home | retract | move --joints ... | move --pose ... | fingers open|close|a,b,c`:
 // motion through orthoflow's JACO driver. The command stays the arm's controlling client until the
 // motion ends: it feeds the driver's watchdog every 20 ms, so if this process dies the arm stops
-// within 100 ms; Ctrl-C pulls the emergency stop. Every target is checked by the driver's safety
-// layer first; a refusal names the limit and nothing moves.
+// within 100 ms; Ctrl-C pulls the emergency stop (finger moves too). Every target is checked by the
+// driver's safety layer first; a refusal names the limit and nothing moves.
 #include <atomic>
 #include <chrono>
 #include <csignal>
+#include <functional>
 #include <iostream>
+#include <optional>
 #include <thread>
 
 #include "apps/arm_cli.hpp"
@@ -19,9 +21,14 @@ namespace jaco = drivers::jaco;
 std::atomic<bool> interrupted{false};
 extern "C" void on_interrupt(int) { interrupted.store(true); }
 
-/// Submits @p command and waits until the controller is done with it, feeding the watchdog.
-void run_until_done(jaco::JacoArm& arm, const jaco::ArmCommand& command, const ArmArgs& a) {
-  const std::uint64_t start_cycle = arm.snapshot().cycle;
+/// What a wait loop asks after every look at the arm: nullopt to keep waiting, "" when the command
+/// is done, or why it failed.
+using DoneCheck = std::function<std::optional<std::string>(const jaco::ArmSnapshot&)>;
+
+/// Submits @p command, then waits until @p done says so, feeding the watchdog every 20 ms. Ctrl-C
+/// pulls the emergency stop; a fault or --timeout ends the wait (the timeout stops the arm).
+jaco::ArmSnapshot submit_and_wait(jaco::JacoArm& arm, const jaco::ArmCommand& command,
+                                  const ArmArgs& a, const DoneCheck& done) {
   if (auto ok = arm.submit(command); !ok.has_value()) {
     const int code =
         ok.error().code == jaco::JacoError::Code::REFUSED ? EXIT_USAGE : EXIT_FAILURE_GENERIC;
@@ -51,10 +58,8 @@ void run_until_done(jaco::JacoArm& arm, const jaco::ArmCommand& command, const A
       failure = "the arm faulted: " + jaco::to_string(s.fault_error);
       break;
     }
-    const bool idle = s.control == jaco::ControlState::IDLE;
-    if (idle && s.cycle > start_cycle + 2) {
-      if (s.last_stop != jaco::StopReason::REACHED)
-        failure = std::string("the motion ended: ") + jaco::to_string(s.last_stop);
+    if (const auto verdict = done(s)) {
+      failure = *verdict;
       break;
     }
     if (std::chrono::steady_clock::now() > deadline) {
@@ -66,6 +71,20 @@ void run_until_done(jaco::JacoArm& arm, const jaco::ArmCommand& command, const A
   }
   sigaction(SIGINT, &previous, nullptr);
   if (!failure.empty()) fail(failure);
+  return s;
+}
+
+/// Joint, pose and HOME / RETRACT commands: done when the controller is idle again.
+void run_until_done(jaco::JacoArm& arm, const jaco::ArmCommand& command, const ArmArgs& a) {
+  const std::uint64_t start_cycle = arm.snapshot().cycle;
+  const jaco::ArmSnapshot s =
+      submit_and_wait(arm, command, a, [start_cycle](const jaco::ArmSnapshot& now) {
+        if (now.control != jaco::ControlState::IDLE || now.cycle <= start_cycle + 2)
+          return std::optional<std::string>{};
+        if (now.last_stop == jaco::StopReason::REACHED) return std::optional<std::string>{""};
+        return std::optional<std::string>{std::string("the motion ended: ") +
+                                          jaco::to_string(now.last_stop)};
+      });
   if (a.json) {
     std::cout << snapshot_json(s).dump(2) << '\n';
     return;
@@ -116,25 +135,14 @@ void run_fingers(const ArmArgs& a) {
     command.fingers = {f[0], f[1], f[2]};
   }
   // Finger moves end when the fingers arrive: wait on them instead of the joint controller.
-  if (auto ok = arm->submit(command); !ok.has_value())
-    fail(jaco::to_string(ok.error()), EXIT_USAGE);
-  const auto deadline =
-      std::chrono::steady_clock::now() + std::chrono::duration<double>(a.timeout_s);
-  jaco::ArmSnapshot s;
-  for (;;) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    arm->keep_alive();
-    s = arm->snapshot();
-    if (s.fault) fail("the arm faulted: " + jaco::to_string(s.fault_error));
-    double error = 0.0;
-    for (std::size_t f = 0; f < jaco::FINGERS; ++f)
-      error = std::max(error, std::abs(s.fingers[f] - command.fingers[f]));
-    if (error <= 0.02 * closed) break;
-    if (std::chrono::steady_clock::now() > deadline) {
-      (void)arm->submit(jaco::ArmCommand{jaco::ArmCommand::Kind::STOP});
-      fail("fingers timed out after " + std::to_string(a.timeout_s) + " s; stopped");
-    }
-  }
+  const jaco::ArmSnapshot s =
+      submit_and_wait(*arm, command, a, [&command, closed](const jaco::ArmSnapshot& now) {
+        double error = 0.0;
+        for (std::size_t f = 0; f < jaco::FINGERS; ++f)
+          error = std::max(error, std::abs(now.fingers[f] - command.fingers[f]));
+        return error <= 0.02 * closed ? std::optional<std::string>{""}
+                                      : std::optional<std::string>{};
+      });
   if (a.json) {
     std::cout << snapshot_json(s).dump(2) << '\n';
     return;

@@ -31,8 +31,10 @@ void JacoArm::run() noexcept {
   std::int64_t next = clock_start;
   while (!stop_.load(std::memory_order_acquire)) {
     controller_->cycle();
-    const ArmSnapshot snapshot = controller_->snapshot();
-    for (const StateCallback& callback : options_.subscribers) callback(snapshot);
+    if (!options_.subscribers.empty()) {  // one copy of the snapshot per cycle, and only if used
+      const ArmSnapshot snapshot = controller_->snapshot();
+      for (const StateCallback& callback : options_.subscribers) callback(snapshot);
+    }
     next += ARM_PERIOD_NS;
     // Wait for the next period on the transport's clock: a real transport blocks in its event
     // pump, a simulator advances its time. Bounded: a late cycle starts at once (counted by the
