@@ -25,6 +25,7 @@
 #include "apps/json_numbers.hpp"
 #include "formats/pcd_io.hpp"
 #include "kernels/frame_labels.hpp"
+#include "kernels/pinhole_regrid.hpp"
 #include "kernels/segmentation_chain.hpp"
 
 namespace orthoflow::apps {
@@ -36,6 +37,9 @@ struct SegmentOptions {
   int repeat = 1;
   std::string graph;       ///< empty: the PCL baseline's parameters
   std::string labels_out;  ///< non-empty: write the frame with our per-point labels here
+  /// Put an unorganized camera-frame cloud back on its pixel grid (kernels/pinhole_regrid.hpp) as
+  /// the product's pcd_source does: on with --graph unless --keep-unorganized.
+  bool keep_unorganized = false;
   kernels::SegmentationParams params{};
   kernels::CandidateParams candidates{};
   // flags given on the command line (applied over the graph's parameters)
@@ -112,6 +116,13 @@ void print_text(const nlohmann::json& j) {
     std::printf("plane input: voxel grid, leaf %g m\n", in["leaf"].get<double>());
   } else {
     std::printf("plane input: every point inside the region of interest\n");
+  }
+  if (const auto& g = j["regridded"]; g.is_object() && g.contains("refused")) {
+    std::printf("unorganized cloud kept as it is: %s\n", g["refused"].get<std::string>().c_str());
+  } else if (g.is_object()) {
+    std::printf("unorganized cloud put back on its %ux%u pixel grid (fx %.2f, fy %.2f)\n",
+                g["width"].get<unsigned>(), g["height"].get<unsigned>(), g["fx"].get<double>(),
+                g["fy"].get<double>());
   }
   const auto& n = j["plane"]["normal"];
   std::printf("plane: normal (%.5f, %.5f, %.5f) d %.5f, %zu inliers\n", n[0].get<double>(),
@@ -192,6 +203,15 @@ void run_segment(SegmentOptions& opt) {
     std::cerr << "orthoflow segment: " << cloud_result.error().to_string() << '\n';
     throw CLI::RuntimeError(EXIT_BAD_INPUT);
   }
+  nlohmann::json regridded = nullptr;
+  if (!opt.graph.empty() && !opt.keep_unorganized && !cloud_result->organized()) {
+    if (auto grid = kernels::organize_if_pinhole(*cloud_result)) {
+      regridded = {{"width", grid->width}, {"height", grid->height}, {"fx", grid->fx},
+                   {"fy", grid->fy},       {"cx", grid->cx},         {"cy", grid->cy}};
+    } else {
+      regridded = {{"refused", std::string(kernels::to_string(grid.error()))}};
+    }
+  }
   kernels::SegmentationChain chain(cloud_result->size(), opt.params, opt.candidates);
   std::vector<kernels::SegmentationTimings> runs;
   nlohmann::json out;
@@ -204,6 +224,7 @@ void run_segment(SegmentOptions& opt) {
     runs.push_back(seg_result->timings);
     if (r + 1 == opt.repeat) {
       out = to_json(*seg_result, median_timings(runs), plane_input_json(*cloud_result, opt.params));
+      out["regridded"] = regridded;
       if (!opt.labels_out.empty()) write_labels(*seg_result, opt, *cloud_result);
     }
   }
@@ -227,6 +248,8 @@ void add_segment_command(CLI::App& app) {
   cmd->add_option(
       "--graph", opt->graph,
       "Take the segmentation parameters from this graph file ('tabletop': the embedded one)");
+  cmd->add_flag("--keep-unorganized", opt->keep_unorganized,
+                "With --graph: do not put an unorganized cloud back on its pixel grid");
   cmd->add_option("--labels-out", opt->labels_out,
                   "Write the frame as PCD with a label field: 0 no object, 1 table, k >= 2 "
                   "object k - 2 of the objects list (organized frames)");

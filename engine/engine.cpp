@@ -108,6 +108,7 @@ struct Engine::Impl {
       rt->stats->device = [node = rt->node](std::span<DeviceCounter> out) {
         return node->device_counters(out);
       };
+      rt->stats->counter_group = rt->node->counter_group();
       rt->policy = gr.spec.nodes[i].policy;
       rt->deadline_ns =
           gr.spec.nodes[i].deadline_ns > 0 ? gr.spec.nodes[i].deadline_ns : gr.spec.period_ns;

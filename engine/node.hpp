@@ -71,6 +71,10 @@ class Node {
     (void)out;
     return 0;
   }
+  /// @brief What the counters of device_counters() are about, as the telemetry names them: "device"
+  /// for a camera's own account; a stage reports its own (the table stage: "plane"). Static
+  /// storage.
+  [[nodiscard]] virtual const char* counter_group() const noexcept { return "device"; }
 };
 
 }  // namespace orthoflow::engine

@@ -42,6 +42,8 @@ inline constexpr std::uint32_t OBJECT_KEY_VIEW =
 inline constexpr std::uint32_t OBJECT_FRAGMENT =
     1U << 3;  ///< a piece of an object with the same track id
 inline constexpr std::uint32_t OBJECT_TAUGHT = 1U << 4;  ///< this view was taught in this frame
+/// The answer is its track's from an earlier frame: the recognise node's period had not run out.
+inline constexpr std::uint32_t OBJECT_CARRIED = 1U << 5;
 
 /// @brief Header (64 bytes) + count + up to 64 objects. The user-written empty constructors leave
 /// the members uninitialised on purpose: iceoryx's typed loan() value-initialises its payload, and

@@ -63,7 +63,7 @@ std::string format_table(const GraphStats& stats) {
     std::array<DeviceCounter, MAX_DEVICE_COUNTERS> counters{};
     const std::size_t k = n.device ? std::min(n.device(counters), counters.size()) : 0;
     if (k == 0) continue;
-    table += n.name + " device:";
+    table += n.name + " " + n.counter_group + ":";
     for (std::size_t i = 0; i < k; ++i)
       table += std::string(i == 0 ? " " : ", ") + counters[i].name + " " +
                std::to_string(counters[i].value);
@@ -88,9 +88,9 @@ std::string to_json(const GraphStats& stats) {
     std::array<DeviceCounter, MAX_DEVICE_COUNTERS> counters{};
     const std::size_t k = n.device ? std::min(n.device(counters), counters.size()) : 0;
     if (k > 0) {
-      nlohmann::json device = nlohmann::json::object();
-      for (std::size_t i = 0; i < k; ++i) device[counters[i].name] = counters[i].value;
-      node["device"] = std::move(device);
+      nlohmann::json group = nlohmann::json::object();
+      for (std::size_t i = 0; i < k; ++i) group[counters[i].name] = counters[i].value;
+      node[n.counter_group] = std::move(group);
     }
     nodes.push_back(std::move(node));
   }

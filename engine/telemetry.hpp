@@ -38,6 +38,9 @@ struct NodeStats {
   /// Reads the node's device counters into the span, returns how many (set at start-up for every
   /// node; empty in hand-made stats). Any thread, while the graph lives.
   std::function<std::size_t(std::span<DeviceCounter>)> device;
+  /// What those counters are about (Node::counter_group(): "device", "plane"): the table's label
+  /// and the JSON member they are under.
+  const char* counter_group = "device";
 };
 
 /// @brief Whole-graph counters plus one NodeStats per node (stable addresses: a deque).

@@ -57,7 +57,10 @@ struct ObjectRecord {
   std::array<float, 16> frame{};  ///< world -> object, row-major (kernels::GoodResult::frame)
   std::array<float, 3> bbox{};
   // recognise
-  bool recognised = false;
+  bool recognised = false;  ///< the learner was asked about this view in this frame
+  /// Not asked in this frame (the recognise node's period had not run out for its track): label,
+  /// unknown, score, nearest and runner_up are the track's answer from its last ask.
+  bool carried = false;
   bool unknown = true;
   Text label;  ///< this frame's answer (smoothed over the track)
   float score = 0.0F;
@@ -111,6 +114,7 @@ struct FrameState {
   bool table_found = false;
   kernels::Plane plane{};
   std::uint32_t plane_inliers = 0;
+  kernels::PlaneCheck plane_check{};  ///< how sure the table stage is of the plane
   std::uint32_t hull_count = 0;
   std::uint32_t clusters = 0;           ///< clusters before the candidate constraints
   std::uint32_t rejected_size = 0;      ///< failed C_size

@@ -71,17 +71,17 @@ void fill_object_list(const FrameBlock& block, std::uint64_t frame_id, std::int6
     e.track_id = o.track_id;
     e.label = o.unknown ? Text{} : o.label;
     e.score = o.score;
-    e.unknown = o.unknown || !o.recognised ? 1U : 0U;
+    e.unknown = o.unknown || !(o.recognised || o.carried) ? 1U : 0U;
     std::copy(o.stats.centroid.begin(), o.stats.centroid.end(), e.centroid);
     std::copy(o.frame.begin(), o.frame.end(), e.frame);
     std::copy(o.bbox.begin(), o.bbox.end(), e.bbox);
     std::copy(o.stats.bbox_min.begin(), o.stats.bbox_min.end(), e.bbox_min);
     std::copy(o.stats.bbox_max.begin(), o.stats.bbox_max.end(), e.bbox_max);
     e.point_count = o.count;
-    e.flags = (o.described ? engine::OBJECT_DESCRIBED : 0U) |
-              (o.moving ? engine::OBJECT_MOVING : 0U) |
-              (o.key_view ? engine::OBJECT_KEY_VIEW : 0U) |
-              (o.fragment ? engine::OBJECT_FRAGMENT : 0U) | (o.taught ? engine::OBJECT_TAUGHT : 0U);
+    e.flags =
+        (o.described ? engine::OBJECT_DESCRIBED : 0U) | (o.moving ? engine::OBJECT_MOVING : 0U) |
+        (o.key_view ? engine::OBJECT_KEY_VIEW : 0U) | (o.fragment ? engine::OBJECT_FRAGMENT : 0U) |
+        (o.taught ? engine::OBJECT_TAUGHT : 0U) | (o.carried ? engine::OBJECT_CARRIED : 0U);
   }
 }
 

@@ -25,6 +25,16 @@ PcdDecoder::~PcdDecoder() {
   thread_.join();
 }
 
+void PcdDecoder::read_pcd_into(const std::filesystem::path& file, Slot& slot) {
+  auto cloud = formats::read_pcd(file);
+  slot.ok = static_cast<bool>(cloud);
+  if (cloud) {
+    slot.cloud = std::move(*cloud);
+  } else {
+    slot.error = cloud.error();
+  }
+}
+
 void PcdDecoder::loop() noexcept {
   std::size_t next = 0;
   bool ended = false;
@@ -41,19 +51,11 @@ void PcdDecoder::loop() noexcept {
       ended = true;
     } else {
       try {
-        if (decode_) {
-          slot.end = false;
-          decode_(next++, slot);
-          (void)ready_.try_push(k);
-          continue;
-        }
-        auto cloud = formats::read_pcd(files_[next++]);
         slot.end = false;
-        slot.ok = static_cast<bool>(cloud);
-        if (cloud) {
-          slot.cloud = std::move(*cloud);
+        if (decode_) {
+          decode_(next++, slot);
         } else {
-          slot.error = cloud.error();
+          read_pcd_into(files_[next++], slot);
         }
       } catch (const std::exception& e) {  // std::bad_alloc: a frame error, not a dead thread
         slot.end = false;

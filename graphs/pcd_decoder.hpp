@@ -48,6 +48,8 @@ class PcdDecoder {
   [[nodiscard]] Slot* next(std::chrono::milliseconds timeout) noexcept;
   /// @brief Gives the slot of the last next() back to the decoder.
   void release() noexcept;
+  /// @brief The default decoding: formats::read_pcd of @p file into @p slot (ok, cloud or error).
+  static void read_pcd_into(const std::filesystem::path& file, Slot& slot);
 
  private:
   void loop() noexcept;

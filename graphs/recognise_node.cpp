@@ -28,6 +28,9 @@ constexpr std::array<std::uint32_t, 3> INSTRUCTOR_AGES{5, 15,
 struct RecogniseParams {
   std::uint32_t smoothing = 5;
   bool instructor = false;
+  /// A track is asked about again only this long after its last ask (0: every frame), unless its
+  /// view is a key view or a lesson changed the memory since; between asks it keeps its answer.
+  std::int64_t period_ns = 0;
 };
 
 /// The instructor's record of one category: the track it teaches it from.
@@ -51,20 +54,46 @@ class Recognise final : public engine::Node {
   void process(const Message& in, engine::Emitter& out) noexcept override {
     const FrameBlock block = block_of(in, capacity_);
     FrameState& s = block.state();
-    for (std::uint32_t k = 0; k < s.object_count; ++k) recognise(block, k, in.frame_id);
+    auto frame = block.frame();
+    const std::int64_t stamp = frame ? frame->header->sensor_stamp_ns : in.stamp_ns;
+    const bool ask_all = memory_changed_;  // a lesson of the last frame may change every answer
+    memory_changed_ = false;
+    for (std::uint32_t k = 0; k < s.object_count; ++k)
+      recognise(block, k, in.frame_id, stamp, ask_all);
     LearningCommand command;
     for (std::size_t n = 0; n < MAX_COMMANDS_PER_FRAME && service_.poll(command); ++n) {
       desk_.apply(block, command, in.frame_id);
+      memory_changed_ = memory_changed_ || command.kind != LearningCommand::Kind::ASK;
     }
     if (p_.instructor) instruct(block, in.frame_id);
     out.emit(0, in);
   }
 
  private:
-  void recognise(const FrameBlock& block, std::uint32_t k, std::uint64_t frame) noexcept {
+  /// True if the track's answer from its last ask still stands in the frame stamped @p stamp.
+  [[nodiscard]] bool carries(const TrackMemory* t, const ObjectRecord& o, std::int64_t stamp,
+                             bool ask_all) const noexcept {
+    return p_.period_ns > 0 && t != nullptr && t->asked && !ask_all && !o.key_view &&
+           stamp >= t->asked_ns && stamp - t->asked_ns < p_.period_ns;
+  }
+
+  void recognise(const FrameBlock& block, std::uint32_t k, std::uint64_t frame, std::int64_t stamp,
+                 bool ask_all) noexcept {
     ObjectRecord& o = block.state().objects[k];
     if (o.fragment || !o.described || o.descriptor_length != service_.descriptor_length()) return;
     const auto descriptor = block.descriptor(k).first(o.descriptor_length);
+    if (TrackMemory* known = o.track_id == 0 ? nullptr : memories_.find(o.track_id);
+        carries(known, o, stamp, ask_all)) {
+      known->last_frame = frame;
+      ++known->age;
+      o.carried = true;
+      o.label = known->label;
+      o.unknown = known->label.empty();
+      o.score = known->score;
+      o.nearest = known->nearest;
+      o.runner_up = known->runner_up;
+      return;
+    }
     const auto prediction = service_.learner().ask(descriptor, scratch_);
     o.recognised = true;
     o.score = prediction.score;
@@ -83,6 +112,12 @@ class Recognise final : public engine::Node {
     if (o.key_view) memories_.add_key_view(t, descriptor);
     o.label = memories_.vote(t, answer, p_.smoothing);
     o.unknown = o.label.empty();
+    t.asked = true;
+    t.asked_ns = stamp;
+    t.label = o.label;
+    t.score = o.score;
+    t.nearest = o.nearest;
+    t.runner_up = o.runner_up;
   }
 
   void instruct(const FrameBlock& block, std::uint64_t frame) noexcept {
@@ -107,6 +142,7 @@ class Recognise final : public engine::Node {
                               INSTRUCTOR_AGES.end()) {
         (void)desk_.teach_object(block, k, o.truth_category.view(), LearningAck{},
                                  static_cast<std::int64_t>(frame));
+        memory_changed_ = true;
       }
     }
   }
@@ -119,6 +155,7 @@ class Recognise final : public engine::Node {
   LessonDesk desk_;
   std::array<InstructorEntry, MAX_CATEGORIES> categories_{};
   std::size_t categories_used_ = 0;
+  bool memory_changed_ = false;  // a lesson was applied in the last frame: ask every track again
 };
 
 }  // namespace
@@ -128,18 +165,24 @@ void add_recognise_node(engine::NodeRegistry& registry, LearningService& service
       "recognise",
       "asks the learner per object, smooths per track, keeps key views, applies the learning "
       "channel's "
-      "commands: smoothing (answers), instructor=0|1 (scripted teacher of the synthetic session)",
+      "commands: smoothing (answers), instructor=0|1 (scripted teacher of the synthetic session), "
+      "period_ms (ask each track at most this often, 0 = every frame; key views and lessons ask "
+      "again at once)",
       [&service](const engine::ParamMap& params, const engine::NodeContext& context) -> NodeResult {
         auto capacity = frame_capacity(context);
         if (!capacity) return err(capacity.error());
-        if (auto ok = params.only({"smoothing", "instructor"}); !ok) return err(ok.error());
+        if (auto ok = params.only({"smoothing", "instructor", "period_ms"}); !ok)
+          return err(ok.error());
         RecogniseParams p;
         std::string e;
         std::int64_t instructor = 0;
+        double period_ms = 0.0;
         take(params.integer("smoothing", p.smoothing, 1, MAX_VOTES), p.smoothing, e);
         take(params.integer("instructor", 0, 0, 1), instructor, e);
+        take(params.number("period_ms", 0.0, 0.0, 60000.0), period_ms, e);
         if (!e.empty()) return err(e);
         p.instructor = instructor == 1;
+        p.period_ns = static_cast<std::int64_t>(period_ms * 1e6);
         return std::unique_ptr<engine::Node>(new Recognise(*capacity, p, service));
       });
 }

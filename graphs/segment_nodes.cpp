@@ -10,6 +10,7 @@
 #include <new>
 
 #include "graphs/node_support.hpp"
+#include "graphs/plane_quality.hpp"
 #include "graphs/segment_params.hpp"
 
 namespace orthoflow::graphs {
@@ -87,18 +88,25 @@ class Table final : public FrameStage {
       if (auto table = stage_.run(plane_input(block), params_, block.hull_u(), block.hull_v())) {
         s.plane = table->plane.plane;
         s.plane_inliers = static_cast<std::uint32_t>(table->plane.inliers);
+        s.plane_check = table->check;
         s.hull_count = static_cast<std::uint32_t>(table->hull_u.size());
         s.table_found = true;
+        quality_.record(table->check);
       } else {
         s.error.set(name_, table.error());
       }
     }
     out.emit(0, in);
   }
+  const char* counter_group() const noexcept override { return "plane"; }
+  std::size_t device_counters(std::span<engine::DeviceCounter> out) const noexcept override {
+    return quality_.read(out);
+  }
 
  private:
   kernels::SegmentationParams params_;
   kernels::TableStage stage_;
+  PlaneQualityCounters quality_;
 };
 
 NodeResult make_preprocess(const ParamMap& params, const engine::NodeContext& context) {

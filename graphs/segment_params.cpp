@@ -49,10 +49,11 @@ Result<void, std::string> parse_table_params(const engine::ParamMap& params,
 
 Result<void, std::string> parse_objects_params(const engine::ParamMap& params,
                                                TabletopSegmentation& out) {
-  if (auto ok = params.only({"h_min", "h_max", "tolerance", "min_points", "max_points",
-                             "pixel_radius", "min_size", "max_size", "edge_margin", "merge_overlap",
-                             "cluster_mode", "crease_angle", "crease_gap", "normal_offset",
-                             "max_rise", "depth_change", "stand_height"});
+  if (auto ok = params.only({"h_min",        "h_max",          "tolerance",    "min_points",
+                             "max_points",   "pixel_radius",   "min_size",     "max_size",
+                             "edge_margin",  "merge_overlap",  "cluster_mode", "crease_angle",
+                             "crease_gap",   "normal_offset",  "max_rise",     "depth_change",
+                             "stand_height", "occlusion_rows", "occluder_gap", "occlusion_top"});
       !ok) {
     return err(ok.error());
   }
@@ -83,6 +84,9 @@ Result<void, std::string> parse_objects_params(const engine::ParamMap& params,
        e);
   take(params.number("max_rise", k.max_rise, 0.0, 1.0), k.max_rise, e);
   take(params.number("stand_height", k.stand_height, 0.0, 1.0), k.stand_height, e);
+  take(params.integer("occlusion_rows", k.occlusion_rows, 0, 10000), k.occlusion_rows, e);
+  take(params.number("occluder_gap", k.occluder_gap, 0.0, 1.0), k.occluder_gap, e);
+  take(params.number("occlusion_top", k.occlusion_top, 0.0, 1.0), k.occlusion_top, e);
   take(params.number("min_size", c.min_size, 0.0, 10.0), c.min_size, e);
   take(params.number("max_size", c.max_size, 0.0, 10.0), c.max_size, e);
   take(params.number("edge_margin", c.edge_margin, -1.0, 1.0), c.edge_margin, e);

@@ -81,6 +81,26 @@ void SessionLog::record(const FrameBlock& block, std::uint64_t frame_id) noexcep
   if (s.object_count > 0) keep_snapshot(block, frame_id);
 }
 
+namespace {
+
+/// `"plane":{...},"objects":[` (the plane null when the frame has none): the table plane (normal .
+/// p + d = 0, sensor frame, metres), its inlier count on the dense sample and how sure the table
+/// stage is of it (kernels::PlaneCheck). @return the characters written.
+std::size_t write_plane(const FrameState& s, char* out, std::size_t cap) noexcept {
+  if (!s.table_found)
+    return static_cast<std::size_t>(std::snprintf(out, cap, R"("plane":null,"objects":[)"));
+  const auto& n = s.plane.normal;
+  const kernels::PlaneCheck& c = s.plane_check;
+  const auto finite = [](float v) { return std::isfinite(v) ? static_cast<double>(v) : 0.0; };
+  return static_cast<std::size_t>(std::snprintf(
+      out, cap,
+      R"("plane":{"normal":[%.6f,%.6f,%.6f],"d":%.6f,"inliers":%u,"near_share":%.4f,"rms_m":%.6f,"switched":%s},"objects":[)",
+      finite(n[0]), finite(n[1]), finite(n[2]), finite(s.plane.d), s.plane_inliers,
+      finite(c.near_share), finite(c.rms_m), c.switched ? "true" : "false"));
+}
+
+}  // namespace
+
 void SessionLog::write_json(const FrameBlock& block, std::uint64_t frame_id) noexcept {
   const FrameState& s = block.state();
   auto frame = block.frame();
@@ -88,9 +108,10 @@ void SessionLog::write_json(const FrameBlock& block, std::uint64_t frame_id) noe
   char* out = line_.data();
   const std::size_t cap = line_.size();
   std::size_t n = static_cast<std::size_t>(
-      std::snprintf(out, cap, R"({"frame":%llu,"stamp_ns":%lld,"table":%s,"objects":[)",
+      std::snprintf(out, cap, R"({"frame":%llu,"stamp_ns":%lld,"table":%s,)",
                     static_cast<unsigned long long>(frame_id), static_cast<long long>(stamp),
                     s.table_found ? "true" : "false"));
+  n += write_plane(s, out + n, cap - n);
   for (std::uint32_t k = 0; k < s.object_count && n + 2048 < cap; ++k) {
     const ObjectRecord& o = s.objects[k];
     // Labels are category names given by people: escape nothing but refuse quotes/backslashes in
@@ -102,11 +123,11 @@ void SessionLog::write_json(const FrameBlock& block, std::uint64_t frame_id) noe
       std::snprintf(score, sizeof score, "%.6g", static_cast<double>(o.score));
     n += static_cast<std::size_t>(std::snprintf(
         out + n, cap - n,
-        R"(%s{"track":%u,"label":%s%.*s%s,"unknown":%s,"score":%s,"nearest":"%.*s","truth":"%.*s","points":%u,"centroid":[%.5f,%.5f,%.5f],"bbox":[%.5f,%.5f,%.5f],"frame":[)",
+        R"(%s{"track":%u,"label":%s%.*s%s,"unknown":%s,"carried":%s,"score":%s,"nearest":"%.*s","truth":"%.*s","points":%u,"centroid":[%.5f,%.5f,%.5f],"bbox":[%.5f,%.5f,%.5f],"frame":[)",
         k == 0 ? "" : ",", o.track_id, o.unknown || !plain ? "null" : "\"",
         o.unknown || !plain ? 0 : static_cast<int>(label.size()), label.data(),
-        o.unknown || !plain ? "" : "\"", o.unknown ? "true" : "false", score,
-        plain ? static_cast<int>(o.nearest.view().size()) : 0, o.nearest.view().data(),
+        o.unknown || !plain ? "" : "\"", o.unknown ? "true" : "false", o.carried ? "true" : "false",
+        score, plain ? static_cast<int>(o.nearest.view().size()) : 0, o.nearest.view().data(),
         static_cast<int>(o.truth_category.view().size()), o.truth_category.view().data(), o.count,
         static_cast<double>(o.stats.centroid[0]), static_cast<double>(o.stats.centroid[1]),
         static_cast<double>(o.stats.centroid[2]), static_cast<double>(o.bbox[0]),

@@ -1,6 +1,8 @@
 #include "graphs/source_nodes.hpp"
 
 #include <algorithm>
+#include <array>
+#include <atomic>
 #include <chrono>
 #include <filesystem>
 #include <new>
@@ -11,6 +13,7 @@
 #include "graphs/node_support.hpp"
 #include "graphs/pcd_decoder.hpp"
 #include "graphs/session_script.hpp"
+#include "kernels/pinhole_regrid.hpp"
 #include "simulation/object_catalog.hpp"
 
 namespace orthoflow::graphs {
@@ -55,8 +58,23 @@ class PcdSource final : public FrameSource {
  public:
   static constexpr std::chrono::milliseconds DECODE_TIMEOUT{5000};
   PcdSource(std::size_t capacity, const engine::NodeContext& context,
-            std::vector<std::filesystem::path> files, bool loop)
-      : FrameSource(capacity, context), decoder_(std::move(files), loop) {}
+            std::vector<std::filesystem::path> files, bool loop, bool organize)
+      : FrameSource(capacity, context),
+        decoder_(files, loop, 3,
+                 [this, files, organize](std::size_t index, PcdDecoder::Slot& slot) {
+                   PcdDecoder::read_pcd_into(files[index], slot);
+                   if (slot.ok && organize && !slot.cloud.organized()) organize_cloud(slot.cloud);
+                 }) {}
+  const char* counter_group() const noexcept override { return "decode"; }
+  std::size_t device_counters(std::span<engine::DeviceCounter> out) const noexcept override {
+    const std::array<engine::DeviceCounter, 2> all{{
+        {"regridded", regridded_.load(std::memory_order_relaxed)},
+        {"left_unorganized", left_unorganized_.load(std::memory_order_relaxed)},
+    }};
+    const std::size_t k = std::min(out.size(), all.size());
+    std::copy_n(all.begin(), k, out.begin());
+    return k;
+  }
   engine::SourceStatus produce(Message& out) noexcept override {
     PcdDecoder::Slot* slot = decoder_.next(DECODE_TIMEOUT);
     if (slot != nullptr && slot->end) return engine::SourceStatus::END;
@@ -88,6 +106,21 @@ class PcdSource final : public FrameSource {
   }
 
  private:
+  /// On the decoder thread: an unorganized cloud that a pinhole camera took goes back on its pixel
+  /// grid (kernels/pinhole_regrid.hpp), so it takes the organized chain; any other stays as it is.
+  /// (A grid larger than the pool block keeps the cloud unorganized, which fits.)
+  void organize_cloud(kernels::PointCloud& cloud) {
+    const auto grid = kernels::find_pinhole_grid(cloud.points());
+    if (!grid || std::size_t{grid->width} * grid->height > capacity_) {
+      left_unorganized_.fetch_add(1, std::memory_order_relaxed);
+      return;
+    }
+    kernels::PointCloud organized;
+    kernels::regrid(cloud, *grid, organized);
+    cloud = std::move(organized);
+    regridded_.fetch_add(1, std::memory_order_relaxed);
+  }
+  std::atomic<std::uint64_t> regridded_{0}, left_unorganized_{0};  // before decoder_: its thread
   PcdDecoder decoder_;
   std::uint64_t frame_ = 0;
 };
@@ -116,11 +149,12 @@ NodeResult make_synthetic(const ParamMap& params, const engine::NodeContext& con
 NodeResult make_pcd(const ParamMap& params, const engine::NodeContext& context) {
   auto capacity = frame_capacity(context);
   if (!capacity) return err(capacity.error());
-  if (auto ok = params.only({"dir", "loop"}); !ok) return err(ok.error());
+  if (auto ok = params.only({"dir", "loop", "organize"}); !ok) return err(ok.error());
   std::string dir, e;
-  std::int64_t loop = 0;
+  std::int64_t loop = 0, organize = 1;
   take(params.text("dir", ""), dir, e);
   take(params.integer("loop", 0, 0, 1), loop, e);
+  take(params.integer("organize", 1, 0, 1), organize, e);
   if (!e.empty()) return err(e);
   std::error_code ec;
   std::vector<std::filesystem::path> files;
@@ -131,7 +165,7 @@ NodeResult make_pcd(const ParamMap& params, const engine::NodeContext& context) 
   if (files.empty()) return err("pcd_source: no .pcd files in '" + dir + "'");
   std::sort(files.begin(), files.end());
   return std::unique_ptr<engine::Node>(
-      new PcdSource(*capacity, context, std::move(files), loop == 1));
+      new PcdSource(*capacity, context, std::move(files), loop == 1, organize == 1));
 }
 
 }  // namespace
@@ -140,7 +174,10 @@ void add_source_nodes(engine::NodeRegistry& registry) {
   registry.add("synthetic_source",
                "synthetic Kinect v1 frames: seed, frames, objects (0 = embedded session)",
                make_synthetic);
-  registry.add("pcd_source", "the .pcd files of a folder in name order: dir, loop=0|1", make_pcd);
+  registry.add("pcd_source",
+               "the .pcd files of a folder in name order: dir, loop=0|1, organize=0|1 (put "
+               "unorganized camera-frame clouds back on their pixel grid; default 1)",
+               make_pcd);
 }
 
 }  // namespace orthoflow::graphs

@@ -30,6 +30,12 @@ struct TrackMemory {
   std::uint32_t key_views =
       0;  ///< key views recorded (ring position; the newest MAX_KEY_VIEWS are kept)
   std::uint32_t untaught = 0;  ///< how many of the newest kept key views no teach has stored yet
+  // The answer of the track's last ask, shown in the frames the recognise node's period skips.
+  bool asked = false;         ///< the learner was asked about this track at least once
+  std::int64_t asked_ns = 0;  ///< stamp of the frame of that ask
+  Text label;                 ///< its smoothed answer (empty: Unknown)
+  float score = 0.0F;
+  Text nearest, runner_up;
 };
 
 /// @brief The memories of up to MAX_OBJECTS tracks (the least recently seen is reused).

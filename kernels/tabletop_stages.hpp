@@ -60,6 +60,13 @@ struct CreaseParams {
   /// Rounds of re-attaching crease pixels to the piece beside them (each reaches pixel_radius
   /// further into the crease band).
   std::uint32_t attach_rounds = 4;
+  /// Crowded mode, occlusion join (kernels/occlusion_join.cpp): two pieces standing on the table
+  /// with tops within occlusion_top of each other are one object seen on both sides of a nearer
+  /// one when at least occlusion_rows image rows (and 30 % of the shorter piece's rows) run piece,
+  /// occluder at least occluder_gap nearer, piece. 0 rows: off. Metres.
+  std::uint32_t occlusion_rows = 8;
+  float occluder_gap = 0.02F;
+  float occlusion_top = 0.015F;
 };
 
 /// @brief Chain settings; defaults are the PCL baseline's (specs/BASELINES.md).
@@ -137,6 +144,8 @@ struct PlaneInput {
 /// tell the table from that plane. A narrower organized frame takes the voxel grid of every kept
 /// pixel, as an unorganized cloud does (the prism and the clustering still run on its pixels).
 inline constexpr std::uint32_t MIN_SAMPLE_LINES = 3;
+/// @brief Pieces the occlusion join considers (the first ones; a cluttered frame has more).
+inline constexpr std::size_t MAX_OCCLUSION_PIECES = 64;
 
 /// @brief The number of sample lines pixel_subsample takes across @p extent pixels at @p stride.
 /// @pre stride >= 1.
@@ -249,6 +258,10 @@ class ObjectStage {
   std::size_t merge_footprints(PointsView target, std::span<const std::uint32_t> members,
                                const PlaneBasis& basis, std::size_t clusters, float overlap,
                                float max_rise, float stand_height, float attach_gap) noexcept;
+  /// Crowded mode, organized: joins the pieces an occluder cut apart (CreaseParams::occlusion_*);
+  /// @return the cluster count after. kernels/occlusion_join.cpp.
+  std::size_t join_occluded(CloudView cloud, std::span<const std::uint32_t> members,
+                            std::size_t clusters, const CreaseParams& p) noexcept;
   /// Crowded mode, organized: clusters of the prism pixels off the creases, then the crease pixels
   /// re-attached; members_ lists every prism pixel. kernels/crease_split.cpp.
   [[nodiscard]] Result<std::size_t, ClusterError> cluster_crowded(
@@ -262,11 +275,13 @@ class ObjectStage {
   std::vector<std::array<double, 7>>
       footprints_;  // u, v box, highest, lowest height, lies on/under
   std::vector<std::int32_t> root_, new_id_;
-  std::vector<float> nx_, ny_, nz_;       // crowded mode: per-pixel normals
-  std::vector<std::uint8_t> off_crease_;  // crowded mode: prism pixels off the creases
-  std::vector<std::uint8_t> round_;       // crowded mode: attach round of each pixel
-  std::vector<std::uint32_t> members_;    // crowded mode: every prism pixel, ascending
-  std::vector<std::uint32_t> pending_;    // crowded mode: crease pixels not yet attached
+  std::vector<float> nx_, ny_, nz_;           // crowded mode: per-pixel normals
+  std::vector<std::uint8_t> off_crease_;      // crowded mode: prism pixels off the creases
+  std::vector<std::uint8_t> round_;           // crowded mode: attach round of each pixel
+  std::vector<std::uint32_t> members_;        // crowded mode: every prism pixel, ascending
+  std::vector<std::uint32_t> pending_;        // crowded mode: crease pixels not yet attached
+  std::vector<std::uint16_t> votes_;          // occlusion join: rows per piece pair
+  std::vector<std::array<float, 4>> pieces_;  // occlusion join: top, bottom, first row, last row
 };
 
 }  // namespace orthoflow::kernels

@@ -5,12 +5,14 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <set>
 #include <string>
 
+#include "formats/pcd_io.hpp"
 #include "tabletop_run.hpp"
 
 namespace orthoflow::graphs {
@@ -19,6 +21,7 @@ namespace {
 struct SessionRun {
   SessionSummary summary;
   std::vector<nlohmann::json> frames;  // the JSON lines
+  nlohmann::json telemetry;            // engine::to_json after the run
 };
 
 SessionRun run_graph(const test::Overrides& overrides, int threads, LearningService& learning) {
@@ -38,6 +41,7 @@ SessionRun run_graph(const test::Overrides& overrides, int threads, LearningServ
     engine::Engine engine(**graph, {threads});
     engine.run({});
     result.summary = log.summary();
+    result.telemetry = nlohmann::json::parse(engine::to_json(engine.stats()));
   }  // the writer flushes and closes here
   std::ifstream in(path);
   for (std::string line; std::getline(in, line);)
@@ -137,7 +141,122 @@ TEST(TabletopSession, FindsTheObjectsOfTheRealKinectFrames) {
   for (const auto& f : r.frames) {
     EXPECT_TRUE(f["table"].get<bool>()) << f["frame"];
     EXPECT_GE(f["objects"].size(), 2U) << f["frame"];
+    // The plane and how sure the table stage is of it, per frame.
+    const auto& plane = f["plane"];
+    ASSERT_TRUE(plane.is_object()) << f["frame"];
+    const double nx = plane["normal"][0], ny = plane["normal"][1], nz = plane["normal"][2];
+    EXPECT_NEAR(nx * nx + ny * ny + nz * nz, 1.0, 1e-4) << f["frame"];
+    EXPECT_GT(plane["inliers"].get<int>(), 1000) << f["frame"];
+    EXPECT_GE(plane["near_share"].get<double>(), 0.9) << f["frame"];  // 0.927 for test55
+    EXPECT_GT(plane["rms_m"].get<double>(), 0.0) << f["frame"];
+    EXPECT_LT(plane["rms_m"].get<double>(), 0.01) << f["frame"];
+    EXPECT_FALSE(plane["switched"].get<bool>()) << f["frame"];
   }
+}
+
+/// The telemetry node called @p name.
+nlohmann::json node_of(const SessionRun& r, const std::string& name) {
+  for (const auto& n : r.telemetry["nodes"])
+    if (n["name"] == name) return n;
+  return {};
+}
+
+// A frame stored without its invalid pixels (HEIGHT 1, as ROS bags keep them) goes back on its
+// pixel grid in pcd_source's decoder and takes the organized chain: the same objects as the
+// organized file. With organize 0 it takes the voxel grid.
+TEST(TabletopSession, UnorganizedFramesGoBackOnTheirGrid) {
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("orthoflow_flat_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir / "organized");
+  std::filesystem::create_directories(dir / "flat");
+  for (const char* name : {"learn0", "learn21", "learn40"}) {
+    const std::string file =
+        std::string(ORTHOFLOW_SHARED_DIR) + "/data/mosd_learn/" + name + ".pcd";
+    auto cloud = formats::read_pcd(file);
+    ASSERT_TRUE(cloud) << file;
+    std::filesystem::copy_file(file, dir / "organized" / (std::string(name) + ".pcd"));
+    kernels::PointCloud flat;
+    flat.add_field(kernels::Field::RGB);
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < cloud->size(); ++i) n += std::isfinite(cloud->z()[i]) ? 1U : 0U;
+    flat.resize_unorganized(n);
+    for (std::size_t i = 0, k = 0; i < cloud->size(); ++i) {
+      if (!std::isfinite(cloud->z()[i])) continue;
+      flat.x()[k] = cloud->x()[i];
+      flat.y()[k] = cloud->y()[i];
+      flat.z()[k] = cloud->z()[i];
+      flat.rgb()[k++] = cloud->has(kernels::Field::RGB) ? cloud->rgb()[i] : 0U;
+    }
+    ASSERT_TRUE(formats::write_pcd(flat, (dir / "flat" / (std::string(name) + ".pcd")).string(),
+                                   formats::PcdEncoding::BINARY));
+  }
+  auto l1 = test::in_memory_learning(), l2 = test::in_memory_learning(),
+       l3 = test::in_memory_learning();
+  const auto source = [&](const char* sub, const char* organize) {
+    return test::Overrides{
+        {"source", {{"kind", "pcd_source"}, {"dir", (dir / sub).string()}, {"organize", organize}}},
+        {"recognise", {{"instructor", "0"}}}};
+  };
+  const auto organized = run_graph(source("organized", "1"), 1, *l1);
+  const auto regridded = run_graph(source("flat", "1"), 1, *l2);
+  const auto voxels = run_graph(source("flat", "0"), 1, *l3);
+  std::filesystem::remove_all(dir);
+  EXPECT_EQ(node_of(regridded, "source")["decode"]["regridded"], 3);
+  EXPECT_EQ(node_of(regridded, "source")["decode"]["left_unorganized"], 0);
+  EXPECT_EQ(node_of(voxels, "source")["decode"]["regridded"], 0);
+  EXPECT_EQ(node_of(organized, "table")["plane"]["frames"], 3);
+  ASSERT_EQ(regridded.frames.size(), 3U);
+  for (std::size_t f = 0; f < 3; ++f) {
+    const auto& a = organized.frames[f]["objects"];
+    const auto& b = regridded.frames[f]["objects"];
+    ASSERT_EQ(a.size(), b.size()) << "frame " << f;
+    for (std::size_t k = 0; k < a.size(); ++k) {
+      double d2 = 0.0;
+      for (int i = 0; i < 3; ++i) {
+        const double d = a[k]["centroid"][i].get<double>() - b[k]["centroid"][i].get<double>();
+        d2 += d * d;
+      }
+      EXPECT_LT(std::sqrt(d2), 0.005) << "frame " << f << " object " << k;
+      EXPECT_NEAR(a[k]["points"].get<double>(), b[k]["points"].get<double>(),
+                  0.02 * a[k]["points"].get<double>())
+          << "frame " << f << " object " << k;
+    }
+  }
+}
+
+// Recognition at a lower rate than tracking (recognise period_ms): between asks a track keeps the
+// answer of its last ask, marked carried; key views and lessons ask again at once.
+TEST(TabletopSession, RecognitionPeriodCarriesEachTracksAnswerBetweenAsks) {
+  auto every_frame = test::in_memory_learning();
+  auto periodic = test::in_memory_learning();
+  const auto a = run_graph(SESSION, 2, *every_frame);
+  const auto b = run_graph({{"source", {{"frames", "90"}}}, {"recognise", {{"period_ms", "500"}}}},
+                           2, *periodic);
+  ASSERT_EQ(a.frames.size(), 90U);
+  ASSERT_EQ(b.frames.size(), 90U);
+  int carried_a = 0, asked_b = 0, carried_b = 0;
+  std::map<int, nlohmann::json> last;  // track -> its previous object in b
+  for (std::size_t i = 0; i < b.frames.size(); ++i) {
+    for (const auto& o : a.frames[i]["objects"]) carried_a += o["carried"].get<bool>() ? 1 : 0;
+    for (const auto& o : b.frames[i]["objects"]) {
+      const int track = o["track"];
+      if (o["carried"].get<bool>()) {
+        ++carried_b;
+        ASSERT_TRUE(last.count(track)) << "frame " << i << ": carried before any ask";
+        EXPECT_EQ(o["label"], last[track]["label"]) << "frame " << i << " track " << track;
+      } else if (o["nearest"] != "" || !o["unknown"].get<bool>()) {
+        ++asked_b;
+      }
+      last[track] = o;
+    }
+  }
+  EXPECT_EQ(carried_a, 0);            // period 0: every frame asks
+  EXPECT_GT(carried_b, 3 * asked_b);  // 500 ms at 30 Hz: most frames carry
+  EXPECT_GT(asked_b, 0);
+  // The lessons still land: the same categories are taught and recognised after teaching.
+  EXPECT_EQ(b.summary.taught, a.summary.taught);
+  EXPECT_GT(b.summary.after_teaching.asked, 0U);
+  EXPECT_GE(b.summary.after_teaching.right * 10, b.summary.after_teaching.asked * 8);
 }
 
 }  // namespace

@@ -122,6 +122,33 @@ TEST(CrowdedMode, TouchingObjectsAndSingleObjectsStayRight) {
   }
 }
 
+TEST(CrowdedMode, JoinsTheTwoSidesOfAnObjectBehindANearerOne) {
+  // mOSD learn28, learn31, learn32: a box behind a bottle, seen left and right of it. Without the
+  // occlusion join the box is two pieces (over-segmented); with it, one object, and each frame's
+  // two objects are found.
+  for (const char* name : {"learn28", "learn31", "learn32"}) {
+    auto cloud = orthoflow::formats::read_pcd(std::string(ORTHOFLOW_SHARED_DIR) +
+                                              "/data/mosd_learn/" + name + ".pcd");
+    ASSERT_TRUE(cloud) << cloud.error().to_string();
+    auto seg = tabletop(ok::ClusterMode::CROWDED);
+    EXPECT_GT(seg.stages.crease.occlusion_rows, 0U);  // on by default
+    const auto score = [&](const orthoflow::graphs::TabletopSegmentation& s) {
+      const auto out = orthoflow::evaluation::make_chain_segmenter(s.stages, s.candidates)(*cloud);
+      EXPECT_TRUE(out.error.empty()) << out.error;
+      return orthoflow::evaluation::score_objects(cloud->label(), out.labels);
+    };
+    const auto joined = score(seg);
+    seg.stages.crease.occlusion_rows = 0;
+    const auto apart = score(seg);
+    EXPECT_EQ(joined.truth, 2U) << name;
+    EXPECT_EQ(joined.matched, 2U) << name;
+    EXPECT_EQ(joined.over, 0U) << name;
+    EXPECT_EQ(joined.predicted, 2U) << name;
+    EXPECT_GE(apart.over, 1U) << name;
+    EXPECT_EQ(apart.predicted, 3U) << name;
+  }
+}
+
 TEST(CrowdedMode, SplitsARealStackAndAllocatesNothingWhenWarm) {
   // mOSD learn21: two boxes on a third: Euclidean clustering gives at most one right object, the
   // crowded mode at least two; a second run of the same frame allocates nothing and repeats
