@@ -18,6 +18,7 @@
 #include "apps/commands.hpp"
 #include "apps/graph_overrides.hpp"
 #include "apps/graph_run.hpp"
+#include "apps/run_ui.hpp"
 #include "apps/scene_snapshot_png.hpp"
 #include "engine/engine.hpp"
 #include "engine/graph.hpp"
@@ -56,6 +57,8 @@ struct RunOptions {
   bool publish_objects = false;  // every frame's objects to orthoflow/<graph>/objects over iceoryx
   std::string on_bad_frame = "skip";  // skip: count and report; fail: also exit 2
   int threads = 0;
+  std::string ui;             // --ui [ADDR:]PORT: the web view beside the graph (empty: off)
+  std::string ui_token_file;  // --ui-token-file FILE
 };
 
 [[noreturn]] void fail(const std::string& message, int code) {
@@ -245,17 +248,25 @@ void run(const RunOptions& o) {
     if (!writer) fail(writer.error(), EXIT_FAILURE_GENERIC);
     labels = std::move(*writer);
   }
-  const auto registry = graphs::make_tabletop_registry(**learning, log, nullptr, labels.get());
+  // The web view reads every frame's objects through the hub (only when --ui asks for it).
+  graphs::ObjectsHub objects;
+  const auto registry = graphs::make_tabletop_registry(
+      **learning, log, o.ui.empty() ? nullptr : &objects, labels.get());
   auto graph = engine::build_graph(*spec, registry);
   if (!graph) fail(engine::to_string(graph.error()), EXIT_BAD_INPUT);
   g_run_stop.store(false);
   auto previous_int = std::signal(SIGINT, on_run_signal);
   auto previous_term = std::signal(SIGTERM, on_run_signal);
   engine::Engine engine(**graph, {o.threads});
+  std::unique_ptr<RunUi> ui;
+  if (!o.ui.empty()) {
+    ui = start_run_ui(o.ui, o.ui_token_file, **learning, objects, engine.stats(), spec->period_ns);
+  }
   // --publish-objects: a lost RouDi ends the run within ~100 ms (docs/IPC.md), exit 22 below.
   const auto reason = run_watching_roudi(engine, {o.frames, &g_run_stop});
   std::signal(SIGINT, previous_int);
   std::signal(SIGTERM, previous_term);
+  ui.reset();  // the server and its learning client go before the graph's results are read
   (*learning)->flush();
   if (log.json() != nullptr) log.json()->flush();
   if (labels) report_labels(*labels, o);
@@ -313,6 +324,14 @@ void add_run_command(CLI::App& app) {
       "publish every frame's objects on the iceoryx topic orthoflow/<graph>/objects (needs RouDi)");
   cmd->add_option("--threads", o->threads, "arena threads (0 = all cores)")
       ->check(CLI::Range(0, 1024));
+  auto* ui = cmd->add_option("--ui", o->ui,
+                             "serve the live web view and its JSON API on [ADDR:]PORT while the "
+                             "graph runs (default address 127.0.0.1; another address needs the "
+                             "bearer token printed at start; ui/README.md)")
+                 ->check(check_ui_listen);
+  cmd->add_option("--ui-token-file", o->ui_token_file,
+                  "read the web view's bearer token from FILE instead of generating one")
+      ->needs(ui);
   cmd->callback([o] { run(*o); });
 }
 

@@ -65,6 +65,9 @@ struct LearningAck {
   core::Text label;     ///< TEACH / CORRECT / FORGET: the label; ASK: the answer (empty = Unknown)
   float score = 0.0F;   ///< ASK: the learner's score for the answer
   bool unknown = true;  ///< ASK
+  core::Text nearest;   ///< ASK: the nearest category even when the answer is Unknown (score is its
+                        ///< decision value: the L2 distance for plain nearest neighbour)
+  core::Text runner_up;        ///< ASK: the second-nearest category (empty when fewer than two)
   std::uint64_t frame_id = 0;  ///< the frame that handled it
   [[nodiscard]] bool ok() const noexcept {
     return outcome == Outcome::STORED || outcome == Outcome::LEARNED ||

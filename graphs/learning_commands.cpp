@@ -76,6 +76,8 @@ void LessonDesk::answer(const FrameBlock& block, std::int64_t k, LearningAck ack
   ack.label = o.label;
   ack.unknown = o.unknown;
   ack.score = o.score;
+  ack.nearest = o.nearest;
+  ack.runner_up = o.runner_up;
   service_.acknowledge(ack);
 }
 

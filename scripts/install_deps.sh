@@ -7,6 +7,7 @@ PACKAGES=(
   cmake ninja-build g++ pkg-config git
   libeigen3-dev libxsimd-dev libtbb-dev libyaml-cpp-dev nlohmann-json3-dev libcli11-dev
   liblzf-dev libcairo2-dev libleveldb-dev libusb-1.0-0-dev
+  libcivetweb-dev  # the web view's HTTP + WebSocket server (ui/, `orthoflow run --ui`)
   iceoryx libiceoryx-posh-dev libiceoryx-hoofs-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   clang-14 libclang-rt-14-dev clang-format-14

@@ -27,8 +27,10 @@ ALLOWED = {
     "learning": ["core", "memory_pool", "kernels"],
     "evaluation": ["core", "memory_pool", "kernels", "formats", "simulation", "learning"],
     "graphs": ["core", "memory_pool", "kernels", "engine", "formats", "simulation", "drivers", "learning"],
+    "ui": ["core", "memory_pool", "kernels", "engine", "formats", "simulation", "drivers", "learning",
+           "graphs"],
     "apps": ["core", "memory_pool", "kernels", "engine", "formats", "simulation", "drivers", "learning",
-             "evaluation", "graphs"],
+             "evaluation", "graphs", "ui"],
 }
 # Top-level folders beside the product that product code never includes (STYLE rule 1).
 NOT_PRODUCT = ["tests", "bench", "toolchains", "docs", "scripts", "deploy", "config"]

@@ -1,0 +1,198 @@
+// UiServer over real loopback sockets with a recording backend: the checks every request passes
+// (token, origin, host, body limit, rate limit), the WebSocket upgrade's checks and its stream, the
+// status of each learning outcome, and assets (no path reaches the file system).
+#include "ui/ui_server.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <atomic>
+#include <mutex>
+
+#include "http_test_client.hpp"
+
+namespace orthoflow::ui {
+namespace {
+
+using test::http;
+using test::post_json;
+using Outcome = graphs::LearningAck::Outcome;
+
+/// Answers every action with a set outcome and remembers what it was sent.
+class RecordingBackend : public UiBackend {
+ public:
+  UiSnapshot snapshot() const override {
+    UiSnapshot s;
+    s.frame_id = frames_.fetch_add(1) + 1;
+    ObjectView o;
+    o.track_id = 3;
+    o.label = "mug";
+    o.unknown = false;
+    o.score = 0.125F;
+    s.objects.push_back(o);
+    s.memory.push_back({"mug", 4, 1700000000000});
+    return s;
+  }
+  UiAnswer submit(const UiAction& action, int /*timeout_ms*/) override {
+    std::lock_guard<std::mutex> guard(lock_);
+    actions.push_back(action);
+    UiAnswer a{status, {}};
+    a.ack.outcome = outcome;
+    a.ack.track_id = action.track;
+    a.ack.label = action.label;
+    return a;
+  }
+  std::mutex lock_;
+  std::vector<UiAction> actions;
+  Outcome outcome = Outcome::LEARNED;
+  UiAnswer::Status status = UiAnswer::Status::ACKNOWLEDGED;
+  mutable std::atomic<std::uint64_t> frames_{0};
+};
+
+class UiServerTest : public ::testing::Test {
+ protected:
+  void start(std::string token = "", RateLimit rate = {1000.0, 1000.0, 64}) {
+    UiServerConfig config;
+    config.token = std::move(token);
+    config.rate = rate;
+    auto server_result = UiServer::start(config, backend_);
+    ASSERT_TRUE(server_result) << server_result.error();
+    server_ = std::move(*server_result);
+    port_ = server_->port();
+    ASSERT_NE(port_, 0);
+  }
+  RecordingBackend backend_;
+  std::unique_ptr<UiServer> server_;
+  std::uint16_t port_ = 0;
+};
+
+const std::string TOKEN = "test-token-0123456789abcdef";
+
+TEST_F(UiServerTest, ServesStateAndAssetsOnLoopbackWithoutAToken) {
+  start();
+  EXPECT_EQ(server_->url(), "http://127.0.0.1:" + std::to_string(port_) + "/");
+  const auto state = http(port_, "GET", "/api/state");
+  ASSERT_EQ(state.status, 200) << state.head;
+  const auto doc = nlohmann::json::parse(state.body);
+  EXPECT_EQ(doc["objects"][0]["track"], 3);
+  EXPECT_EQ(doc["objects"][0]["label"], "mug");
+  EXPECT_EQ(doc["memory"][0]["views"], 4);
+  const auto page = http(port_, "GET", "/");
+  EXPECT_EQ(page.status, 200);
+  EXPECT_NE(page.head.find("Content-Type: text/html"), std::string::npos);
+  EXPECT_NE(page.head.find("Content-Security-Policy: default-src 'self'"), std::string::npos);
+  EXPECT_NE(page.body.find("<canvas"), std::string::npos);
+  EXPECT_NE(http(port_, "GET", "/app.js").head.find("text/javascript"), std::string::npos);
+}
+
+TEST_F(UiServerTest, UnknownPathsAndTraversalAre404) {
+  start();
+  for (const char* path : {"/nothing", "/../CMakeLists.txt", "/%2e%2e/%2e%2e/etc/passwd",
+                           "/..%2fui%2fCMakeLists.txt", "/assets/app.js", "/api/nope"}) {
+    const auto r = http(port_, "GET", path);
+    EXPECT_TRUE(r.status == 404 || r.status == 400) << path << ": " << r.head;
+    EXPECT_EQ(r.body.find("add_library"), std::string::npos) << path;
+  }
+}
+
+TEST_F(UiServerTest, TokenIsCheckedOnEveryRequest) {
+  start(TOKEN);
+  EXPECT_EQ(http(port_, "GET", "/api/state").status, 401);
+  EXPECT_NE(http(port_, "GET", "/api/state").head.find("WWW-Authenticate: Bearer"),
+            std::string::npos);
+  EXPECT_EQ(http(port_, "GET", "/", {{"Authorization", "Bearer nope"}}).status, 401);
+  EXPECT_EQ(post_json(port_, "/api/teach", R"({"track":3,"label":"cup"})").status, 401);
+  EXPECT_TRUE(backend_.actions.empty());
+  EXPECT_EQ(http(port_, "GET", "/api/state", {{"Authorization", "Bearer " + TOKEN}}).status, 200);
+  EXPECT_EQ(http(port_, "GET", "/?token=" + TOKEN).status, 200);
+  const auto taught = post_json(port_, "/api/teach", R"({"track":3,"label":"cup"})",
+                                {{"Authorization", "Bearer " + TOKEN}});
+  EXPECT_EQ(taught.status, 200) << taught.body;
+  ASSERT_EQ(backend_.actions.size(), 1U);
+  EXPECT_NE(server_->url().find("?token=" + TOKEN), std::string::npos);
+}
+
+TEST_F(UiServerTest, WebSocketUpgradeChecksTheTokenAndStreams) {
+  start(TOKEN);
+  std::string frame;
+  EXPECT_EQ(test::websocket_first_frame(port_, "/api/events?hz=5", frame).status, 401);
+  EXPECT_EQ(test::websocket_first_frame(port_, "/api/events?hz=5&token=bad", frame).status, 401);
+  EXPECT_TRUE(frame.empty());
+  const auto ok = test::websocket_first_frame(port_, "/api/events?hz=5&token=" + TOKEN, frame);
+  ASSERT_EQ(ok.status, 101) << ok.head;
+  const auto doc = nlohmann::json::parse(frame);
+  EXPECT_EQ(doc["objects"][0]["label"], "mug");
+  EXPECT_EQ(test::websocket_first_frame(port_, "/api/events?hz=0&token=" + TOKEN, frame).status,
+            400);
+  std::string other;
+  EXPECT_EQ(test::websocket_first_frame(port_, "/api/events?token=" + TOKEN, other,
+                                        {{"Origin", "http://evil.example"}})
+                .status,
+            403);
+}
+
+TEST_F(UiServerTest, CrossOriginAndForeignHostAreRefused) {
+  start();
+  const auto r =
+      post_json(port_, "/api/forget", R"({"label":"mug"})", {{"Origin", "http://evil.example"}});
+  EXPECT_EQ(r.status, 403);
+  EXPECT_NE(r.body.find("cross-origin"), std::string::npos);
+  EXPECT_TRUE(backend_.actions.empty());
+  const std::string own = "http://127.0.0.1:" + std::to_string(port_);
+  EXPECT_EQ(post_json(port_, "/api/forget", R"({"label":"mug"})", {{"Origin", own}}).status, 200);
+  EXPECT_EQ(http(port_, "GET", "/api/state", {{"Host", "rebound.example"}}, "", false).status, 403);
+}
+
+TEST_F(UiServerTest, BodyLimitAndMalformedInputGet4xxWithJson) {
+  start();
+  const auto big = post_json(port_, "/api/teach", std::string(MAX_BODY_BYTES + 10, ' '));
+  EXPECT_EQ(big.status, 413);
+  const auto bad = post_json(port_, "/api/teach", "{\"track\":");
+  EXPECT_EQ(bad.status, 400);
+  EXPECT_EQ(nlohmann::json::parse(bad.body)["error"], "the body is not valid JSON");
+  const auto label = post_json(port_, "/api/teach", R"({"track":3,"label":"a\u0001"})");
+  EXPECT_EQ(label.status, 400);
+  EXPECT_EQ(nlohmann::json::parse(label.body)["error"], "label holds a control character");
+  EXPECT_EQ(http(port_, "GET", "/api/teach").status, 405);
+  EXPECT_EQ(http(port_, "GET", "/api/events").status, 426);
+  EXPECT_TRUE(backend_.actions.empty());
+}
+
+TEST_F(UiServerTest, AFloodIsRateLimited) {
+  start("", {/*rate_per_s=*/1.0, /*burst=*/5.0, /*max_clients=*/64});
+  int ok = 0, limited = 0;
+  for (int i = 0; i < 12; ++i) {
+    const int s = http(port_, "GET", "/api/state").status;
+    ok += s == 200 ? 1 : 0;
+    limited += s == 429 ? 1 : 0;
+  }
+  EXPECT_GE(ok, 5);
+  EXPECT_LE(ok, 7);  // the burst, and a token or so refilled while the loop ran
+  EXPECT_EQ(ok + limited, 12);
+}
+
+TEST_F(UiServerTest, LearningOutcomesMapToStatuses) {
+  start();
+  const std::pair<Outcome, int> cases[] = {
+      {Outcome::STORED, 200},        {Outcome::LEARNED, 200},      {Outcome::NO_SUCH_TRACK, 404},
+      {Outcome::NOT_DESCRIBED, 409}, {Outcome::BAD_LABEL, 400},    {Outcome::REJECTED, 422},
+      {Outcome::UNKNOWN_LABEL, 404}, {Outcome::WRITE_FAILED, 500}, {Outcome::BUSY, 503}};
+  for (const auto& [outcome, status] : cases) {
+    backend_.outcome = outcome;
+    const auto r = post_json(port_, "/api/correct", R"({"track":9,"label":"bowl"})");
+    EXPECT_EQ(r.status, status) << graphs::to_string(outcome);
+    EXPECT_EQ(nlohmann::json::parse(r.body)["outcome"], graphs::to_string(outcome));
+  }
+  backend_.status = UiAnswer::Status::TIMEOUT;
+  EXPECT_EQ(post_json(port_, "/api/ask", R"({"track":9})").status, 504);
+  backend_.status = UiAnswer::Status::QUEUE_FULL;
+  EXPECT_EQ(post_json(port_, "/api/ask", R"({"track":9})").status, 503);
+  ASSERT_EQ(backend_.actions.size(), 11U);
+  EXPECT_EQ(backend_.actions[0].kind, graphs::LearningCommand::Kind::CORRECT);
+  EXPECT_EQ(backend_.actions[0].track, 9U);
+  EXPECT_EQ(backend_.actions[0].label.view(), "bowl");
+  EXPECT_EQ(backend_.actions[10].kind, graphs::LearningCommand::Kind::ASK);
+}
+
+}  // namespace
+}  // namespace orthoflow::ui

@@ -1,0 +1,185 @@
+// The orthoflow live view: reads the state over the WebSocket /api/events (JSON documents, see
+// ui/ui_json.hpp), draws it, and sends teach / correct / ask / forget to the JSON API.
+'use strict';
+
+const params = new URLSearchParams(location.search);
+const token = params.get('token') || '';
+let state = null;
+let selected = null;  // track id
+
+const $ = (id) => document.getElementById(id);
+
+function cell(row, text, cls) {
+  const td = row.insertCell();
+  td.textContent = text;
+  if (cls) td.className = cls;
+  return td;
+}
+
+function fill(tableId, items, render) {
+  const body = $(tableId).tBodies[0];
+  body.replaceChildren();
+  for (const item of items) render(body.insertRow(), item);
+}
+
+function fmt(v, digits) { return v === null || v === undefined ? '-' : Number(v).toFixed(digits); }
+
+function mainObjects(s) { return s.objects.filter((o) => !o.fragment && o.track !== 0); }
+
+function renderObjects(s) {
+  fill('objects', mainObjects(s), (row, o) => {
+    if (o.track === selected) row.className = 'selected';
+    row.onclick = () => select(o.track);
+    cell(row, o.track);
+    if (o.label === null) cell(row, 'Unknown', 'unknown'); else cell(row, o.label);
+    cell(row, fmt(o.score, 3));
+    cell(row, o.points);
+    cell(row, o.centroid.map((c) => fmt(c, 2)).join(', '));
+  });
+}
+
+function renderMemory(s) {
+  fill('memory', s.memory, (row, c) => {
+    cell(row, c.label);
+    cell(row, c.views);
+    cell(row, c.last_taught_ms ? new Date(c.last_taught_ms).toLocaleTimeString() : '-');
+  });
+  const list = $('categories');
+  list.replaceChildren();
+  for (const c of s.memory) {
+    const option = document.createElement('option');
+    option.value = c.label;
+    list.appendChild(option);
+  }
+}
+
+function renderEvents(s) {
+  fill('events', s.events.slice().reverse(), (row, e) => {
+    cell(row, e.id);
+    cell(row, e.action);
+    cell(row, e.action === 'forget' ? '-' : e.track);
+    cell(row, e.label || (e.action === 'ask' ? 'Unknown' : ''));
+    cell(row, e.outcome, e.ok ? 'good' : 'bad');
+  });
+}
+
+function renderLatency(s) {
+  const t = s.telemetry;
+  $('graph').textContent = `${t.frames} frames, ${t.drops} dropped, frame p99 ${fmt(t.frame_p99_us, 0)} us` +
+      (s.durable ? ', memory on disk' : ', memory in RAM');
+  fill('latency', t.nodes, (row, n) => {
+    cell(row, n.name);
+    cell(row, n.processed);
+    cell(row, n.dropped);
+    cell(row, fmt(n.p50_us, 0));
+    cell(row, fmt(n.p99_us, 0));
+    cell(row, fmt(n.max_us, 0));
+  });
+}
+
+// Top view: sensor x to the right, depth z upwards, fitted to the objects with a margin.
+function viewBox(objects) {
+  let x0 = -0.4, x1 = 0.4, z0 = 0.6, z1 = 1.4;
+  for (const o of objects) {
+    x0 = Math.min(x0, o.bbox_min[0]); x1 = Math.max(x1, o.bbox_max[0]);
+    z0 = Math.min(z0, o.bbox_min[2]); z1 = Math.max(z1, o.bbox_max[2]);
+  }
+  return {x0: x0 - 0.05, x1: x1 + 0.05, z0: z0 - 0.05, z1: z1 + 0.05};
+}
+
+function projector(canvas, box) {
+  const scale = Math.min(canvas.width / (box.x1 - box.x0), canvas.height / (box.z1 - box.z0));
+  return (x, z) => [(x - box.x0) * scale, canvas.height - (z - box.z0) * scale];
+}
+
+function drawTop(s) {
+  const canvas = $('top');
+  const g = canvas.getContext('2d');
+  g.clearRect(0, 0, canvas.width, canvas.height);
+  const objects = mainObjects(s).filter((o) => o.centroid.every((c) => c !== null));
+  const at = projector(canvas, viewBox(objects));
+  canvas.objectsAt = [];
+  for (const o of objects) {
+    const [ax, ay] = at(o.bbox_min[0], o.bbox_min[2]);
+    const [bx, by] = at(o.bbox_max[0], o.bbox_max[2]);
+    g.fillStyle = o.label === null ? '#b0bec588' : '#4caf5088';
+    g.strokeStyle = o.track === selected ? '#f57f17' : '#37474f';
+    g.lineWidth = o.track === selected ? 3 : 1;
+    g.fillRect(ax, by, bx - ax, ay - by);
+    g.strokeRect(ax, by, bx - ax, ay - by);
+    const [cx, cy] = at(o.centroid[0], o.centroid[2]);
+    g.fillStyle = '#222';
+    g.font = '12px sans-serif';
+    g.fillText(`#${o.track} ${o.label === null ? 'Unknown' : o.label}`, ax, by - 4);
+    canvas.objectsAt.push({track: o.track, x: cx, y: cy});
+  }
+}
+
+function render(s) {
+  state = s;
+  $('frame').textContent = `frame ${s.frame} (${fmt(s.age_ms, 1)} ms old)`;
+  renderObjects(s);
+  renderMemory(s);
+  renderEvents(s);
+  renderLatency(s);
+  drawTop(s);
+}
+
+function select(track) {
+  selected = track;
+  $('selected').textContent = `track ${track}`;
+  if (state) render(state);
+}
+
+$('top').addEventListener('click', (event) => {
+  const canvas = $('top');
+  const r = canvas.getBoundingClientRect();
+  const x = (event.clientX - r.left) * canvas.width / r.width;
+  const y = (event.clientY - r.top) * canvas.height / r.height;
+  let best = null, bestDistance = 40 * 40;
+  for (const o of canvas.objectsAt || []) {
+    const d = (o.x - x) ** 2 + (o.y - y) ** 2;
+    if (d < bestDistance) { best = o.track; bestDistance = d; }
+  }
+  if (best !== null) select(best);
+});
+
+async function act(action) {
+  const label = $('label').value.trim();
+  const body = action === 'forget' ? {label} : action === 'ask' ? {track: selected} : {track: selected, label};
+  if (action !== 'forget' && selected === null) { $('answer').textContent = 'click an object first'; return; }
+  const headers = {'Content-Type': 'application/json'};
+  if (token) headers.Authorization = `Bearer ${token}`;
+  $('answer').textContent = `${action}...`;
+  try {
+    const response = await fetch(`/api/${action}`, {method: 'POST', headers, body: JSON.stringify(body)});
+    const answer = await response.json();
+    let text = `${action}: ${answer.outcome || answer.error}`;
+    if (action === 'ask' && answer.ok) {
+      text += ` -> ${answer.answer === null ? 'Unknown' : answer.answer}`;
+      const near = answer.nearest.map((n) => n.score === null ? n.label : `${n.label} ${fmt(n.score, 3)}`);
+      if (near.length > 0) text += `; nearest: ${near.join(', ')}`;
+    }
+    if (!answer.ok && answer.error) text += ` (${answer.error})`;
+    if (answer.ok && answer.outcome === 'stored') text += ' (on disk)';
+    $('answer').textContent = text;
+    $('answer').className = answer.ok ? 'good' : 'bad';
+  } catch (e) {
+    $('answer').textContent = `${action} failed: ${e}`;
+    $('answer').className = 'bad';
+  }
+}
+
+for (const button of document.querySelectorAll('#action button')) {
+  button.addEventListener('click', () => act(button.dataset.action));
+}
+
+function connect() {
+  const q = new URLSearchParams({hz: '10'});
+  if (token) q.set('token', token);
+  const ws = new WebSocket(`${location.protocol === 'https:' ? 'wss' : 'ws'}://${location.host}/api/events?${q}`);
+  ws.onopen = () => { $('status').textContent = 'live'; };
+  ws.onmessage = (m) => render(JSON.parse(m.data));
+  ws.onclose = () => { $('status').textContent = 'disconnected, retrying...'; setTimeout(connect, 1000); };
+}
+connect();

@@ -1,0 +1,173 @@
+#include "ui/graph_backend.hpp"
+
+#include <chrono>
+#include <cstring>
+
+namespace orthoflow::ui {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+std::int64_t unix_ms() {
+  return std::chrono::duration_cast<std::chrono::milliseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+ObjectView view_of(const engine::ObjectEntry& e) {
+  ObjectView o;
+  o.track_id = e.track_id;
+  o.unknown = e.unknown != 0;
+  o.label = o.unknown ? std::string{} : std::string(e.label.view());
+  o.score = e.score;
+  std::memcpy(o.centroid, e.centroid, sizeof o.centroid);
+  std::memcpy(o.bbox_min, e.bbox_min, sizeof o.bbox_min);
+  std::memcpy(o.bbox_max, e.bbox_max, sizeof o.bbox_max);
+  o.point_count = e.point_count;
+  o.flags = e.flags;
+  return o;
+}
+
+std::string outcome_text(const UiAnswer& a) {
+  switch (a.status) {
+    case UiAnswer::Status::ACKNOWLEDGED:
+      return std::string(graphs::to_string(a.ack.outcome));
+    case UiAnswer::Status::QUEUE_FULL:
+      return "queue_full";
+    case UiAnswer::Status::TIMEOUT:
+      return "timeout";
+  }
+  return "?";
+}
+
+}  // namespace
+
+Result<std::unique_ptr<GraphBackend>, std::string> GraphBackend::open(
+    graphs::LearningService& learning, graphs::ObjectsHub& hub) {
+  auto client = learning.connect();
+  if (!client) return err(std::string("the learning channel has no free client slot"));
+  return std::unique_ptr<GraphBackend>(
+      new GraphBackend(learning, std::move(client), hub.subscribe(4)));
+}
+
+GraphBackend::GraphBackend(graphs::LearningService& learning,
+                           std::unique_ptr<graphs::LearningClient> client,
+                           std::unique_ptr<graphs::ObjectsSubscription> objects)
+    : learning_(learning),
+      client_(std::move(client)),
+      objects_(std::move(objects)),
+      latest_(std::make_unique<engine::ObjectListPayload>()) {
+  latest_->reset_header();
+  poller_ = std::thread([this] { poll_objects(); });
+}
+
+GraphBackend::~GraphBackend() {
+  stop_.store(true);
+  poller_.join();
+}
+
+// Takes the newest list from the subscription's ring into a scratch copy, then swaps it in under
+// the lock, so a reader never waits for more than a pointer swap.
+void GraphBackend::poll_objects() noexcept {
+  auto scratch = std::make_unique<engine::ObjectListPayload>();
+  while (!stop_.load()) {
+    bool got = false;
+    while (objects_->poll(*scratch)) got = true;
+    if (got) {
+      std::lock_guard<std::mutex> guard(state_lock_);
+      std::swap(latest_, scratch);
+      have_latest_ = true;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+}
+
+UiSnapshot GraphBackend::snapshot() const {
+  UiSnapshot s;
+  s.durable = durable();
+  {
+    std::lock_guard<std::mutex> guard(state_lock_);
+    if (have_latest_) {
+      s.frame_id = latest_->frame_id;
+      s.age_ns = latest_->age_ns;
+      const std::uint32_t n = std::min(latest_->count, engine::OBJECT_LIST_CAPACITY);
+      for (std::uint32_t k = 0; k < n; ++k) s.objects.push_back(view_of(latest_->objects[k]));
+    }
+    s.events.assign(events_.begin(), events_.end());
+    for (const learning::CategorySummary& c : learning_.learner().categories()) {
+      const std::string label(c.label.view());
+      const auto it = last_taught_ms_.find(label);
+      s.memory.push_back({label, c.views, it == last_taught_ms_.end() ? 0 : it->second});
+    }
+  }
+  add_telemetry(s);
+  return s;
+}
+
+void GraphBackend::add_telemetry(UiSnapshot& s) const {
+  const engine::GraphStats* stats = stats_.load();
+  if (stats == nullptr) return;
+  s.frames_done = stats->frames_done.load();
+  s.drops = stats->total_drops();
+  s.frame_p99_ns = stats->frame_latency.percentile(0.99);
+  for (const engine::NodeStats& n : stats->nodes) {
+    s.nodes.push_back({n.name, n.processed.load(), n.dropped.load(), n.deadline_misses.load(),
+                       n.service.percentile(0.5), n.service.percentile(0.99), n.service.max()});
+  }
+}
+
+UiAnswer GraphBackend::submit(const UiAction& action, int timeout_ms) {
+  UiAnswer answer;
+  {
+    std::lock_guard<std::mutex> guard(client_lock_);
+    graphs::LearningCommand command;
+    command.kind = action.kind;
+    command.track_id = action.track;
+    command.label = action.label;
+    const std::uint64_t sequence = client_->send(command);
+    if (sequence == 0) {
+      answer.status = UiAnswer::Status::QUEUE_FULL;
+    } else {
+      // Acks of earlier actions that timed out arrive late: skipped by their sequence number.
+      const auto deadline = Clock::now() + std::chrono::milliseconds(timeout_ms);
+      while (answer.status == UiAnswer::Status::TIMEOUT && Clock::now() < deadline) {
+        graphs::LearningAck ack;
+        while (client_->poll(ack)) {
+          if (ack.sequence == sequence) {
+            answer = {UiAnswer::Status::ACKNOWLEDGED, ack};
+            break;
+          }
+        }
+        if (answer.status == UiAnswer::Status::TIMEOUT)
+          std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      }
+    }
+  }
+  record(action, answer);
+  return answer;
+}
+
+void GraphBackend::record(const UiAction& action, const UiAnswer& answer) {
+  using Kind = graphs::LearningCommand::Kind;
+  const bool ok = answer.status == UiAnswer::Status::ACKNOWLEDGED && answer.ack.ok();
+  EventView e;
+  e.time_ms = unix_ms();
+  e.action = std::string(graphs::to_string(action.kind));
+  e.track = ok && action.kind != Kind::FORGET ? answer.ack.track_id : action.track;
+  e.label = action.kind == Kind::ASK ? std::string(answer.ack.label.view())
+                                     : std::string(action.label.view());
+  e.outcome = outcome_text(answer);
+  e.ok = ok;
+  e.views = answer.ack.views;
+  e.frame_id = answer.ack.frame_id;
+  std::lock_guard<std::mutex> guard(state_lock_);
+  e.id = next_event_++;
+  if (ok && (action.kind == Kind::TEACH || action.kind == Kind::CORRECT))
+    last_taught_ms_[e.label] = e.time_ms;
+  if (ok && action.kind == Kind::FORGET) last_taught_ms_.erase(e.label);
+  events_.push_back(std::move(e));
+  if (events_.size() > MAX_UI_EVENTS) events_.pop_front();
+}
+
+}  // namespace orthoflow::ui

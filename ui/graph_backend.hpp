@@ -1,0 +1,69 @@
+#pragma once
+/// @file
+/// @brief GraphBackend: the web view's backend over a running tabletop graph. Objects come from an
+/// ObjectsSubscription of the graph's ObjectsHub (the objects_output node copies each frame's list
+/// into the subscription's ring without waiting; a thread here takes the newest into a
+/// mutex-guarded copy), the memory from the learner's snapshot, latency from the engine's
+/// telemetry; actions go through one LearningClient of the learning channel and wait for their
+/// LearningAck. Nothing here runs on the frame path.
+#include <atomic>
+#include <deque>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+
+#include "core/result.hpp"
+#include "engine/object_list_payload.hpp"
+#include "engine/telemetry.hpp"
+#include "graphs/learning_service.hpp"
+#include "graphs/objects_output.hpp"
+#include "ui/ui_backend.hpp"
+
+namespace orthoflow::ui {
+
+/// @brief Recent events kept for the page.
+inline constexpr std::size_t MAX_UI_EVENTS = 32;
+
+/// @note Thread-safe. @pre destroyed before @p learning and @p hub (and before the engine whose
+/// telemetry it reads).
+class GraphBackend final : public UiBackend {
+ public:
+  /// @brief Connects to the learning channel and subscribes to the objects. Errors: no free
+  /// learning client slot.
+  [[nodiscard]] static Result<std::unique_ptr<GraphBackend>, std::string> open(
+      graphs::LearningService& learning, graphs::ObjectsHub& hub);
+  ~GraphBackend() override;
+  GraphBackend(const GraphBackend&) = delete;
+  GraphBackend& operator=(const GraphBackend&) = delete;
+
+  /// @brief The engine telemetry to show (null: none). @pre outlives this backend or is reset.
+  void set_telemetry(const engine::GraphStats* stats) noexcept { stats_.store(stats); }
+  [[nodiscard]] UiSnapshot snapshot() const override;
+  [[nodiscard]] UiAnswer submit(const UiAction& action, int timeout_ms) override;
+  [[nodiscard]] bool durable() const noexcept override { return learning_.durable(); }
+
+ private:
+  GraphBackend(graphs::LearningService& learning, std::unique_ptr<graphs::LearningClient> client,
+               std::unique_ptr<graphs::ObjectsSubscription> objects);
+  void poll_objects() noexcept;
+  void record(const UiAction& action, const UiAnswer& answer);
+  void add_telemetry(UiSnapshot& s) const;
+
+  graphs::LearningService& learning_;
+  std::unique_ptr<graphs::LearningClient> client_;
+  std::unique_ptr<graphs::ObjectsSubscription> objects_;
+  std::mutex client_lock_;  // LearningClient is thread-compatible: one action at a time
+  mutable std::mutex state_lock_;
+  std::unique_ptr<engine::ObjectListPayload> latest_;   // guarded by state_lock_
+  bool have_latest_ = false;                            // guarded by state_lock_
+  std::deque<EventView> events_;                        // guarded by state_lock_
+  std::map<std::string, std::int64_t> last_taught_ms_;  // guarded by state_lock_
+  std::uint64_t next_event_ = 1;                        // guarded by state_lock_
+  std::atomic<const engine::GraphStats*> stats_{nullptr};
+  std::atomic<bool> stop_{false};
+  std::thread poller_;
+};
+
+}  // namespace orthoflow::ui

@@ -1,0 +1,87 @@
+#include "ui/ui_event_stream.hpp"
+
+#include <algorithm>
+#include <chrono>
+
+#include "ui/ui_json.hpp"
+
+namespace orthoflow::ui {
+
+namespace {
+std::int64_t now_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+}  // namespace
+
+EventStream::EventStream(UiBackend& backend, double max_hz, std::size_t max_clients, Write write)
+    : backend_(backend), max_hz_(max_hz), max_clients_(max_clients), write_(std::move(write)) {
+  thread_ = std::thread([this] { run(); });
+}
+
+EventStream::~EventStream() {
+  {
+    std::lock_guard<std::mutex> guard(lock_);
+    stop_ = true;
+  }
+  wake_.notify_all();
+  thread_.join();
+}
+
+bool EventStream::add(void* client, double hz) {
+  {
+    std::lock_guard<std::mutex> guard(lock_);
+    if (clients_.size() >= max_clients_) return false;
+    const double rate = clamp(hz);
+    clients_.push_back({client, static_cast<std::int64_t>(1e9 / rate), now_ns(), false});
+  }
+  wake_.notify_all();
+  return true;
+}
+
+void EventStream::remove(void* client) {
+  std::lock_guard<std::mutex> guard(lock_);
+  std::erase_if(clients_, [&](const Client& c) { return c.id == client; });
+}
+
+std::size_t EventStream::clients() const {
+  std::lock_guard<std::mutex> guard(lock_);
+  return clients_.size();
+}
+
+std::uint64_t EventStream::sent() const {
+  std::lock_guard<std::mutex> guard(lock_);
+  return sent_;
+}
+
+bool EventStream::any_due(std::int64_t now) const {
+  return std::any_of(clients_.begin(), clients_.end(),
+                     [&](const Client& c) { return !c.failed && c.next_ns <= now; });
+}
+
+// One tick: wait until a client is due, make the document without the lock (the backend copies the
+// state), then write it to every client due by now. A client's next time advances by its period
+// from its previous time, so its rate does not drift with the document's cost.
+void EventStream::run() {
+  std::unique_lock<std::mutex> guard(lock_);
+  while (!stop_) {
+    if (!any_due(now_ns())) {
+      wake_.wait_for(guard, std::chrono::milliseconds(2));
+      continue;
+    }
+    guard.unlock();
+    const std::string document = state_json(backend_.snapshot());
+    guard.lock();
+    const std::int64_t now = now_ns();
+    for (Client& c : clients_) {
+      if (c.failed || c.next_ns > now) continue;
+      c.failed = !write_(c.id, document);
+      if (!c.failed) ++sent_;
+      c.next_ns += c.period_ns;
+      if (c.next_ns <= now) c.next_ns = now + c.period_ns;  // behind: skip, never burst
+    }
+  }
+}
+
+}  // namespace orthoflow::ui

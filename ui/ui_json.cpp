@@ -1,0 +1,146 @@
+#include "ui/ui_json.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+
+#include "engine/object_list_payload.hpp"
+
+namespace orthoflow::ui {
+
+namespace {
+
+using Json = nlohmann::json;
+using Outcome = graphs::LearningAck::Outcome;
+
+Json number_or_null(float v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
+Json vec3(const float (&v)[3]) {
+  return Json::array({number_or_null(v[0]), number_or_null(v[1]), number_or_null(v[2])});
+}
+
+Json object_json(const ObjectView& o) {
+  return {{"track", o.track_id},
+          {"label", o.unknown ? Json(nullptr) : Json(o.label)},
+          {"score", number_or_null(o.score)},
+          {"centroid", vec3(o.centroid)},
+          {"bbox_min", vec3(o.bbox_min)},
+          {"bbox_max", vec3(o.bbox_max)},
+          {"points", o.point_count},
+          {"described", (o.flags & engine::OBJECT_DESCRIBED) != 0},
+          {"moving", (o.flags & engine::OBJECT_MOVING) != 0},
+          {"fragment", (o.flags & engine::OBJECT_FRAGMENT) != 0}};
+}
+
+Json event_json(const EventView& e) {
+  return {{"id", e.id},       {"time_ms", e.time_ms}, {"action", e.action},
+          {"track", e.track}, {"label", e.label},     {"outcome", e.outcome},
+          {"ok", e.ok},       {"views", e.views},     {"frame", e.frame_id}};
+}
+
+Json telemetry_json(const UiSnapshot& s) {
+  Json nodes = Json::array();
+  for (const NodeLatency& n : s.nodes) {
+    nodes.push_back({{"name", n.name},
+                     {"processed", n.processed},
+                     {"dropped", n.dropped},
+                     {"deadline_misses", n.deadline_misses},
+                     {"p50_us", static_cast<double>(n.p50_ns) * 1e-3},
+                     {"p99_us", static_cast<double>(n.p99_ns) * 1e-3},
+                     {"max_us", static_cast<double>(n.max_ns) * 1e-3}});
+  }
+  return {{"frames", s.frames_done},
+          {"drops", s.drops},
+          {"frame_p99_us", static_cast<double>(s.frame_p99_ns) * 1e-3},
+          {"nodes", std::move(nodes)}};
+}
+
+}  // namespace
+
+std::string state_json(const UiSnapshot& s) {
+  Json objects = Json::array(), memory = Json::array(), events = Json::array();
+  for (const ObjectView& o : s.objects) objects.push_back(object_json(o));
+  for (const CategoryView& c : s.memory) {
+    memory.push_back(
+        {{"label", c.label},
+         {"views", c.views},
+         {"last_taught_ms", c.last_taught_ms == 0 ? Json(nullptr) : Json(c.last_taught_ms)}});
+  }
+  for (const EventView& e : s.events) events.push_back(event_json(e));
+  const Json doc = {
+      {"frame", s.frame_id},           {"age_ms", static_cast<double>(s.age_ns) * 1e-6},
+      {"durable", s.durable},          {"objects", std::move(objects)},
+      {"memory", std::move(memory)},   {"events", std::move(events)},
+      {"telemetry", telemetry_json(s)}};
+  // Labels are valid UTF-8 by the label rule; replace keeps a bad byte from throwing regardless.
+  return doc.dump(-1, ' ', false, Json::error_handler_t::replace);
+}
+
+int http_status(const UiAnswer& answer) noexcept {
+  if (answer.status == UiAnswer::Status::QUEUE_FULL) return 503;
+  if (answer.status == UiAnswer::Status::TIMEOUT) return 504;
+  switch (answer.ack.outcome) {
+    case Outcome::STORED:
+    case Outcome::LEARNED:
+    case Outcome::ANSWERED:
+      return 200;
+    case Outcome::NO_SUCH_TRACK:
+    case Outcome::UNKNOWN_LABEL:
+      return 404;
+    case Outcome::BAD_LABEL:
+      return 400;
+    case Outcome::NOT_DESCRIBED:
+      return 409;
+    case Outcome::REJECTED:
+      return 422;
+    case Outcome::WRITE_FAILED:
+      return 500;
+    case Outcome::BUSY:
+      return 503;
+  }
+  return 500;
+}
+
+std::string answer_json(const UiAction& action, const UiAnswer& answer, bool durable) {
+  using Kind = graphs::LearningCommand::Kind;
+  const bool acked = answer.status == UiAnswer::Status::ACKNOWLEDGED;
+  const bool ok = acked && answer.ack.ok();
+  Json doc = {{"ok", ok}, {"action", graphs::to_string(action.kind)}, {"durable", durable}};
+  doc["outcome"] = acked ? std::string(graphs::to_string(answer.ack.outcome))
+                   : answer.status == UiAnswer::Status::QUEUE_FULL ? "queue_full"
+                                                                   : "timeout";
+  if (acked) {
+    doc["track"] = answer.ack.track_id;
+    doc["frame"] = answer.ack.frame_id;
+    doc["views"] = answer.ack.views;
+  }
+  if (action.kind == Kind::ASK && ok) {
+    doc["answer"] = answer.ack.unknown ? Json(nullptr) : Json(std::string(answer.ack.label.view()));
+    doc["score"] = number_or_null(answer.ack.score);
+    // The learner's nearest categories: the best one with its decision value (also when the answer
+    // is Unknown), then the runner-up by name (the channel carries no second score).
+    Json nearest = Json::array();
+    if (!answer.ack.nearest.empty())
+      nearest.push_back({{"label", std::string(answer.ack.nearest.view())},
+                         {"score", number_or_null(answer.ack.score)}});
+    if (!answer.ack.runner_up.empty())
+      nearest.push_back({{"label", std::string(answer.ack.runner_up.view())}, {"score", nullptr}});
+    doc["nearest"] = std::move(nearest);
+  } else if (action.kind != Kind::ASK) {
+    doc["label"] = std::string(action.label.view());
+  }
+  if (!ok) {
+    doc["error"] = !acked ? (answer.status == UiAnswer::Status::QUEUE_FULL
+                                 ? "the learning channel is full; send again"
+                                 : "no acknowledgement in time (is the graph running?)")
+                          : "the learning channel answered " +
+                                std::string(graphs::to_string(answer.ack.outcome));
+  }
+  return doc.dump(-1, ' ', false, Json::error_handler_t::replace);
+}
+
+std::string error_json(const ApiError& error) {
+  const Json doc = {{"error", error.message}, {"status", error.status}};
+  return doc.dump(-1, ' ', false, Json::error_handler_t::replace);
+}
+
+}  // namespace orthoflow::ui
