@@ -107,18 +107,11 @@ class PcdSource final : public FrameSource {
 
  private:
   /// On the decoder thread: an unorganized cloud that a pinhole camera took goes back on its pixel
-  /// grid (kernels/pinhole_regrid.hpp), so it takes the organized chain; any other stays as it is.
-  /// (A grid larger than the pool block keeps the cloud unorganized, which fits.)
+  /// grid (kernels/pinhole_regrid.hpp), so it takes the organized chain; any other stays as it is,
+  /// and so does one whose grid would not fit the pool block.
   void organize_cloud(kernels::PointCloud& cloud) {
-    const auto grid = kernels::find_pinhole_grid(cloud.points());
-    if (!grid || std::size_t{grid->width} * grid->height > capacity_) {
-      left_unorganized_.fetch_add(1, std::memory_order_relaxed);
-      return;
-    }
-    kernels::PointCloud organized;
-    kernels::regrid(cloud, *grid, organized);
-    cloud = std::move(organized);
-    regridded_.fetch_add(1, std::memory_order_relaxed);
+    auto& counter = kernels::organize_if_pinhole(cloud, capacity_) ? regridded_ : left_unorganized_;
+    counter.fetch_add(1, std::memory_order_relaxed);
   }
   std::atomic<std::uint64_t> regridded_{0}, left_unorganized_{0};  // before decoder_: its thread
   PcdDecoder decoder_;

@@ -8,11 +8,14 @@
 #include <algorithm>
 #include <cmath>
 
+#include "kernels/detail/piece_union.hpp"
 #include "kernels/tabletop_stages.hpp"
 
 namespace orthoflow::kernels {
 
 namespace {
+
+using detail::unite;
 
 /// Calls f(i) for every index of @p members, or for 0..n-1 when @p members is empty.
 template <class F>
@@ -22,22 +25,6 @@ void for_each_member(std::span<const std::uint32_t> members, std::size_t n, F&& 
   } else {
     for (const std::uint32_t i : members) f(std::size_t{i});
   }
-}
-
-std::int32_t find_root(std::span<std::int32_t> root, std::size_t c) noexcept;
-
-/// Joins the sets of a and b; the lowest id stays the root.
-void unite(std::span<std::int32_t> root, std::size_t a, std::size_t b) noexcept {
-  const std::int32_t ra = find_root(root, a), rb = find_root(root, b);
-  root[static_cast<std::size_t>(std::max(ra, rb))] = std::min(ra, rb);
-}
-
-std::int32_t find_root(std::span<std::int32_t> root, std::size_t c) noexcept {
-  while (root[c] != static_cast<std::int32_t>(c)) {
-    root[c] = root[static_cast<std::size_t>(root[c])];  // path halving
-    c = static_cast<std::size_t>(root[c]);
-  }
-  return static_cast<std::int32_t>(c);
 }
 
 }  // namespace
@@ -100,17 +87,8 @@ std::size_t ObjectStage::merge_footprints(PointsView target, std::span<const std
     }
     if (nearest != i) unite(root, i, nearest);
   }
-  std::size_t merged = 0;
-  for (std::size_t c = 0; c < clusters; ++c) {
-    const auto r = static_cast<std::size_t>(find_root(root, c));
-    new_id_[c] =
-        r == c ? static_cast<std::int32_t>(merged++) : new_id_[r];  // a root is its lowest member
-  }
-  if (merged == clusters) return clusters;
-  for_each_member(members, target.size(), [&](std::size_t i) {
-    if (labels[i] >= 0) labels[i] = new_id_[static_cast<std::size_t>(labels[i])];
-  });
-  return merged;
+  return detail::relabel(root.first(clusters), new_id_, labels,
+                         [&](auto&& f) { for_each_member(members, target.size(), f); });
 }
 
 }  // namespace orthoflow::kernels

@@ -1,12 +1,14 @@
 // ObjectStage's occlusion join (kernels/tabletop_stages.hpp, crowded mode): an object standing
 // behind a nearer one (a box behind a bottle) is seen on both sides of it, and the clustering makes
 // two pieces of it. Along an image row such an object reads piece A, then the occluder C nearer to
-// the camera, then piece B; A and B are joined when enough rows read so, both stand on the table
-// and their tops are level (one box, one lid). Two different objects of one height side by side
-// behind a third would be joined too: the price of the rule (docs/SEGMENTATION.md).
+// the camera, then piece B; A and B are joined when enough rows read so and their tops are level
+// (one box, one lid). The pieces need not reach the table: the occluder may hide the object's foot
+// too. Two different objects of one height side by side behind a third would be joined as well:
+// the price of the rule (docs/SEGMENTATION.md).
 #include <algorithm>
 #include <cmath>
 
+#include "kernels/detail/piece_union.hpp"
 #include "kernels/tabletop_stages.hpp"
 
 namespace orthoflow::kernels {
@@ -26,11 +28,6 @@ struct Run {
   std::uint32_t first = 0, last = 0;  // columns
   float z_first = 0.0F, z_last = 0.0F;
 };
-
-std::int32_t root_of(std::span<std::int32_t> root, std::int32_t c) noexcept {
-  while (root[static_cast<std::size_t>(c)] != c) c = root[static_cast<std::size_t>(c)];
-  return c;
-}
 
 }  // namespace
 
@@ -79,7 +76,6 @@ std::size_t ObjectStage::join_occluded(CloudView cloud, std::span<const std::uin
   }
   const auto root = std::span(root_).first(clusters);
   for (std::size_t c = 0; c < clusters; ++c) root[c] = static_cast<std::int32_t>(c);
-  bool joined = false;
   for (std::size_t a = 0; a < n; ++a) {
     for (std::size_t b = a + 1; b < n; ++b) {
       const std::uint32_t v = votes_[a * n + b];
@@ -88,22 +84,12 @@ std::size_t ObjectStage::join_occluded(CloudView cloud, std::span<const std::uin
       const float rows = std::min(pa[3] - pa[2], pb[3] - pb[2]) + 1.0F;
       if (static_cast<float>(v) < 0.3F * rows) continue;
       if (std::fabs(pa[0] - pb[0]) > p.occlusion_top) continue;
-      const std::int32_t ra = root_of(root, static_cast<std::int32_t>(a)),
-                         rb = root_of(root, static_cast<std::int32_t>(b));
-      root[static_cast<std::size_t>(std::max(ra, rb))] = std::min(ra, rb);
-      joined = true;
+      detail::unite(root, a, b);
     }
   }
-  if (!joined) return clusters;
-  std::size_t merged = 0;
-  for (std::size_t c = 0; c < clusters; ++c) {
-    const auto r = static_cast<std::size_t>(root_of(root, static_cast<std::int32_t>(c)));
-    new_id_[c] = r == c ? static_cast<std::int32_t>(merged++) : new_id_[r];
-  }
-  for (const std::uint32_t i : members) {
-    if (labels[i] >= 0) labels[i] = new_id_[static_cast<std::size_t>(labels[i])];
-  }
-  return merged;
+  return detail::relabel(root, new_id_, labels, [&](auto&& f) {
+    for (const std::uint32_t i : members) f(std::size_t{i});
+  });
 }
 
 }  // namespace orthoflow::kernels

@@ -184,7 +184,7 @@ void regrid(const PointCloud& in, const PinholeGrid& grid, PointCloud& out) {
   out.info = in.info;
 }
 
-Result<PinholeGrid, GridRefusal> organize_if_pinhole(PointCloud& cloud) {
+Result<PinholeGrid, GridRefusal> organize_if_pinhole(PointCloud& cloud, std::size_t max_points) {
   if (cloud.organized()) {
     PinholeGrid g;
     g.width = cloud.width();
@@ -193,6 +193,7 @@ Result<PinholeGrid, GridRefusal> organize_if_pinhole(PointCloud& cloud) {
   }
   auto grid = find_pinhole_grid(cloud.points());
   if (!grid) return grid;
+  if (std::size_t{grid->width} * grid->height > max_points) return err(GridRefusal::TOO_LARGE);
   PointCloud organized;
   regrid(cloud, *grid, organized);
   cloud = std::move(organized);

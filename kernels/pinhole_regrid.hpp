@@ -43,7 +43,7 @@ enum class GridRefusal : std::uint8_t {
   TOO_FEW_POINTS,  ///< fewer than MIN_GRID_POINTS finite points in front of the sensor
   NO_PITCH,        ///< the stored order shows no row of consecutive pixels to measure the pitch on
   OFF_GRID,        ///< a point lies farther than MAX_RESIDUAL_PX from every pixel
-  TOO_LARGE,       ///< the grid would be wider or higher than MAX_GRID_SIDE
+  TOO_LARGE,       ///< the grid would be wider or higher than MAX_GRID_SIDE (or the caller's limit)
   SHARED_PIXEL,    ///< two points fall on one pixel
 };
 [[nodiscard]] std::string_view to_string(GridRefusal refusal) noexcept;
@@ -56,7 +56,9 @@ enum class GridRefusal : std::uint8_t {
 void regrid(const PointCloud& in, const PinholeGrid& grid, PointCloud& out);
 
 /// @brief find_pinhole_grid + regrid: organizes @p cloud in place when it is unorganized and a
-/// grid is found. @return the grid, or why not (an organized cloud is left alone: its grid).
-Result<PinholeGrid, GridRefusal> organize_if_pinhole(PointCloud& cloud);
+/// grid of at most @p max_points pixels is found (a larger one: TOO_LARGE, the cloud unchanged).
+/// @return the grid, or why not (an organized cloud is left alone: its grid).
+Result<PinholeGrid, GridRefusal> organize_if_pinhole(
+    PointCloud& cloud, std::size_t max_points = std::size_t{MAX_GRID_SIDE} * MAX_GRID_SIDE);
 
 }  // namespace orthoflow::kernels

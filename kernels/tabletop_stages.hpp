@@ -60,10 +60,10 @@ struct CreaseParams {
   /// Rounds of re-attaching crease pixels to the piece beside them (each reaches pixel_radius
   /// further into the crease band).
   std::uint32_t attach_rounds = 4;
-  /// Crowded mode, occlusion join (kernels/occlusion_join.cpp): two pieces standing on the table
-  /// with tops within occlusion_top of each other are one object seen on both sides of a nearer
-  /// one when at least occlusion_rows image rows (and 30 % of the shorter piece's rows) run piece,
-  /// occluder at least occluder_gap nearer, piece. 0 rows: off. Metres.
+  /// Crowded mode, occlusion join (kernels/occlusion_join.cpp): two pieces with tops within
+  /// occlusion_top of each other are one object seen on both sides of a nearer one when at least
+  /// occlusion_rows image rows (and 30 % of the shorter piece's rows) run piece, occluder at least
+  /// occluder_gap nearer, piece. 0 rows: off. Metres.
   std::uint32_t occlusion_rows = 8;
   float occluder_gap = 0.02F;
   float occlusion_top = 0.015F;

@@ -28,6 +28,7 @@
 #include "graphs/embedded_graphs.hpp"
 #include "graphs/tabletop.hpp"
 #include "simulation/synthetic_sequence.hpp"
+#include "tests/support/unorganized_copy.hpp"
 
 namespace {
 
@@ -121,17 +122,7 @@ fs::path frames_dir(bool unorganized, std::vector<ok::PointCloud>& clouds) {
       clouds.push_back(std::move(*c));
       continue;
     }
-    ok::PointCloud flat;
-    flat.add_field(ok::Field::RGB);
-    std::size_t n = 0;
-    for (std::size_t i = 0; i < c->size(); ++i) n += std::isfinite(c->z()[i]) ? 1U : 0U;
-    flat.resize_unorganized(n);
-    for (std::size_t i = 0, k = 0; i < c->size(); ++i) {
-      if (!std::isfinite(c->z()[i])) continue;
-      flat.x()[k] = c->x()[i], flat.y()[k] = c->y()[i], flat.z()[k] = c->z()[i];
-      flat.rgb()[k] = c->rgb()[i];
-      ++k;
-    }
+    ok::PointCloud flat = orthoflow::test::unorganized_copy(*c);
     (void)orthoflow::formats::write_pcd(flat, tmp / f.filename());
     clouds.push_back(std::move(flat));
   }

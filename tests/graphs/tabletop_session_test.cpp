@@ -14,6 +14,7 @@
 
 #include "formats/pcd_io.hpp"
 #include "tabletop_run.hpp"
+#include "tests/support/unorganized_copy.hpp"
 
 namespace orthoflow::graphs {
 namespace {
@@ -175,18 +176,7 @@ TEST(TabletopSession, UnorganizedFramesGoBackOnTheirGrid) {
     auto cloud = formats::read_pcd(file);
     ASSERT_TRUE(cloud) << file;
     std::filesystem::copy_file(file, dir / "organized" / (std::string(name) + ".pcd"));
-    kernels::PointCloud flat;
-    flat.add_field(kernels::Field::RGB);
-    std::size_t n = 0;
-    for (std::size_t i = 0; i < cloud->size(); ++i) n += std::isfinite(cloud->z()[i]) ? 1U : 0U;
-    flat.resize_unorganized(n);
-    for (std::size_t i = 0, k = 0; i < cloud->size(); ++i) {
-      if (!std::isfinite(cloud->z()[i])) continue;
-      flat.x()[k] = cloud->x()[i];
-      flat.y()[k] = cloud->y()[i];
-      flat.z()[k] = cloud->z()[i];
-      flat.rgb()[k++] = cloud->has(kernels::Field::RGB) ? cloud->rgb()[i] : 0U;
-    }
+    const kernels::PointCloud flat = orthoflow::test::unorganized_copy(*cloud);
     ASSERT_TRUE(formats::write_pcd(flat, (dir / "flat" / (std::string(name) + ".pcd")).string(),
                                    formats::PcdEncoding::BINARY));
   }

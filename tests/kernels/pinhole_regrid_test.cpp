@@ -10,6 +10,7 @@
 #include <random>
 
 #include "formats/pcd_io.hpp"
+#include "tests/support/unorganized_copy.hpp"
 
 namespace orthoflow::kernels {
 namespace {
@@ -40,25 +41,6 @@ PointCloud pinhole_image(std::uint32_t width, std::uint32_t height, double fx, d
     }
   }
   return c;
-}
-
-/// @p organized without its NaN points, in stored (row-major) order: what such recordings keep.
-PointCloud drop_invalid(const PointCloud& organized) {
-  PointCloud flat;
-  if (organized.has(Field::LABEL)) flat.add_field(Field::LABEL);
-  std::size_t n = 0;
-  for (std::size_t i = 0; i < organized.size(); ++i) n += std::isfinite(organized.z()[i]) ? 1 : 0;
-  flat.resize_unorganized(n);
-  std::size_t k = 0;
-  for (std::size_t i = 0; i < organized.size(); ++i) {
-    if (!std::isfinite(organized.z()[i])) continue;
-    flat.x()[k] = organized.x()[i];
-    flat.y()[k] = organized.y()[i];
-    flat.z()[k] = organized.z()[i];
-    if (organized.has(Field::LABEL)) flat.label()[k] = organized.label()[i];
-    ++k;
-  }
-  return flat;
 }
 
 /// Every valid pixel of @p original is in @p regridded at one common offset, bit for bit, and
@@ -105,7 +87,7 @@ TEST(PinholeRegrid, PutsTheMosdFramesBackOnTheirPixels) {
     auto organized =
         formats::read_pcd(std::string(ORTHOFLOW_SHARED_DIR) + "/data/mosd_learn/" + name + ".pcd");
     ASSERT_TRUE(organized) << name;
-    PointCloud flat = drop_invalid(*organized);
+    PointCloud flat = test::unorganized_copy(*organized);
     auto grid = find_pinhole_grid(flat.points());
     ASSERT_TRUE(grid) << name << ": " << to_string(grid.error());
     EXPECT_LT(grid->max_residual_px, 0.01) << name;
@@ -122,7 +104,7 @@ TEST(PinholeRegrid, SyntheticGridsOfManyShapesAndHoleShares) {
   for (const double holes : {0.0, 0.3, 0.7}) {
     for (const auto& [w, h] : {std::pair{64U, 48U}, std::pair{320U, 240U}, std::pair{33U, 97U}}) {
       const PointCloud original = pinhole_image(w, h, 525.3, 519.8, 31.7, 23.2, holes, seed++);
-      PointCloud cloud = drop_invalid(original);
+      PointCloud cloud = test::unorganized_copy(original);
       auto grid = organize_if_pinhole(cloud);
       if (cloud.size() < MIN_GRID_POINTS) {  // 64x48 with 70 % holes
         EXPECT_EQ(refusal(grid), to_string(GridRefusal::TOO_FEW_POINTS));
@@ -138,7 +120,7 @@ TEST(PinholeRegrid, SyntheticGridsOfManyShapesAndHoleShares) {
 
 TEST(PinholeRegrid, RefusesWhatIsNotAPinholeImage) {
   const PointCloud original = pinhole_image(160, 120, 525.0, 525.0, 80.0, 60.0, 0.2, 9);
-  const PointCloud flat = drop_invalid(original);
+  const PointCloud flat = test::unorganized_copy(original);
   // Empty, too few points, NaN / Inf / behind the sensor.
   EXPECT_EQ(refusal(find_pinhole_grid(PointsView{})), to_string(GridRefusal::TOO_FEW_POINTS));
   {
