@@ -16,6 +16,8 @@ std::string_view to_string(LearningCommand::Kind kind) noexcept {
       return "forget";
     case LearningCommand::Kind::ASK:
       return "ask";
+    case LearningCommand::Kind::UNDO:
+      return "undo";
   }
   return "unknown";
 }
@@ -43,6 +45,8 @@ std::string_view to_string(LearningAck::Outcome outcome) noexcept {
       return "write_failed";
     case O::BUSY:
       return "busy";
+    case O::NOTHING_TO_UNDO:
+      return "nothing_to_undo";
   }
   return "unknown";
 }

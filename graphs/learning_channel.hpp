@@ -27,6 +27,7 @@ struct LearningCommand {
     CORRECT,  ///< the answer for track was wrong: store its current view under label
     FORGET,   ///< forget category label
     ASK,      ///< what is track? (the current smoothed answer)
+    UNDO,     ///< take back the most recent teach or correct not undone yet (from any sender)
   };
   Kind kind = Kind::TEACH;
   std::uint32_t track_id = 0;       ///< TEACH (when not by_position), CORRECT, ASK
@@ -38,7 +39,7 @@ struct LearningCommand {
   std::uint64_t sequence = 0;  ///< set by LearningClient::send (1, 2, ... per client)
 };
 
-/// @brief "teach", "correct", "forget" or "ask".
+/// @brief "teach", "correct", "forget", "ask" or "undo".
 [[nodiscard]] std::string_view to_string(LearningCommand::Kind kind) noexcept;
 
 /// @brief The answer to one command.
@@ -54,6 +55,7 @@ struct LearningAck {
     UNKNOWN_LABEL,  ///< FORGET of a category that was never taught
     WRITE_FAILED,   ///< the synced write failed: nothing was stored
     BUSY,           ///< the durable writer is behind: nothing was stored, send again
+    NOTHING_TO_UNDO,  ///< UNDO with no lesson left to take back (or the memory changed under it)
   };
   std::uint64_t sequence = 0;  ///< the command's
   std::uint32_t sender = 0;
@@ -61,8 +63,9 @@ struct LearningAck {
   Outcome outcome = Outcome::NO_SUCH_TRACK;
   std::uint32_t track_id =
       0;  ///< the object the command applied to (TEACH by position: the one chosen)
-  std::uint32_t views = 0;  ///< TEACH / CORRECT: views stored
-  core::Text label;     ///< TEACH / CORRECT / FORGET: the label; ASK: the answer (empty = Unknown)
+  std::uint32_t views = 0;  ///< TEACH / CORRECT: views stored; UNDO: views taken back
+  core::Text label;  ///< TEACH / CORRECT / FORGET: the label; UNDO: the category the undone lesson
+                     ///< was for; ASK: the answer (empty = Unknown)
   float score = 0.0F;   ///< ASK: the learner's score for the answer
   bool unknown = true;  ///< ASK
   core::Text nearest;   ///< ASK: the nearest category even when the answer is Unknown (score is its

@@ -112,6 +112,11 @@ void LessonDesk::apply(const FrameBlock& block, const LearningCommand& c,
     if (ack.ok()) memories_.drop_answers(c.label.view());
     return;
   }
+  if (c.kind == Kind::UNDO) {
+    ack = service_.undo(ack);  // the tracks' answers of that category are asked again
+    if (ack.ok()) memories_.drop_answers(ack.label.view());
+    return;
+  }
   const std::int64_t k = find_object(block.state(), c);
   if (k < 0) {
     ack.outcome = Outcome::NO_SUCH_TRACK;

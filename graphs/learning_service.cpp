@@ -15,7 +15,8 @@ using Outcome = LearningAck::Outcome;
 /// A durable teach or forget waiting for the background writer; fixed size so queueing never
 /// allocates.
 struct LearningService::Job {
-  bool forget = false;
+  enum class Kind : std::uint8_t { TEACH, FORGET, UNDO };
+  Kind kind = Kind::TEACH;
   Text label;
   std::uint32_t track_id = 0;
   std::int64_t stamp_ns = 0;
@@ -42,6 +43,7 @@ Result<std::unique_ptr<LearningService>, std::string> LearningService::open(
   const std::size_t length = cfg.descriptor.length();
   if (length > MAX_DESCRIPTOR)
     return err("learning: " + cfg.descriptor.describe() + " does not fit the frame block");
+  s->history_ = std::make_unique<LessonHistory>(MAX_UNDO_LESSONS, MAX_TEACH_VIEWS * length);
   if (settings.db) {
     auto memory = learning::PerceptualMemory::open(*settings.db, cfg);
     if (!memory) return err("learning: " + memory.error().to_string());
@@ -75,7 +77,7 @@ LearningAck LearningService::finish(LearningAck ack, bool ok, Outcome failure) n
   ack.outcome = ok ? (memory_ ? Outcome::STORED : Outcome::LEARNED) : failure;
   if (!ok) {
     refused_.fetch_add(1);
-  } else if (ack.kind != LearningCommand::Kind::FORGET) {
+  } else if (ack.kind != LearningCommand::Kind::FORGET && ack.kind != LearningCommand::Kind::UNDO) {
     teaches_.fetch_add(1);
   }
   if (ack.sequence != 0) acknowledge(ack);
@@ -92,14 +94,17 @@ LearningAck LearningService::teach(std::string_view label, std::span<const float
   ack.label.assign(label);
   if (!learning::validate_label(label)) return finish(ack, false, Outcome::BAD_LABEL);
   if (count == 0) return finish(ack, false, Outcome::REJECTED);
+  const auto taught_values = views.first(count * length);
   if (!memory_) {
-    const bool taught = learner_->teach(label, {views.first(count * length), length}).has_value();
+    const bool taught = learner_->teach(label, {taught_values, length}).has_value();
+    if (taught) history_->push(label, taught_values);
     return finish(ack, taught, Outcome::REJECTED);
   }
   Job* job = jobs_.claim();
   if (job == nullptr)
     return finish(ack, false, Outcome::BUSY);  // the writer is behind: refuse, never wait
-  job->forget = false;
+  history_->push(label, taught_values);        // a write that fails later makes its undo refused
+  job->kind = Job::Kind::TEACH;
   job->label.assign(label);
   job->track_id = track_id;
   job->stamp_ns = stamp_ns;
@@ -115,11 +120,13 @@ LearningAck LearningService::forget(std::string_view label, LearningAck ack) noe
   ack.label.assign(label);
   if (!memory_) {
     const bool forgotten = learner_->forget(label).has_value();
+    if (forgotten) history_->drop(label);
     return finish(ack, forgotten, Outcome::UNKNOWN_LABEL);
   }
   Job* job = jobs_.claim();
   if (job == nullptr) return finish(ack, false, Outcome::BUSY);
-  job->forget = true;
+  history_->drop(label);
+  job->kind = Job::Kind::FORGET;
   job->label.assign(label);
   job->views = 0;
   job->ack = ack;
@@ -128,17 +135,49 @@ LearningAck LearningService::forget(std::string_view label, LearningAck ack) noe
   return ack;
 }
 
+LearningAck LearningService::undo(LearningAck ack) noexcept {
+  LessonHistory::Lesson lesson;
+  ack.track_id = 0;
+  if (!history_->newest(lesson)) return finish(ack, false, Outcome::NOTHING_TO_UNDO);
+  const std::size_t length = descriptor_length();
+  ack.label.assign(lesson.label);
+  ack.views = static_cast<std::uint32_t>(lesson.values.size() / length);
+  if (!memory_) {
+    const bool undone = learner_->retract(lesson.label, {lesson.values, length}).has_value();
+    history_->pop();
+    return finish(ack, undone, Outcome::NOTHING_TO_UNDO);
+  }
+  Job* job = jobs_.claim();
+  if (job == nullptr) return finish(ack, false, Outcome::BUSY);  // the lesson stays undoable
+  job->kind = Job::Kind::UNDO;
+  job->label.assign(lesson.label);
+  job->views = ack.views;
+  job->ack = ack;
+  std::copy(lesson.values.begin(), lesson.values.end(), job->values.begin());
+  jobs_.publish();
+  history_->pop();
+  ack.outcome = Outcome::STORED;
+  return ack;
+}
+
 // One durable write, then its acknowledgement (only now is the lesson on disk and visible to asks).
 void LearningService::run_job(const Job& job) noexcept {
   LearningAck ack = job.ack;
-  if (job.forget) {
+  const std::size_t length = descriptor_length();
+  if (job.kind == Job::Kind::UNDO) {
+    const std::span<const float> values(job.values.data(), job.views * length);
+    auto undone = memory_->retract(job.label.view(), {values, length});
+    const bool failed = !undone && undone.error().code == learning::MemoryError::Code::WRITE_FAILED;
+    finish(ack, undone.has_value(), failed ? Outcome::WRITE_FAILED : Outcome::NOTHING_TO_UNDO);
+    return;
+  }
+  if (job.kind == Job::Kind::FORGET) {
     auto forgotten = memory_->forget(job.label.view());
     const bool unknown =
         !forgotten && forgotten.error().code == learning::MemoryError::Code::UNKNOWN_LABEL;
     finish(ack, forgotten.has_value(), unknown ? Outcome::UNKNOWN_LABEL : Outcome::WRITE_FAILED);
     return;
   }
-  const std::size_t length = descriptor_length();
   std::vector<learning::ViewRecord> records(job.views);  // the writer thread may allocate
   for (std::size_t v = 0; v < job.views; ++v) {
     records[v].descriptor.assign(

@@ -27,6 +27,7 @@
 #include "core/spsc_ring.hpp"
 #include "graphs/frame_block.hpp"
 #include "graphs/learning_channel.hpp"
+#include "graphs/lesson_history.hpp"
 #include "learning/perceptual_memory.hpp"
 
 namespace orthoflow::graphs {
@@ -112,6 +113,12 @@ class LearningService {
                     std::int64_t stamp_ns, LearningAck ack) noexcept;
   /// @brief Forgets @p label; same acknowledgement rules as teach().
   LearningAck forget(std::string_view label, LearningAck ack) noexcept;
+  /// @brief Takes back the most recent teach or correct that is not undone yet (of any sender,
+  /// the scripted instructor's too; up to MAX_UNDO_LESSONS back; a forget drops its category's
+  /// lessons): exactly the views it stored, from the memory too (synced) when durable. @p ack gets
+  /// the lesson's label and view count; NOTHING_TO_UNDO when there is none, or when the memory's
+  /// last views of the category are not the lesson's. Same acknowledgement rules as teach().
+  LearningAck undo(LearningAck ack) noexcept;
 
   /// @brief Waits until every queued durable write is done (tests, shutdown).
   void flush() noexcept;
@@ -137,6 +144,7 @@ class LearningService {
 
   std::unique_ptr<learning::Learner> learner_;          // in memory
   std::unique_ptr<learning::PerceptualMemory> memory_;  // durable
+  std::unique_ptr<LessonHistory> history_;  // the recognise node's: lessons that undo can take back
   kernels::DescriptorSpec spec_{};
   std::mutex senders_;  // serialises the command producers
   core::SpscRing<LearningCommand> commands_{64};

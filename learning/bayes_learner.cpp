@@ -38,6 +38,16 @@ void accumulate_views(DescriptorBatch views, std::span<double> sums) noexcept {
   }
 }
 
+void subtract_views(DescriptorBatch views, std::span<double> sums) noexcept {
+  for (std::size_t v = 0; v < views.count(); ++v) {
+    const std::span<const float> x = views.view(v);
+    for (std::size_t i = 0; i < sums.size(); ++i) {
+      // A retraction subtracts what a teach added; rounding must not leave a negative bin.
+      sums[i] = std::max(0.0, sums[i] - static_cast<double>(x[i]));
+    }
+  }
+}
+
 namespace {
 
 using CategoryPtr = std::shared_ptr<const BayesCategory>;
@@ -119,6 +129,19 @@ Prediction BayesLearner::ask(std::span<const float> descriptor,
 
 Result<void, LearnError> BayesLearner::forget(std::string_view label) {
   return erase_category(writer_, *cell_, label, finish);
+}
+
+Result<void, LearnError> BayesLearner::retract(std::string_view label, DescriptorBatch views) {
+  if (auto r = validate_batch(views, cfg_.descriptor_length, true); !r) { return err(r.error()); }
+  auto make = [&](const BayesCategory& c) -> Result<CategoryPtr, LearnError> {
+    if (views.count() > c.seen) { return err(LearnError::NOT_LAST_VIEWS); }
+    const std::uint64_t seen = c.seen - views.count();
+    if (seen == 0) { return CategoryPtr{}; }
+    std::vector<double> sums = c.sums;
+    subtract_views(views, sums);
+    return make_category(c.id, c.label, seen, std::move(sums), cfg_.count_scale);
+  };
+  return shrink_category(writer_, *cell_, label, make, finish);
 }
 
 Result<void, LearnError> BayesLearner::restore(std::span<const RestoredCategory> categories,

@@ -30,6 +30,9 @@ struct BayesConfig {
 /// of a_k / scale).
 /// @pre sums.size() == views.length. @note No allocation; deterministic.
 void accumulate_views(DescriptorBatch views, std::span<double> sums) noexcept;
+/// @brief Takes every view of @p views back out of @p sums (the inverse of accumulate_views; a bin
+/// never goes below 0). @pre sums.size() == views.length.
+void subtract_views(DescriptorBatch views, std::span<double> sums) noexcept;
 
 struct BayesSnapshot;
 
@@ -47,6 +50,8 @@ class BayesLearner final : public Learner {
   [[nodiscard]] Prediction ask(std::span<const float> descriptor,
                                AskScratch& scratch) const noexcept override;
   [[nodiscard]] Result<void, LearnError> forget(std::string_view label) override;
+  [[nodiscard]] Result<void, LearnError> retract(std::string_view label,
+                                                 DescriptorBatch views) override;
   [[nodiscard]] Result<void, LearnError> restore(std::span<const RestoredCategory> categories,
                                                  CategoryId next_id) override;
   [[nodiscard]] LearnerStats stats() const noexcept override;

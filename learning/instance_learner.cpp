@@ -197,6 +197,39 @@ Result<void, LearnError> InstanceLearner::forget(std::string_view label) {
   return erase_category(writer_, *cell_, label, finisher(cfg_));
 }
 
+// The category without its last views.count() views, which must equal @p views bit for bit;
+// null when none would be left. The pair sum is recomputed over the views that stay.
+Result<CategoryPtr, LearnError> without_last(const InstanceCategory& c, DescriptorBatch views,
+                                             std::size_t dims) {
+  const std::size_t n = views.count();
+  if (n > c.count) { return err(LearnError::NOT_LAST_VIEWS); }
+  const std::size_t keep = c.count - n;
+  for (std::size_t v = 0; v < n; ++v) {
+    for (std::size_t d = 0; d < dims; ++d) {
+      if (c.soa[d * c.stride + keep + v] != views.view(v)[d]) {
+        return err(LearnError::NOT_LAST_VIEWS);
+      }
+    }
+  }
+  if (keep == 0) { return CategoryPtr{}; }
+  std::vector<float> kept(keep * dims);
+  for (std::size_t v = 0; v < keep; ++v) {
+    for (std::size_t d = 0; d < dims; ++d) { kept[v * dims + d] = c.soa[d * c.stride + v]; }
+  }
+  InstanceCategory base;
+  base.id = c.id;
+  base.label = c.label;
+  return extend(base, DescriptorBatch{kept, dims}, dims);
+}
+
+Result<void, LearnError> InstanceLearner::retract(std::string_view label, DescriptorBatch views) {
+  if (auto r = validate_batch(views, cfg_.descriptor_length, false); !r) { return err(r.error()); }
+  auto make = [&](const InstanceCategory& c) {
+    return without_last(c, views, cfg_.descriptor_length);
+  };
+  return shrink_category(writer_, *cell_, label, make, finisher(cfg_));
+}
+
 Result<void, LearnError> InstanceLearner::restore(std::span<const RestoredCategory> categories,
                                                   CategoryId next_id) {
   if (auto r = validate_restored(categories, cfg_.descriptor_length, false); !r) {

@@ -55,6 +55,8 @@ class InstanceLearner final : public Learner {
   [[nodiscard]] Prediction ask(std::span<const float> descriptor,
                                AskScratch& scratch) const noexcept override;
   [[nodiscard]] Result<void, LearnError> forget(std::string_view label) override;
+  [[nodiscard]] Result<void, LearnError> retract(std::string_view label,
+                                                 DescriptorBatch views) override;
   [[nodiscard]] Result<void, LearnError> restore(std::span<const RestoredCategory> categories,
                                                  CategoryId next_id) override;
   [[nodiscard]] LearnerStats stats() const noexcept override;

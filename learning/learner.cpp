@@ -30,6 +30,8 @@ const char* to_string(LearnError error) noexcept {
       return "no category has this label";
     case LearnError::DUPLICATE_ID:
       return "two restored categories share an id or a label";
+    case LearnError::NOT_LAST_VIEWS:
+      return "those views are not the category's last views";
   }
   return "unknown learn error";
 }

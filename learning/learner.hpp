@@ -59,6 +59,7 @@ enum class LearnError : std::uint8_t {
   NEGATIVE_VALUE,  ///< a histogram value is negative (BayesLearner: histograms only)
   UNKNOWN_LABEL,   ///< forget() of a label that was never taught
   DUPLICATE_ID,    ///< restore() got two categories with one id or one label
+  NOT_LAST_VIEWS,  ///< retract(): the views are not the category's last ones (or more than it has)
 };
 /// @brief A sentence saying what was wrong, e.g. "label longer than 63 bytes".
 [[nodiscard]] const char* to_string(LearnError error) noexcept;
@@ -162,6 +163,13 @@ class Learner {
                                        AskScratch& scratch) const noexcept = 0;
   /// @brief Removes category @p label and all its views. @note Thread-safe; publishes one snapshot.
   [[nodiscard]] virtual Result<void, LearnError> forget(std::string_view label) = 0;
+  /// @brief Takes back the last views.count() views taught to @p label (undo of a teach or
+  /// correct): @p views must be those views, in teaching order (InstanceLearner compares them
+  /// exactly; BayesLearner subtracts them from the accumulators and N_k). A category left with no
+  /// view is removed. Errors: UNKNOWN_LABEL, NOT_LAST_VIEWS, and the batch errors of teach().
+  /// Nothing changes on an error. @note Thread-safe; publishes one snapshot.
+  [[nodiscard]] virtual Result<void, LearnError> retract(std::string_view label,
+                                                         DescriptorBatch views) = 0;
   /// @brief Replaces the whole state with @p categories (start-up load). The next new label gets
   /// max(@p next_id, largest restored id + 1), so ids stay in step with the store that assigned
   /// them. Errors: DUPLICATE_ID, and the teach() errors for a bad label or view. @note Publishes

@@ -145,6 +145,87 @@ Result<CategoryId, MemoryError> PerceptualMemory::correct(std::string_view label
   return teach(label, std::span<const ViewRecord>(&view, 1));
 }
 
+namespace {
+
+// The keys of the last @p n views of category @p id, oldest first, with their descriptors
+// compared to @p views: REJECTED unless they are exactly those views.
+Result<std::vector<std::string>, MemoryError> last_view_keys(PerceptualMemory::State& s,
+                                                             CategoryId id, DescriptorBatch views,
+                                                             const std::string& what) {
+  std::vector<std::string> keys;
+  std::vector<ViewRecord> records;
+  const std::string prefix = category_key(KIND_VIEW, id);
+  std::unique_ptr<leveldb::Iterator> it(s.db->NewIterator(leveldb::ReadOptions()));
+  for (it->Seek(prefix); it->Valid() && it->key().starts_with(prefix); it->Next()) {
+    std::string why;
+    auto view = decode_view(as_view(it->value()), s.cfg.descriptor, why);
+    if (!view) return err(memory_error(Code::CORRUPT, s.dir, what + ": " + why));
+    keys.emplace_back(it->key().ToString());
+    records.push_back(std::move(*view));
+  }
+  const std::size_t n = views.count();
+  if (n > records.size()) {
+    return err(memory_error(Code::REJECTED, s.dir,
+                            what + ": " + std::to_string(n) + " views asked back, " +
+                                std::to_string(records.size()) + " stored"));
+  }
+  const std::size_t first = records.size() - n;
+  for (std::size_t v = 0; v < n; ++v) {
+    const std::span<const float> want = views.view(v);
+    const std::vector<float>& have = records[first + v].descriptor;
+    if (!std::equal(want.begin(), want.end(), have.begin(), have.end())) {
+      return err(memory_error(Code::REJECTED, s.dir,
+                              what + ": the stored views differ from the ones to take back " +
+                                  "(a later lesson or another writer changed the category)"));
+    }
+  }
+  keys.erase(keys.begin(), keys.begin() + static_cast<std::ptrdiff_t>(first));
+  return keys;
+}
+
+}  // namespace
+
+Result<void, MemoryError> PerceptualMemory::retract(std::string_view label, DescriptorBatch views) {
+  State& s = *state_;
+  const std::string what = "undo \"" + std::string(label.substr(0, LABEL_MAX_BYTES)) + "\"";
+  IndexedCategory* c = s.find(label);
+  if (c == nullptr) {
+    return err(memory_error(Code::UNKNOWN_LABEL, s.dir, what + ": no such category"));
+  }
+  const std::size_t length = s.learner->descriptor_length();
+  if (auto r = validate_batch(views, length, false); !r) {
+    return err(memory_error(Code::REJECTED, s.dir, what + ": " + to_string(r.error())));
+  }
+  auto keys = last_view_keys(s, c->id, views, what);
+  if (!keys) return err(keys.error());
+  IndexedCategory next = *c;
+  next.record.views -= static_cast<std::uint32_t>(views.count());
+  next.model.seen -= std::min<std::uint64_t>(next.model.seen, views.count());
+  subtract_views(views, next.model.sums);
+  leveldb::WriteBatch batch;
+  for (const std::string& key : *keys) batch.Delete(key);
+  const bool emptied = next.record.views == 0;
+  if (emptied) {
+    batch.Delete(category_key(KIND_CATEGORY, next.id));
+    batch.Delete(category_key(KIND_MODEL, next.id));
+  } else {
+    batch.Put(category_key(KIND_CATEGORY, next.id), encode_category(next.record));
+    batch.Put(category_key(KIND_MODEL, next.id), encode_model(next.model));
+  }
+  if (auto r = write_synced(s, batch, what); !r) return err(r.error());
+  const CategoryId id = next.id;
+  if (emptied) {
+    s.index.erase(std::remove_if(s.index.begin(), s.index.end(),
+                                 [id](const IndexedCategory& e) { return e.id == id; }),
+                  s.index.end());
+  } else {
+    *c = std::move(next);
+  }
+  OF_ENFORCE(s.learner->retract(label, views).has_value(),
+             "learner and memory disagree on a category's last views");
+  return {};
+}
+
 Result<void, MemoryError> PerceptualMemory::forget(std::string_view label) {
   State& s = *state_;
   const IndexedCategory* c = s.find(label);

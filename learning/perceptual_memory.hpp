@@ -121,6 +121,12 @@ class PerceptualMemory {
   /// @brief Deletes a category, its views and its model, synced. Errors: UNKNOWN_LABEL,
   /// WRITE_FAILED.
   [[nodiscard]] Result<void, MemoryError> forget(std::string_view label);
+  /// @brief Undoes a teach or correct: deletes the last views.count() stored views of @p label,
+  /// which must hold exactly @p views' descriptors in teaching order, and takes them out of the
+  /// model, in one synced batch; a category left with no view is deleted. Then the learner
+  /// retracts them. Errors: UNKNOWN_LABEL, REJECTED (not its last views, or a bad batch: nothing
+  /// written), WRITE_FAILED.
+  [[nodiscard]] Result<void, MemoryError> retract(std::string_view label, DescriptorBatch views);
   /// @brief The stored categories by id.
   [[nodiscard]] std::vector<CategoryEntry> list() const;
   [[nodiscard]] MemoryStats stats() const;

@@ -38,6 +38,7 @@ constexpr Route ROUTES[] = {
     {"/api/state", Kind::STATE, false}, {"/api/events", Kind::EVENTS, false},
     {"/api/teach", Kind::TEACH, true},  {"/api/correct", Kind::CORRECT, true},
     {"/api/ask", Kind::ASK, true},      {"/api/forget", Kind::FORGET, true},
+    {"/api/undo", Kind::UNDO, true},
 };
 
 // "application/json", optionally followed by parameters ("; charset=utf-8"). Requiring it also
@@ -91,10 +92,12 @@ Result<ApiRequest, ApiError> decode_action(Kind kind, const RawRequest& request)
   if (!body.is_object()) return refuse(400, "the body must be a JSON object");
   ApiRequest decoded;
   decoded.kind = kind;
-  const bool needs_track = kind != Kind::FORGET, needs_label = kind != Kind::ASK;
+  const bool needs_track = kind != Kind::FORGET && kind != Kind::UNDO,
+             needs_label = kind != Kind::ASK && kind != Kind::UNDO;
   if (auto extra = needs_track && needs_label ? only_fields(body, {"track", "label"})
                    : needs_track              ? only_fields(body, {"track"})
-                                              : only_fields(body, {"label"})) {
+                   : needs_label              ? only_fields(body, {"label"})
+                                              : only_fields(body, {})) {
     return err(std::move(*extra));
   }
   if (needs_track) {
@@ -140,6 +143,8 @@ std::string_view to_string(ApiRequest::Kind kind) noexcept {
       return "ask";
     case Kind::FORGET:
       return "forget";
+    case Kind::UNDO:
+      return "undo";
     case Kind::ASSET:
       return "asset";
   }

@@ -9,6 +9,7 @@
 ///   POST /api/correct {"track": T, "label": "L"}
 ///   POST /api/ask     {"track": T}
 ///   POST /api/forget  {"label": "L"}
+///   POST /api/undo    {}                 take back the most recent teach / correct
 ///   GET  any other path                  an embedded asset (ui/ui_assets.hpp)
 /// Actions are POST only (no state-changing GET), with a JSON body of at most MAX_BODY_BYTES.
 #include <cstdint>
@@ -49,7 +50,7 @@ struct ApiError {
 
 /// @brief A decoded request.
 struct ApiRequest {
-  enum class Kind : std::uint8_t { STATE, EVENTS, TEACH, CORRECT, ASK, FORGET, ASSET };
+  enum class Kind : std::uint8_t { STATE, EVENTS, TEACH, CORRECT, ASK, FORGET, UNDO, ASSET };
   Kind kind = Kind::STATE;
   std::uint32_t track = 0;        ///< TEACH, CORRECT, ASK: >= 1
   core::Text label;               ///< TEACH, CORRECT, FORGET: checked with core::check_label

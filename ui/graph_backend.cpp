@@ -154,9 +154,11 @@ void GraphBackend::record(const UiAction& action, const UiAnswer& answer) {
   EventView e;
   e.time_ms = unix_ms();
   e.action = std::string(graphs::to_string(action.kind));
-  e.track = ok && action.kind != Kind::FORGET ? answer.ack.track_id : action.track;
-  e.label = action.kind == Kind::ASK ? std::string(answer.ack.label.view())
-                                     : std::string(action.label.view());
+  e.track = ok && action.kind != Kind::FORGET && action.kind != Kind::UNDO ? answer.ack.track_id
+                                                                           : action.track;
+  e.label = action.kind == Kind::ASK || action.kind == Kind::UNDO
+                ? std::string(answer.ack.label.view())
+                : std::string(action.label.view());
   e.outcome = outcome_text(answer);
   e.ok = ok;
   e.views = answer.ack.views;

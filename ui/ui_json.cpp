@@ -89,6 +89,7 @@ int http_status(const UiAnswer& answer) noexcept {
     case Outcome::BAD_LABEL:
       return 400;
     case Outcome::NOT_DESCRIBED:
+    case Outcome::NOTHING_TO_UNDO:
       return 409;
     case Outcome::REJECTED:
       return 422;
@@ -125,6 +126,9 @@ std::string answer_json(const UiAction& action, const UiAnswer& answer, bool dur
     if (!answer.ack.runner_up.empty())
       nearest.push_back({{"label", std::string(answer.ack.runner_up.view())}, {"score", nullptr}});
     doc["nearest"] = std::move(nearest);
+  } else if (action.kind == Kind::UNDO) {
+    doc["label"] = acked && !answer.ack.label.empty() ? Json(std::string(answer.ack.label.view()))
+                                                      : Json(nullptr);
   } else if (action.kind != Kind::ASK) {
     doc["label"] = std::string(action.label.view());
   }

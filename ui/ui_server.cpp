@@ -191,6 +191,7 @@ int UiServer::act(mg_connection* conn, const ApiRequest& request) {
   action.kind = request.kind == Kind::TEACH     ? graphs::LearningCommand::Kind::TEACH
                 : request.kind == Kind::CORRECT ? graphs::LearningCommand::Kind::CORRECT
                 : request.kind == Kind::ASK     ? graphs::LearningCommand::Kind::ASK
+                : request.kind == Kind::UNDO    ? graphs::LearningCommand::Kind::UNDO
                                                 : graphs::LearningCommand::Kind::FORGET;
   action.track = request.track;
   action.label = request.label;

@@ -60,6 +60,28 @@ Result<void, LearnError> erase_category(std::mutex& writer, Cell& cell, std::str
   return {};
 }
 
+/// @brief Retract: replaces the category named @p label with make(existing), a
+/// Result<Ptr, LearnError>; a null Ptr removes the category. UNKNOWN_LABEL, or make's error, and
+/// nothing is published.
+template <class Cell, class Make, class Finish>
+Result<void, LearnError> shrink_category(std::mutex& writer, Cell& cell, std::string_view label,
+                                         Make&& make, Finish&& finish) {
+  const std::lock_guard lock(writer);
+  const auto& cur = cell.writer_view();
+  auto next = cur.categories;
+  const auto it = find_label(next, label);
+  if (it == next.end()) { return err(LearnError::UNKNOWN_LABEL); }
+  auto shrunk = make(**it);
+  if (!shrunk) { return err(shrunk.error()); }
+  if (*shrunk == nullptr) {
+    next.erase(it);
+  } else {
+    *it = std::move(*shrunk);
+  }
+  cell.publish(finish(std::move(next), cur.generation + 1, cur.next_id));
+  return {};
+}
+
 /// @brief Restore: publishes @p categories (sorted by id here) in place of everything the learner
 /// held.
 template <class Cell, class Ptr, class Finish>

@@ -1,7 +1,7 @@
 // The learning channel end to end: a second thread drives a running tabletop session only through
-// the channel (teach, ask, correct, forget, each acknowledged) and sees every effect in the objects
-// output (graphs/objects_output.hpp), with the in-memory learner and with a durable perceptual
-// memory.
+// the channel (teach, ask, correct, forget, undo, each acknowledged) and sees every effect in the
+// objects output (graphs/objects_output.hpp), with the in-memory learner and with a durable
+// perceptual memory.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -149,6 +149,34 @@ void teach_correct_forget(LearningService& learning, Outcome stored) {
   auto again = teacher.call(command(LearningCommand::Kind::FORGET, 0, "alpha"));
   ASSERT_TRUE(again);
   EXPECT_EQ(again->outcome, Outcome::UNKNOWN_LABEL);
+  // undo takes back the correction (its category had nothing else); alpha's teach went with the
+  // forget, so there is nothing further to undo
+  auto undone = teacher.call(command(LearningCommand::Kind::UNDO, 0, ""));
+  ASSERT_TRUE(undone);
+  EXPECT_EQ(undone->outcome, stored) << to_string(undone->outcome);
+  EXPECT_EQ(undone->label.view(), "beta");
+  EXPECT_EQ(undone->views, 1U);
+  ASSERT_TRUE(teacher.wait_for(labelled(""), 30))
+      << "undoing the only lesson left did not make the object Unknown";
+  auto nothing = teacher.call(command(LearningCommand::Kind::UNDO, 0, ""));
+  ASSERT_TRUE(nothing);
+  EXPECT_EQ(nothing->outcome, Outcome::NOTHING_TO_UNDO);
+  // teach twice, undo once: the first lesson stays and still names the object
+  ASSERT_EQ(
+      teacher
+          .call(command(LearningCommand::Kind::TEACH, static_cast<std::uint32_t>(track), "beta"))
+          ->outcome,
+      stored);
+  ASSERT_EQ(
+      teacher
+          .call(command(LearningCommand::Kind::CORRECT, static_cast<std::uint32_t>(track), "beta"))
+          ->outcome,
+      stored);
+  auto second = teacher.call(command(LearningCommand::Kind::UNDO, 0, ""));
+  ASSERT_TRUE(second);
+  EXPECT_EQ(second->outcome, stored);
+  EXPECT_EQ(second->views, 1U);
+  ASSERT_TRUE(teacher.wait_for(labelled("beta"), 30)) << "undo took more than its lesson";
   ASSERT_TRUE(teacher.call(command(LearningCommand::Kind::FORGET, 0, "beta")));
   ASSERT_TRUE(teacher.wait_for(labelled(""), 30))
       << "forgetting every category did not make the object Unknown";

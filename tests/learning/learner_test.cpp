@@ -213,6 +213,81 @@ TEST(Learners, ForgetRemovesACategoryAndKeptPredictionsStayValid) {
   }
 }
 
+// Undo: retract takes back exactly the last lesson; every answer is then the one a learner that
+// was never given that lesson gives (same label, category, score and runner-up, bit for bit for the
+// instance learner; the Bayes model within rounding of the subtraction).
+TEST(Learners, RetractLeavesTheLearnerAsIfTheLessonWasNeverGiven) {
+  const std::vector<float> cup1{1, 0, 0.9F, 0.1F};
+  const std::vector<float> cup2{0.2F, 0.8F};  // the lesson to take back
+  const std::vector<float> plate{0, 1, 0.1F, 0.9F};
+  const std::vector<std::vector<float>> queries{{1, 0}, {0, 1}, {0.3F, 0.7F}, {0.5F, 0.5F}};
+  for (int kind = 0; kind < 2; ++kind) {
+    auto make = [kind]() -> std::unique_ptr<Learner> {
+      if (kind == 0) return std::make_unique<InstanceLearner>(InstanceConfig{2});
+      return std::make_unique<BayesLearner>(BayesConfig{2});
+    };
+    auto undone = make();
+    auto never = make();
+    for (Learner* l : {undone.get(), never.get()}) {
+      ASSERT_TRUE(l->teach("cup", batch(cup1, 2)));
+      ASSERT_TRUE(l->teach("plate", batch(plate, 2)));
+    }
+    ASSERT_TRUE(undone->teach("cup", batch(cup2, 2)));
+    ASSERT_EQ(undone->stats().views, 5U);
+    ASSERT_TRUE(undone->retract("cup", batch(cup2, 2))) << kind;
+    EXPECT_EQ(undone->stats().views, never->stats().views);
+    AskScratch a;
+    AskScratch b;
+    for (const auto& q : queries) {
+      const Prediction got = undone->ask(q, a);
+      const Prediction want = never->ask(q, b);
+      EXPECT_EQ(got.label.view(), want.label.view()) << kind;
+      EXPECT_EQ(got.category, want.category);
+      EXPECT_EQ(got.unknown, want.unknown);
+      EXPECT_NEAR(got.score, want.score, kind == 0 ? 0.0F : 1e-5F * (1.0F + std::abs(want.score)));
+      EXPECT_EQ(got.runner_up.view(), want.runner_up.view());
+    }
+  }
+}
+
+TEST(Learners, RetractRefusesViewsThatAreNotTheLastOnesAndChangesNothing) {
+  InstanceLearner instance(InstanceConfig{2});
+  BayesLearner bayes(BayesConfig{2});
+  for (Learner* l : {static_cast<Learner*>(&instance), static_cast<Learner*>(&bayes)}) {
+    ASSERT_TRUE(l->teach("cup", batch({1, 0}, 2)));
+    ASSERT_TRUE(l->teach("cup", batch({0.5F, 0.5F}, 2)));
+    const std::uint64_t generation = l->stats().generation;
+    EXPECT_EQ(l->retract("bowl", batch({1, 0}, 2)).error(), LearnError::UNKNOWN_LABEL);
+    EXPECT_EQ(l->retract("cup", batch({1, 0, 0.5F, 0.5F, 1, 0}, 2)).error(),
+              LearnError::NOT_LAST_VIEWS);  // more views than the category has
+    EXPECT_EQ(l->retract("cup", batch({}, 2)).error(), LearnError::NO_VIEWS);
+    EXPECT_EQ(l->retract("cup", batch({1, 0, 1}, 3)).error(), LearnError::WRONG_LENGTH);
+    EXPECT_EQ(l->stats().generation, generation);  // nothing was published
+    EXPECT_EQ(l->stats().views, 2U);
+  }
+  // The instance learner keeps every view, so it can tell a view that is not the last one.
+  EXPECT_EQ(instance.retract("cup", batch({1, 0}, 2)).error(), LearnError::NOT_LAST_VIEWS);
+  EXPECT_EQ(instance.retract("cup", batch({0.5F, 0.50001F}, 2)).error(),
+            LearnError::NOT_LAST_VIEWS);
+  EXPECT_EQ(instance.stats().views, 2U);
+}
+
+TEST(Learners, RetractingEveryViewRemovesTheCategory) {
+  InstanceLearner instance(InstanceConfig{2});
+  BayesLearner bayes(BayesConfig{2});
+  AskScratch scratch;
+  for (Learner* l : {static_cast<Learner*>(&instance), static_cast<Learner*>(&bayes)}) {
+    ASSERT_TRUE(l->teach("plate", batch({0, 1}, 2)));
+    ASSERT_TRUE(l->teach("cup", batch({1, 0, 0.9F, 0.1F}, 2)));
+    ASSERT_TRUE(l->retract("cup", batch({1, 0, 0.9F, 0.1F}, 2)));
+    ASSERT_EQ(l->categories().size(), 1U);
+    EXPECT_EQ(l->categories()[0].label.view(), "plate");
+    EXPECT_EQ(l->ask(std::vector<float>{1, 0}, scratch).label.view(), "plate");
+    EXPECT_EQ(l->retract("cup", batch({1, 0}, 2)).error(), LearnError::UNKNOWN_LABEL);
+    EXPECT_EQ(*l->teach("cup", batch({1, 0}, 2)), 2U);  // ids are never reused
+  }
+}
+
 TEST(Learners, RestoreGivesTheSameAnswersAsTeaching) {
   const std::vector<float> a{0, 0, 2, 0};
   const std::vector<float> b{10, 0, 10, 4};

@@ -4,6 +4,7 @@
 #include <leveldb/db.h>
 #include <sys/resource.h>
 
+#include <cmath>
 #include <csignal>
 #include <fstream>
 
@@ -113,6 +114,50 @@ TEST(PerceptualMemory, ForgetIsDurableAndUnknownLabelsAreReported) {
   EXPECT_EQ(m.views_of(1)->size(), 0U);
   AskScratch scratch;
   EXPECT_NE(m.learner().ask(make_view(LENGTH, 9, 3).descriptor, scratch).label.view(), "bowl");
+}
+
+// Undo in the store: exactly the last lesson's views go, durably, for either learner; a lesson
+// that is not the category's last is refused and nothing changes.
+TEST(PerceptualMemory, RetractTakesBackTheLastLessonDurably) {
+  const auto dir = fresh_dir();
+  AskScratch scratch;
+  const ViewRecord late = make_view(LENGTH, 1, 7);
+  const ViewRecord query = make_view(LENGTH, 1, 12);
+  for (const LearnerKind kind : {LearnerKind::INSTANCE, LearnerKind::BAYES}) {
+    std::filesystem::remove_all(dir);
+    Prediction never;
+    {
+      auto m = must_open(dir, small_config(kind));
+      teach_three(m);
+      never = m.learner().ask(query.descriptor, scratch);
+      ASSERT_TRUE(m.teach("mug", std::vector{late}));
+      EXPECT_EQ(m.stats().views, 6U);
+      const DescriptorBatch wrong{make_view(LENGTH, 1, 1).descriptor, LENGTH};
+      const auto refused = m.retract("mug", wrong);  // mug's first view, not its last
+      ASSERT_FALSE(refused);
+      EXPECT_EQ(refused.error().code, Code::REJECTED);
+      EXPECT_EQ(m.retract("cup", {late.descriptor, LENGTH}).error().code, Code::UNKNOWN_LABEL);
+      EXPECT_EQ(m.stats().views, 6U);
+      ASSERT_TRUE(m.retract("mug", {late.descriptor, LENGTH}))
+          << m.retract("mug", {late.descriptor, LENGTH}).error().to_string();
+      EXPECT_EQ(m.stats().views, 5U);
+    }
+    auto m = must_open(dir, small_config(kind));  // what the undo left is what a reopen finds
+    EXPECT_EQ(m.stats().views, 5U);
+    ASSERT_EQ(m.list().size(), 3U);
+    EXPECT_EQ(m.list()[0].views, 2U);
+    ASSERT_EQ(m.views_of(0)->size(), 2U);
+    EXPECT_EQ(m.views_of(0)->back().descriptor, make_view(LENGTH, 1, 2).descriptor);
+    const Prediction after = m.learner().ask(query.descriptor, scratch);
+    EXPECT_EQ(after.label, never.label);
+    EXPECT_NEAR(after.score, never.score, 1e-5F * (1.0F + std::abs(never.score)));
+    // Taking back a category's only lesson removes the category, in the store too.
+    ASSERT_TRUE(m.retract("knife", {make_view(LENGTH, 17, 5).descriptor, LENGTH}));
+    EXPECT_EQ(m.list().size(), 2U);
+  }
+  auto m = must_open(dir, small_config());
+  EXPECT_EQ(m.list().size(), 2U);
+  EXPECT_EQ(m.views_of(2)->size(), 0U);
 }
 
 TEST(PerceptualMemory, RejectedTeachWritesNothing) {

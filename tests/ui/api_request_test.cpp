@@ -41,6 +41,7 @@ TEST(ApiRequest, DecodesEveryRoute) {
   auto forget = decode("POST", "/api/forget", R"({"label": "tasse à café"})");
   ASSERT_TRUE(forget);
   EXPECT_EQ(forget->label.view(), "tasse à café");
+  EXPECT_EQ(decode("POST", "/api/undo", "{}")->kind, Kind::UNDO);
   auto asset = decode("GET", "/app.js");
   ASSERT_TRUE(asset);
   EXPECT_EQ(asset->kind, Kind::ASSET);
@@ -48,7 +49,7 @@ TEST(ApiRequest, DecodesEveryRoute) {
 }
 
 TEST(ApiRequest, WrongMethodIs405AndNoActionIsAGet) {
-  for (const char* path : {"/api/teach", "/api/correct", "/api/ask", "/api/forget"}) {
+  for (const char* path : {"/api/teach", "/api/correct", "/api/ask", "/api/forget", "/api/undo"}) {
     const auto r = decode("GET", path, R"({"track":1,"label":"x"})");
     EXPECT_EQ(status_of(r), 405) << path;
     EXPECT_NE(r.error().message.find("POST"), std::string::npos);
@@ -111,6 +112,8 @@ TEST(ApiRequest, FieldsAreCheckedOneByOne) {
   EXPECT_EQ(message("/api/teach", R"({"track":1,"label":3})"), "'label' must be a string");
   EXPECT_EQ(message("/api/ask", R"({"track":1,"label":"x"})"), "unknown field 'label'");
   EXPECT_EQ(message("/api/forget", R"({"label":"x","track":1})"), "unknown field 'track'");
+  EXPECT_EQ(message("/api/undo", R"({"label":"x"})"), "unknown field 'label'");
+  EXPECT_EQ(message("/api/undo", "[]"), "the body must be a JSON object");
   EXPECT_EQ(message("/api/teach", R"({"track":1,"label":"x","lable":"y"})"),
             "unknown field 'lable'");
 }

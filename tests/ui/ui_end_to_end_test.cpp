@@ -142,6 +142,25 @@ void teach_ask_forget(graphs::LearningService& learning, const std::string& lear
   EXPECT_EQ(streamed["memory"][0]["label"], "alpha");
   EXPECT_GT(streamed["frame"].get<std::uint64_t>(), 0U);
 
+  // Undo takes the teach back (the memory forgets its views); a second undo has nothing left.
+  const Json undone = post(port, "/api/undo", Json::object(), 200);
+  EXPECT_EQ(undone["outcome"], learned);
+  EXPECT_EQ(undone["label"], "alpha");
+  EXPECT_EQ(undone["views"], taught["views"]);
+  EXPECT_TRUE(wait_for_state(
+      port,
+      [&](const Json& doc) {
+        const Json* o = object_of(doc, track);
+        return doc["memory"].empty() && o != nullptr && o->at("label").is_null();
+      },
+      30))
+      << "undoing the only teach did not empty the memory";
+  const Json nothing = post(port, "/api/undo", Json::object(), 409);
+  EXPECT_EQ(nothing["outcome"], "nothing_to_undo");
+  EXPECT_TRUE(nothing["label"].is_null());
+  ASSERT_EQ(post(port, "/api/teach", {{"track", track}, {"label", "alpha"}}, 200)["outcome"],
+            learned);
+
   // Errors of the learning channel come back as 4xx with the outcome.
   EXPECT_EQ(post(port, "/api/teach", {{"track", 999999}, {"label", "gamma"}}, 404)["outcome"],
             "no_such_track");

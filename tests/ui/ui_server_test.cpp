@@ -174,24 +174,30 @@ TEST_F(UiServerTest, AFloodIsRateLimited) {
 TEST_F(UiServerTest, LearningOutcomesMapToStatuses) {
   start();
   const std::pair<Outcome, int> cases[] = {
-      {Outcome::STORED, 200},        {Outcome::LEARNED, 200},      {Outcome::NO_SUCH_TRACK, 404},
-      {Outcome::NOT_DESCRIBED, 409}, {Outcome::BAD_LABEL, 400},    {Outcome::REJECTED, 422},
-      {Outcome::UNKNOWN_LABEL, 404}, {Outcome::WRITE_FAILED, 500}, {Outcome::BUSY, 503}};
+      {Outcome::STORED, 200},         {Outcome::LEARNED, 200},      {Outcome::NO_SUCH_TRACK, 404},
+      {Outcome::NOT_DESCRIBED, 409},  {Outcome::BAD_LABEL, 400},    {Outcome::REJECTED, 422},
+      {Outcome::UNKNOWN_LABEL, 404},  {Outcome::WRITE_FAILED, 500}, {Outcome::BUSY, 503},
+      {Outcome::NOTHING_TO_UNDO, 409}};
   for (const auto& [outcome, status] : cases) {
     backend_.outcome = outcome;
     const auto r = post_json(port_, "/api/correct", R"({"track":9,"label":"bowl"})");
     EXPECT_EQ(r.status, status) << graphs::to_string(outcome);
     EXPECT_EQ(nlohmann::json::parse(r.body)["outcome"], graphs::to_string(outcome));
   }
+  backend_.outcome = Outcome::NOTHING_TO_UNDO;
+  const auto undo = post_json(port_, "/api/undo", "{}");
+  EXPECT_EQ(undo.status, 409);
+  EXPECT_EQ(nlohmann::json::parse(undo.body)["action"], "undo");
   backend_.status = UiAnswer::Status::TIMEOUT;
   EXPECT_EQ(post_json(port_, "/api/ask", R"({"track":9})").status, 504);
   backend_.status = UiAnswer::Status::QUEUE_FULL;
   EXPECT_EQ(post_json(port_, "/api/ask", R"({"track":9})").status, 503);
-  ASSERT_EQ(backend_.actions.size(), 11U);
+  ASSERT_EQ(backend_.actions.size(), 13U);
   EXPECT_EQ(backend_.actions[0].kind, graphs::LearningCommand::Kind::CORRECT);
   EXPECT_EQ(backend_.actions[0].track, 9U);
   EXPECT_EQ(backend_.actions[0].label.view(), "bowl");
-  EXPECT_EQ(backend_.actions[10].kind, graphs::LearningCommand::Kind::ASK);
+  EXPECT_EQ(backend_.actions[10].kind, graphs::LearningCommand::Kind::UNDO);
+  EXPECT_EQ(backend_.actions[11].kind, graphs::LearningCommand::Kind::ASK);
 }
 
 }  // namespace

@@ -1,5 +1,5 @@
 // The orthoflow live view: reads the state over the WebSocket /api/events (JSON documents, see
-// ui/ui_json.hpp), draws it, and sends teach / correct / ask / forget to the JSON API.
+// ui/ui_json.hpp), draws it, and sends teach / correct / ask / forget / undo to the JSON API.
 'use strict';
 
 const params = new URLSearchParams(location.search);
@@ -57,7 +57,7 @@ function renderEvents(s) {
   fill('events', s.events.slice().reverse(), (row, e) => {
     cell(row, e.id);
     cell(row, e.action);
-    cell(row, e.action === 'forget' ? '-' : e.track);
+    cell(row, e.action === 'forget' || e.action === 'undo' ? '-' : e.track);
     cell(row, e.label || (e.action === 'ask' ? 'Unknown' : ''));
     cell(row, e.outcome, e.ok ? 'good' : 'bad');
   });
@@ -146,8 +146,9 @@ $('top').addEventListener('click', (event) => {
 
 async function act(action) {
   const label = $('label').value.trim();
-  const body = action === 'forget' ? {label} : action === 'ask' ? {track: selected} : {track: selected, label};
-  if (action !== 'forget' && selected === null) { $('answer').textContent = 'click an object first'; return; }
+  const body = action === 'forget' ? {label} : action === 'undo' ? {}
+    : action === 'ask' ? {track: selected} : {track: selected, label};
+  if (action !== 'forget' && action !== 'undo' && selected === null) { $('answer').textContent = 'click an object first'; return; }
   const headers = {'Content-Type': 'application/json'};
   if (token) headers.Authorization = `Bearer ${token}`;
   $('answer').textContent = `${action}...`;
@@ -160,6 +161,7 @@ async function act(action) {
       const near = answer.nearest.map((n) => n.score === null ? n.label : `${n.label} ${fmt(n.score, 3)}`);
       if (near.length > 0) text += `; nearest: ${near.join(', ')}`;
     }
+    if (action === 'undo' && answer.ok) text += `: ${answer.views} view(s) of "${answer.label}" taken back`;
     if (!answer.ok && answer.error) text += ` (${answer.error})`;
     if (answer.ok && answer.outcome === 'stored') text += ' (on disk)';
     $('answer').textContent = text;
