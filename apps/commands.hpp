@@ -17,6 +17,9 @@ inline constexpr int EXIT_USAGE =
 inline constexpr int EXIT_NO_ROUDI = 20;    ///< RouDi unreachable
 inline constexpr int EXIT_POOLS = 21;       ///< RouDi's pools do not fit the topics
 inline constexpr int EXIT_ROUDI_LOST = 22;  ///< RouDi disappeared while running
+/// Remote-client exit codes (`teach|correct|ask|forget|undo|state --url`).
+inline constexpr int EXIT_REFUSED = 30;      ///< the robot answered and refused (HTTP 4xx/5xx)
+inline constexpr int EXIT_UNREACHABLE = 31;  ///< no answer: cannot connect, or timed out
 
 /// @brief `graph check|dot|run FILE`: validate, draw (Graphviz) and run dataflow graph files.
 void add_graph_command(CLI::App& app);
@@ -39,6 +42,11 @@ void add_memory_command(CLI::App& app);
 /// @brief `ipc config|doctor|echo|send|run`: operate the iceoryx transport (exit codes 20-22 in
 /// docs/IPC.md).
 void add_ipc_command(CLI::App& app);
+
+/// @brief `teach|correct TRACK LABEL`, `ask TRACK`, `forget LABEL`, `undo`, `state`, each with
+/// `--url http://HOST:PORT`: a thin client of a running orthoflow's teaching API (exit 30 refused,
+/// 31 unreachable).
+void add_remote_commands(CLI::App& app);
 
 /// @brief `run`: the tabletop graph on the embedded session or a given source; summary, JSON lines,
 /// snapshot.

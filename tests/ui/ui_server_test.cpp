@@ -10,6 +10,7 @@
 #include <mutex>
 
 #include "http_test_client.hpp"
+#include "ui/ui_client.hpp"
 
 namespace orthoflow::ui {
 namespace {
@@ -198,6 +199,64 @@ TEST_F(UiServerTest, LearningOutcomesMapToStatuses) {
   EXPECT_EQ(backend_.actions[0].label.view(), "bowl");
   EXPECT_EQ(backend_.actions[10].kind, graphs::LearningCommand::Kind::UNDO);
   EXPECT_EQ(backend_.actions[11].kind, graphs::LearningCommand::Kind::ASK);
+}
+
+// The program client (ui/ui_client.hpp) against the real server: the body goes out as JSON, the
+// token when it has one, and a refusal comes back as a reply, not an error.
+TEST_F(UiServerTest, ClientSendsActionsWithTheTokenAndReadsEveryAnswer) {
+  start(TOKEN);
+  auto target = parse_ui_url("http://127.0.0.1:" + std::to_string(port_) + "/");
+  ASSERT_TRUE(target) << target.error();
+  auto denied = send_ui_request(*target, "GET", "/api/state", "");
+  ASSERT_TRUE(denied) << denied.error();
+  EXPECT_EQ(denied->status, 401);
+  target->token = TOKEN;
+  auto state = send_ui_request(*target, "GET", "/api/state", "");
+  ASSERT_TRUE(state) << state.error();
+  EXPECT_EQ(state->status, 200);
+  EXPECT_EQ(nlohmann::json::parse(state->body)["objects"][0]["label"], "mug");
+  auto taught = send_ui_request(*target, "POST", "/api/teach", R"({"track":5,"label":"bowl"})");
+  ASSERT_TRUE(taught) << taught.error();
+  EXPECT_EQ(taught->status, 200);
+  ASSERT_EQ(backend_.actions.size(), 1U);
+  EXPECT_EQ(backend_.actions[0].track, 5U);
+  EXPECT_EQ(backend_.actions[0].label.view(), "bowl");
+  backend_.outcome = Outcome::NOTHING_TO_UNDO;
+  auto undo = send_ui_request(*target, "POST", "/api/undo", "{}");
+  ASSERT_TRUE(undo) << undo.error();
+  EXPECT_EQ(undo->status, 409);
+  EXPECT_EQ(nlohmann::json::parse(undo->body)["outcome"], "nothing_to_undo");
+  auto bad = send_ui_request(*target, "POST", "/api/teach", "{not json");
+  ASSERT_TRUE(bad);
+  EXPECT_EQ(bad->status, 400);
+}
+
+TEST(UiClient, UrlsAreCheckedAndAnUnreachableServerIsAnError) {
+  auto ok = parse_ui_url("http://robot.local:8080");
+  ASSERT_TRUE(ok) << ok.error();
+  EXPECT_EQ(ok->host, "robot.local");
+  EXPECT_EQ(ok->port, 8080);
+  for (const char* bad :
+       {"https://127.0.0.1:80", "127.0.0.1:80", "http://127.0.0.1", "http://127.0.0.1:0",
+        "http://127.0.0.1:65536", "http://127.0.0.1:80/api", "http://u:p@127.0.0.1:80",
+        "http://:80", "http://127.0.0.1:8x", "http://127.0.0.1:80?token=x"}) {
+    EXPECT_FALSE(parse_ui_url(bad)) << bad;
+  }
+  // A port nothing listens on (bound, never listening): refused at once.
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ASSERT_EQ(::bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0);
+  socklen_t len = sizeof addr;
+  ::getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &len);
+  ClientTarget target;
+  target.host = "127.0.0.1";
+  target.port = ntohs(addr.sin_port);
+  auto r = send_ui_request(target, "GET", "/api/state", "");
+  ::close(fd);
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().find("cannot connect"), std::string::npos) << r.error();
 }
 
 }  // namespace
