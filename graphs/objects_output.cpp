@@ -37,9 +37,13 @@ class ObjectsOutput final : public engine::Node {
       return;  // every list still in flight downstream: this frame's is not sent on the port
     auto* list =
         new (block->bytes().data()) engine::ObjectListPayload();  // header and count set below
-    fill_object_list(block_of(in, capacity_), in.frame_id, Clock::now().time_since_epoch().count(),
-                     *list);
-    if (hub_ != nullptr) hub_->publish(*list);
+    const FrameBlock frame_block = block_of(in, capacity_);
+    const std::int64_t now_ns = Clock::now().time_since_epoch().count();
+    fill_object_list(frame_block, in.frame_id, now_ns, *list);
+    if (hub_ != nullptr) {
+      hub_->publish(*list);
+      if (auto frame = frame_block.frame()) hub_->camera().offer(*frame, now_ns);
+    }
     engine::Message objects = in;
     objects.payload = std::move(*block);
     out.emit(1, objects);

@@ -20,6 +20,7 @@
 #include "core/spsc_ring.hpp"
 #include "engine/object_list_payload.hpp"
 #include "engine/registry.hpp"
+#include "graphs/camera_tap.hpp"
 #include "graphs/frame_block.hpp"
 
 namespace orthoflow::graphs {
@@ -55,6 +56,9 @@ class ObjectsHub {
   /// @brief Copies @p list (its header and count entries) to every consumer. Allocation-free.
   void publish(const engine::ObjectListPayload& list) noexcept;
   [[nodiscard]] std::uint64_t published() const noexcept { return published_.load(); }
+  /// @brief The camera view of the frames whose lists are published (offered by objects_output
+  /// after each publish(); copies only while a viewer asks for it).
+  [[nodiscard]] CameraTap& camera() noexcept { return camera_; }
 
  private:
   friend class ObjectsSubscription;
@@ -63,6 +67,7 @@ class ObjectsHub {
                                  // progress makes that frame's list skip the consumers, never wait
   std::vector<ObjectsSubscription*> subscribers_;
   std::atomic<std::uint64_t> published_{0}, skipped_{0};
+  CameraTap camera_;
 };
 
 /// @brief Fills @p out from the objects of @p block (frame @p frame_id, decided at @p decided_ns).

@@ -13,6 +13,7 @@ PACKAGES=(
   clang-14 libclang-rt-14-dev clang-format-14
   libpcl-dev
   libfreenect-dev libfreenect-bin  # test-only: libfreenect against the simulated Kinect (tests/support/sim_libusb)
+  chromium chromium-driver  # test-only: the web view in a real, headless browser (tests/ui/check_browser.py)
 )
 
 missing=()

@@ -9,7 +9,9 @@
 ///      (403 otherwise); a cross-site fetch or WebSocket from another page always carries one.
 ///   3. Token (when the server listens beyond loopback): "Authorization: Bearer <token>", or
 ///      "?token=<token>" where a browser cannot set a header (the page's first load, the WebSocket
-///      upgrade); compared in constant time (401 otherwise).
+///      upgrade), or the page's cookie (token_cookie: set on the page that was loaded with the
+///      token, so that the browser's requests for the page's script and style carry it too);
+///      compared in constant time (401 otherwise).
 #include <optional>
 #include <string>
 #include <string_view>
@@ -26,12 +28,19 @@ struct AccessPolicy {
   std::vector<std::string> origins;  ///< rule 2: accepted Origin values ("http://127.0.0.1:8080")
   bool host_is_origin = false;       ///< rule 2 also accepts "http://" + Host (wildcard address)
   std::string token;                 ///< rule 3 when not empty
+  std::string cookie_name;  ///< rule 3's cookie: "orthoflow_token_<port>" (cookies ignore ports)
 };
 
 /// @brief The policy of a server listening on @p address (IPv4 text) port @p port with @p token
 /// ("" = none). @pre a token is given when @p address is not loopback.
 [[nodiscard]] AccessPolicy make_access_policy(std::string_view address, unsigned port,
                                               std::string token);
+
+/// @brief The Set-Cookie header line (with CRLF) that hands the page's browser the token, or ""
+/// when the policy has no token or the token holds a character a cookie value cannot (RFC 6265
+/// cookie-octet: no space, '"', ',', ';' or '\\'; generated tokens are hex). HttpOnly: no script
+/// reads it; SameSite=Strict: no other site's page makes the browser send it.
+[[nodiscard]] std::string token_cookie(const AccessPolicy& policy);
 
 /// @brief Whether @p address is an IPv4 loopback address (127.0.0.0/8) or "localhost".
 [[nodiscard]] bool is_loopback_address(std::string_view address) noexcept;

@@ -38,7 +38,7 @@ constexpr Route ROUTES[] = {
     {"/api/state", Kind::STATE, false}, {"/api/events", Kind::EVENTS, false},
     {"/api/teach", Kind::TEACH, true},  {"/api/correct", Kind::CORRECT, true},
     {"/api/ask", Kind::ASK, true},      {"/api/forget", Kind::FORGET, true},
-    {"/api/undo", Kind::UNDO, true},
+    {"/api/undo", Kind::UNDO, true},    {"/api/camera.png", Kind::CAMERA, false},
 };
 
 // "application/json", optionally followed by parameters ("; charset=utf-8"). Requiring it also
@@ -145,6 +145,8 @@ std::string_view to_string(ApiRequest::Kind kind) noexcept {
       return "forget";
     case Kind::UNDO:
       return "undo";
+    case Kind::CAMERA:
+      return "camera";
     case Kind::ASSET:
       return "asset";
   }
@@ -187,6 +189,11 @@ Result<ApiRequest, ApiError> decode_request(const RawRequest& request) {
     if (route.post && !post) return refuse(405, "use POST for " + std::string(route.path));
     if (!route.post && !get) return refuse(405, "use GET for " + std::string(route.path));
     if (route.kind == Kind::STATE) return ApiRequest{};
+    if (route.kind == Kind::CAMERA) {
+      ApiRequest camera;
+      camera.kind = Kind::CAMERA;
+      return camera;
+    }
     if (route.kind == Kind::EVENTS) return decode_events(request);
     return decode_action(route.kind, request);
   }

@@ -50,7 +50,17 @@ struct ApiError {
 
 /// @brief A decoded request.
 struct ApiRequest {
-  enum class Kind : std::uint8_t { STATE, EVENTS, TEACH, CORRECT, ASK, FORGET, UNDO, ASSET };
+  enum class Kind : std::uint8_t {
+    STATE,
+    EVENTS,
+    TEACH,
+    CORRECT,
+    ASK,
+    FORGET,
+    UNDO,
+    ASSET,
+    CAMERA
+  };
   Kind kind = Kind::STATE;
   std::uint32_t track = 0;        ///< TEACH, CORRECT, ASK: >= 1
   core::Text label;               ///< TEACH, CORRECT, FORGET: checked with core::check_label

@@ -2,6 +2,8 @@
 
 #include <chrono>
 #include <cstring>
+#include <exception>
+#include <thread>
 
 namespace orthoflow::ui {
 
@@ -48,15 +50,17 @@ Result<std::unique_ptr<GraphBackend>, std::string> GraphBackend::open(
   auto client = learning.connect();
   if (!client) return err(std::string("the learning channel has no free client slot"));
   return std::unique_ptr<GraphBackend>(
-      new GraphBackend(learning, std::move(client), hub.subscribe(4)));
+      new GraphBackend(learning, std::move(client), hub.subscribe(4), hub.camera()));
 }
 
 GraphBackend::GraphBackend(graphs::LearningService& learning,
                            std::unique_ptr<graphs::LearningClient> client,
-                           std::unique_ptr<graphs::ObjectsSubscription> objects)
+                           std::unique_ptr<graphs::ObjectsSubscription> objects,
+                           graphs::CameraTap& camera)
     : learning_(learning),
       client_(std::move(client)),
       objects_(std::move(objects)),
+      camera_(camera),
       latest_(std::make_unique<engine::ObjectListPayload>()) {
   latest_->reset_header();
   poller_ = std::thread([this] { poll_objects(); });
@@ -70,6 +74,7 @@ GraphBackend::~GraphBackend() {
 // Takes the newest list from the subscription's ring into a scratch copy, then swaps it in under
 // the lock, so a reader never waits for more than a pointer swap.
 void GraphBackend::poll_objects() noexcept {
+  prepare_camera_fonts();  // now, not at the first image: the graph is warming up
   auto scratch = std::make_unique<engine::ObjectListPayload>();
   while (!stop_.load()) {
     bool got = false;
@@ -78,6 +83,10 @@ void GraphBackend::poll_objects() noexcept {
       std::lock_guard<std::mutex> guard(state_lock_);
       std::swap(latest_, scratch);
       have_latest_ = true;
+    }
+    try {
+      draw_camera();
+    } catch (const std::exception&) {  // out of memory for an image: the page keeps the last one
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
@@ -101,8 +110,65 @@ UiSnapshot GraphBackend::snapshot() const {
       s.memory.push_back({label, c.views, it == last_taught_ms_.end() ? 0 : it->second});
     }
   }
+  {
+    std::lock_guard<std::mutex> guard(camera_lock_);
+    if (camera_fit_.ok && camera_image_.frame_id != 0) {
+      s.camera.frame_id = camera_image_.frame_id;
+      s.camera.width = camera_image_.width;
+      s.camera.height = camera_image_.height;
+      for (const ImageBox& b :
+           project_boxes(camera_fit_, camera_image_.width, camera_image_.height, s.objects))
+        s.camera.boxes.push_back({b.track, b.u0, b.v0, b.u1, b.v1});
+    }
+  }
   add_telemetry(s);
   return s;
+}
+
+std::string GraphBackend::camera_png() {
+  // Asking keeps the tap copying (at most 5 images per second, the rate the page asks at) for the
+  // next 3 s; the poller thread draws each new image. The first request waits up to 300 ms for the
+  // first image.
+  constexpr std::int64_t KEEP_NS = 3'000'000'000;
+  const std::int64_t now = Clock::now().time_since_epoch().count();
+  camera_.request(now, 200'000'000, KEEP_NS);
+  camera_wanted_until_ns_.store(now + KEEP_NS);
+  for (int wait = 0; wait < 30; ++wait) {
+    {
+      std::lock_guard<std::mutex> guard(camera_lock_);
+      if (!camera_png_.empty()) return camera_png_;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return {};
+}
+
+// On the poller thread (a full-size stack: fontconfig, which cairo's text needs, recurses deeply
+// when it first reads its configuration, too deeply for the server's small worker stacks).
+void GraphBackend::draw_camera() {
+  if (Clock::now().time_since_epoch().count() >= camera_wanted_until_ns_.load()) return;
+  std::uint64_t have = 0;
+  {
+    std::lock_guard<std::mutex> guard(camera_lock_);
+    have = camera_image_.frame_id;
+  }
+  graphs::CameraImage image;
+  if (!camera_.take(image, have)) return;
+  const PinholeFit fit = fit_pinhole(image);
+  std::string png = render_camera_png(image, snapshot_objects());
+  std::lock_guard<std::mutex> guard(camera_lock_);
+  camera_image_ = std::move(image);
+  camera_fit_ = fit;
+  if (!png.empty()) camera_png_ = std::move(png);
+}
+
+std::vector<ObjectView> GraphBackend::snapshot_objects() const {
+  std::vector<ObjectView> objects;
+  std::lock_guard<std::mutex> guard(state_lock_);
+  if (!have_latest_) return objects;
+  const std::uint32_t n = std::min(latest_->count, engine::OBJECT_LIST_CAPACITY);
+  for (std::uint32_t k = 0; k < n; ++k) objects.push_back(view_of(latest_->objects[k]));
+  return objects;
 }
 
 void GraphBackend::add_telemetry(UiSnapshot& s) const {

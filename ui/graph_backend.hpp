@@ -19,6 +19,7 @@
 #include "engine/telemetry.hpp"
 #include "graphs/learning_service.hpp"
 #include "graphs/objects_output.hpp"
+#include "ui/camera_view.hpp"
 #include "ui/ui_backend.hpp"
 
 namespace orthoflow::ui {
@@ -43,10 +44,15 @@ class GraphBackend final : public UiBackend {
   [[nodiscard]] UiSnapshot snapshot() const override;
   [[nodiscard]] UiAnswer submit(const UiAction& action, int timeout_ms) override;
   [[nodiscard]] bool durable() const noexcept override { return learning_.durable(); }
+  /// @brief The newest camera image from the hub's tap with the newest objects drawn on it (the
+  /// objects may be a frame or two younger than the image: the tap copies at most 5 images/s).
+  [[nodiscard]] std::string camera_png() override;
 
  private:
   GraphBackend(graphs::LearningService& learning, std::unique_ptr<graphs::LearningClient> client,
-               std::unique_ptr<graphs::ObjectsSubscription> objects);
+               std::unique_ptr<graphs::ObjectsSubscription> objects, graphs::CameraTap& camera);
+  [[nodiscard]] std::vector<ObjectView> snapshot_objects() const;
+  void draw_camera();
   void poll_objects() noexcept;
   void record(const UiAction& action, const UiAnswer& answer);
   void add_telemetry(UiSnapshot& s) const;
@@ -54,6 +60,12 @@ class GraphBackend final : public UiBackend {
   graphs::LearningService& learning_;
   std::unique_ptr<graphs::LearningClient> client_;
   std::unique_ptr<graphs::ObjectsSubscription> objects_;
+  graphs::CameraTap& camera_;
+  mutable std::mutex camera_lock_;
+  graphs::CameraImage camera_image_;  // guarded by camera_lock_: the last image taken
+  PinholeFit camera_fit_;             // guarded by camera_lock_: its camera
+  std::string camera_png_;            // guarded by camera_lock_: it drawn, with the objects
+  std::atomic<std::int64_t> camera_wanted_until_ns_{0};
   std::mutex client_lock_;  // LearningClient is thread-compatible: one action at a time
   mutable std::mutex state_lock_;
   std::unique_ptr<engine::ObjectListPayload> latest_;   // guarded by state_lock_

@@ -51,6 +51,17 @@ struct NodeLatency {
   std::int64_t p50_ns = 0, p99_ns = 0, max_ns = 0;
 };
 
+/// @brief Where the objects are in the camera image (ui/camera_view.hpp), for a click on it.
+struct CameraBoxes {
+  std::uint64_t frame_id = 0;           ///< of the image; 0 = no camera image
+  std::uint32_t width = 0, height = 0;  ///< image pixels
+  struct Box {
+    std::uint64_t track = 0;
+    float u0 = 0, v0 = 0, u1 = 0, v1 = 0;
+  };
+  std::vector<Box> boxes;
+};
+
 /// @brief Everything the page shows, copied out (the server never reads graph memory directly).
 struct UiSnapshot {
   std::uint64_t frame_id = 0;  ///< of the objects; 0 before the first frame
@@ -62,6 +73,7 @@ struct UiSnapshot {
   std::uint64_t frames_done = 0, drops = 0;
   std::int64_t frame_p99_ns = 0;
   bool durable = false;  ///< acknowledged actions are on disk (--db)
+  CameraBoxes camera;    ///< the objects in the last camera image served
 };
 
 /// @brief An action for the learning channel.
@@ -93,6 +105,9 @@ class UiBackend {
   [[nodiscard]] virtual UiAnswer submit(const UiAction& action, int timeout_ms) = 0;
   /// @brief Whether an acknowledged action is on disk (a durable memory, `--db`).
   [[nodiscard]] virtual bool durable() const noexcept { return false; }
+  /// @brief The camera image with the objects drawn on it, as a PNG; "" when there is none (no
+  /// frame yet, or a source without a pixel grid). Asking keeps the images coming for a while.
+  [[nodiscard]] virtual std::string camera_png() { return {}; }
 };
 
 }  // namespace orthoflow::ui

@@ -54,6 +54,16 @@ Json telemetry_json(const UiSnapshot& s) {
           {"nodes", std::move(nodes)}};
 }
 
+// The objects' boxes in the last camera image, or null before one was served.
+Json camera_json(const CameraBoxes& c) {
+  if (c.frame_id == 0) return nullptr;
+  Json boxes = Json::array();
+  for (const CameraBoxes::Box& b : c.boxes)
+    boxes.push_back({{"track", b.track}, {"box", Json::array({b.u0, b.v0, b.u1, b.v1})}});
+  return {
+      {"frame", c.frame_id}, {"width", c.width}, {"height", c.height}, {"boxes", std::move(boxes)}};
+}
+
 }  // namespace
 
 std::string state_json(const UiSnapshot& s) {
@@ -66,11 +76,14 @@ std::string state_json(const UiSnapshot& s) {
          {"last_taught_ms", c.last_taught_ms == 0 ? Json(nullptr) : Json(c.last_taught_ms)}});
   }
   for (const EventView& e : s.events) events.push_back(event_json(e));
-  const Json doc = {
-      {"frame", s.frame_id},           {"age_ms", static_cast<double>(s.age_ns) * 1e-6},
-      {"durable", s.durable},          {"objects", std::move(objects)},
-      {"memory", std::move(memory)},   {"events", std::move(events)},
-      {"telemetry", telemetry_json(s)}};
+  const Json doc = {{"frame", s.frame_id},
+                    {"age_ms", static_cast<double>(s.age_ns) * 1e-6},
+                    {"durable", s.durable},
+                    {"objects", std::move(objects)},
+                    {"memory", std::move(memory)},
+                    {"events", std::move(events)},
+                    {"telemetry", telemetry_json(s)},
+                    {"camera", camera_json(s.camera)}};
   // Labels are valid UTF-8 by the label rule; replace keeps a bad byte from throwing regardless.
   return doc.dump(-1, ' ', false, Json::error_handler_t::replace);
 }

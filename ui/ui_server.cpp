@@ -137,6 +137,7 @@ Result<std::unique_ptr<UiServer>, std::string> UiServer::start(UiServerConfig co
   if (mg_get_server_ports(s->ctx_, 4, bound) < 1) return err("no listening port after start");
   s->port_ = static_cast<std::uint16_t>(bound[0].port);
   s->policy_ = make_access_policy(s->config_.address, s->port_, s->config_.token);
+  s->cookie_ = token_cookie(s->policy_);
   register_handlers(s->ctx_, s);
   return server;
 }
@@ -177,9 +178,20 @@ int UiServer::serve(mg_connection* conn, const ApiRequest& request) {
     case Kind::EVENTS:
       return reply_error(conn, {426, "GET /api/events is a WebSocket: send an Upgrade"},
                          "Upgrade: websocket\r\n");
+    case Kind::CAMERA: {
+      const std::string png = backend_.camera_png();
+      if (png.empty())
+        return reply_error(
+            conn, {404, "no camera image (no frame yet, or the source has no pixel grid)"});
+      return reply(conn, 200, "image/png", png);
+    }
     case Kind::ASSET:
-      if (const Asset* asset = find_asset(request.asset); asset != nullptr)
-        return reply(conn, 200, asset->content_type, asset->text());
+      if (const Asset* asset = find_asset(request.asset); asset != nullptr) {
+        // The page, loaded with the token, hands its browser the token cookie: the browser then
+        // sends it with the page's script and style requests, which carry no ?token=.
+        const bool page = std::string_view(asset->content_type).starts_with("text/html");
+        return reply(conn, 200, asset->content_type, asset->text(), page ? cookie_.c_str() : "");
+      }
       return reply_error(conn, {404, "no such page"});
     default:
       return act(conn, request);

@@ -55,6 +55,7 @@ class UiServer {
   UiServerConfig config_;
   UiBackend& backend_;
   AccessPolicy policy_;
+  std::string cookie_;  ///< the page's Set-Cookie line (token_cookie), "" without a token
   RateLimiter limiter_;
   std::unique_ptr<EventStream> stream_;
   mg_context* ctx_ = nullptr;

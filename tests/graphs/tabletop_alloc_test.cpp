@@ -43,6 +43,9 @@ TEST(TabletopAllocations, SteadyStateAllocatesNothingPerFrame) {
   SessionLog log(std::move(*json));
   ObjectsHub hub;  // an in-process consumer of the objects output, asking over the learning channel
   auto objects = hub.subscribe(16);
+  // A viewer of the camera image (the web view) asking for every frame: the tap copies each one.
+  const auto now_ns = [] { return std::chrono::steady_clock::now().time_since_epoch().count(); };
+  hub.camera().request(now_ns(), 0, 600'000'000'000);
   auto client = learning->connect();
   const auto registry = make_tabletop_registry(*learning, log, &hub);
   // random scene with 5 objects, instructor off (teaching allocates by design)
@@ -87,6 +90,12 @@ TEST(TabletopAllocations, SteadyStateAllocatesNothingPerFrame) {
   EXPECT_GT(log.summary().object_views, 100U);
   EXPECT_GT(log.summary().recognitions, 100U);
   EXPECT_EQ(g_allocations.load(), 0U);
+  EXPECT_GE(hub.camera().copied() + hub.camera().busy(), 60U);
+  CameraImage image;
+  ASSERT_TRUE(hub.camera().take(image, 0));
+  EXPECT_GT(image.frame_id, 40U);  // one of the last frames
+  EXPECT_EQ(image.step, 2U);
+  EXPECT_EQ(image.width * image.height, image.z.size());
 }
 
 TEST(TabletopAllocations, KinectSourceSteadyStateAllocatesNothingPerFrame) {

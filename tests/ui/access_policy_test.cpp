@@ -40,6 +40,25 @@ TEST(AccessPolicy, NonLoopbackNeedsTheRightToken) {
   EXPECT_EQ(status(access(p, {{"Authorization", "Bearer nope"}}, "token=" + token)), 401);
 }
 
+// The page loaded with ?token= hands its browser a cookie, so that its script and style requests
+// (which carry no token) pass; the cookie is per port, and a wrong one is refused like a header.
+TEST(AccessPolicy, ThePagesCookieCarriesTheToken) {
+  const std::string token = "0123456789abcdef0123456789abcdef";
+  const AccessPolicy p = make_access_policy("192.0.2.10", 8080, token);
+  EXPECT_EQ(token_cookie(p), "Set-Cookie: orthoflow_token_8080=" + token +
+                                 "; Path=/; HttpOnly; SameSite=Strict\r\n");
+  EXPECT_EQ(status(access(p, {{"Cookie", "orthoflow_token_8080=" + token}})), 200);
+  EXPECT_EQ(status(access(p, {{"Cookie", "a=1; orthoflow_token_8080=" + token + "; b=2"}})), 200);
+  EXPECT_EQ(status(access(p, {{"Cookie", "orthoflow_token_8081=" + token}})), 401);  // other port
+  EXPECT_EQ(status(access(p, {{"Cookie", "orthoflow_token_8080=nope"}})), 401);
+  EXPECT_EQ(status(access(p, {{"Cookie", "orthoflow_token_8080"}})), 401);
+  EXPECT_EQ(status(access(p, {{"Cookie", ""}})), 401);
+  // A header or a query, when present, is the one that counts.
+  EXPECT_EQ(status(access(p, {{"Cookie", "orthoflow_token_8080=" + token}}, "token=nope")), 401);
+  // No token, no cookie; a token a cookie cannot hold gets none (the page then needs a header).
+  EXPECT_EQ(token_cookie(make_access_policy("127.0.0.1", 8080, "")), "");
+  EXPECT_EQ(token_cookie(make_access_policy("192.0.2.10", 8080, "semi;colon-token-0123456")), "");
+}
 TEST(AccessPolicy, LoopbackNeedsNoTokenButItsOwnHost) {
   const AccessPolicy p = make_access_policy("127.0.0.1", 8080, "");
   EXPECT_EQ(status(access(p, {{"Host", "127.0.0.1:8080"}})), 200);
@@ -135,6 +154,9 @@ TEST(Assets, OnlyTheEmbeddedFilesByExactPath) {
   ASSERT_NE(find_asset("/app.js"), nullptr);
   EXPECT_NE(find_asset("/app.js")->text().find("/api/events"), std::string_view::npos);
   ASSERT_NE(find_asset("/style.css"), nullptr);
+  ASSERT_NE(find_asset("/favicon.svg"),
+            nullptr);  // a browser asks for an icon; 404s clutter its console
+  EXPECT_STREQ(find_asset("/favicon.svg")->content_type, "image/svg+xml");
   for (const char* path : {"/../CMakeLists.txt", "/./app.js", "//app.js", "/app.js/", "/APP.JS",
                            "/assets/app.js", "", "/etc/passwd"}) {
     EXPECT_EQ(find_asset(path), nullptr) << path;

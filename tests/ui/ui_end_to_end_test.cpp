@@ -142,18 +142,17 @@ void teach_ask_forget(graphs::LearningService& learning, const std::string& lear
   EXPECT_EQ(streamed["memory"][0]["label"], "alpha");
   EXPECT_GT(streamed["frame"].get<std::uint64_t>(), 0U);
 
+  // The memory is empty and the object Unknown again.
+  const auto nothing_known = [&](const Json& doc) {
+    const Json* o = object_of(doc, track);
+    return doc["memory"].empty() && o != nullptr && o->at("label").is_null();
+  };
   // Undo takes the teach back (the memory forgets its views); a second undo has nothing left.
   const Json undone = post(port, "/api/undo", Json::object(), 200);
   EXPECT_EQ(undone["outcome"], learned);
   EXPECT_EQ(undone["label"], "alpha");
   EXPECT_EQ(undone["views"], taught["views"]);
-  EXPECT_TRUE(wait_for_state(
-      port,
-      [&](const Json& doc) {
-        const Json* o = object_of(doc, track);
-        return doc["memory"].empty() && o != nullptr && o->at("label").is_null();
-      },
-      30))
+  EXPECT_TRUE(wait_for_state(port, nothing_known, 30))
       << "undoing the only teach did not empty the memory";
   const Json nothing = post(port, "/api/undo", Json::object(), 409);
   EXPECT_EQ(nothing["outcome"], "nothing_to_undo");
@@ -166,13 +165,7 @@ void teach_ask_forget(graphs::LearningService& learning, const std::string& lear
             "no_such_track");
   EXPECT_EQ(post(port, "/api/forget", {{"label", "never"}}, 404)["outcome"], "unknown_label");
   EXPECT_EQ(post(port, "/api/forget", {{"label", "alpha"}}, 200)["outcome"], learned);
-  EXPECT_TRUE(wait_for_state(
-      port,
-      [&](const Json& doc) {
-        const Json* o = object_of(doc, track);
-        return doc["memory"].empty() && o != nullptr && o->at("label").is_null();
-      },
-      30))
+  EXPECT_TRUE(wait_for_state(port, nothing_known, 30))
       << "forgetting the category did not make the object Unknown";
 
   engine.request_stop();

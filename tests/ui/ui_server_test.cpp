@@ -43,8 +43,15 @@ class RecordingBackend : public UiBackend {
     a.ack.label = action.label;
     return a;
   }
+  std::string camera_png() override {
+    std::lock_guard<std::mutex> guard(lock_);
+    ++camera_requests;
+    return png;
+  }
   std::mutex lock_;
   std::vector<UiAction> actions;
+  std::string png;  // what camera_png() answers ("" = no image)
+  int camera_requests = 0;
   Outcome outcome = Outcome::LEARNED;
   UiAnswer::Status status = UiAnswer::Status::ACKNOWLEDGED;
   mutable std::atomic<std::uint64_t> frames_{0};
@@ -86,6 +93,26 @@ TEST_F(UiServerTest, ServesStateAndAssetsOnLoopbackWithoutAToken) {
   EXPECT_NE(http(port_, "GET", "/app.js").head.find("text/javascript"), std::string::npos);
 }
 
+// GET /api/camera.png: the backend's PNG as image/png, a JSON 404 while there is none; GET only,
+// and checked like any request (a token when the server has one).
+TEST_F(UiServerTest, ServesTheCameraImageOrSaysThereIsNone) {
+  start(TOKEN);
+  const std::vector<std::pair<std::string, std::string>> auth = {
+      {"Authorization", "Bearer " + TOKEN}};
+  const auto none = http(port_, "GET", "/api/camera.png", auth);
+  EXPECT_EQ(none.status, 404);
+  EXPECT_NE(none.body.find("no camera image"), std::string::npos) << none.body;
+  backend_.png = std::string("\x89PNG\r\n\x1a\n", 8) + "image bytes";
+  const auto image = http(port_, "GET", "/api/camera.png?n=17", auth);
+  ASSERT_EQ(image.status, 200);
+  EXPECT_NE(image.head.find("Content-Type: image/png"), std::string::npos);
+  EXPECT_NE(image.head.find("Cache-Control: no-store"), std::string::npos);
+  EXPECT_EQ(image.body, backend_.png);
+  EXPECT_EQ(http(port_, "GET", "/api/camera.png").status, 401);
+  EXPECT_EQ(post_json(port_, "/api/camera.png", "{}", auth).status, 405);
+  EXPECT_EQ(backend_.camera_requests, 2);  // the refused requests never reached the backend
+}
+
 TEST_F(UiServerTest, UnknownPathsAndTraversalAre404) {
   start();
   for (const char* path : {"/nothing", "/../CMakeLists.txt", "/%2e%2e/%2e%2e/etc/passwd",
@@ -111,6 +138,25 @@ TEST_F(UiServerTest, TokenIsCheckedOnEveryRequest) {
   EXPECT_EQ(taught.status, 200) << taught.body;
   ASSERT_EQ(backend_.actions.size(), 1U);
   EXPECT_NE(server_->url().find("?token=" + TOKEN), std::string::npos);
+}
+
+// The page loaded with ?token= sets the token cookie, with which the browser fetches the page's
+// script and style (their URLs carry no token); without the cookie they are refused.
+TEST_F(UiServerTest, ThePageHandsItsBrowserTheTokenCookie) {
+  start(TOKEN);
+  const auto page = http(port_, "GET", "/?token=" + TOKEN);
+  ASSERT_EQ(page.status, 200);
+  const std::string cookie = "orthoflow_token_" + std::to_string(port_) + "=" + TOKEN;
+  EXPECT_NE(page.head.find("Set-Cookie: " + cookie + "; Path=/; HttpOnly; SameSite=Strict"),
+            std::string::npos)
+      << page.head;
+  EXPECT_EQ(http(port_, "GET", "/app.js").status, 401);
+  EXPECT_EQ(http(port_, "GET", "/app.js", {{"Cookie", cookie}}).status, 200);
+  EXPECT_EQ(http(port_, "GET", "/style.css", {{"Cookie", cookie}}).status, 200);
+  EXPECT_EQ(http(port_, "GET", "/style.css", {{"Cookie", cookie + "x"}}).status, 401);
+  // Only the page sets it; an API answer does not.
+  EXPECT_EQ(http(port_, "GET", "/api/state", {{"Cookie", cookie}}).head.find("Set-Cookie"),
+            std::string::npos);
 }
 
 TEST_F(UiServerTest, WebSocketUpgradeChecksTheTokenAndStreams) {

@@ -29,7 +29,7 @@ function mainObjects(s) { return s.objects.filter((o) => !o.fragment && o.track 
 function renderObjects(s) {
   fill('objects', mainObjects(s), (row, o) => {
     if (o.track === selected) row.className = 'selected';
-    row.onclick = () => select(o.track);
+    row.dataset.track = o.track;
     cell(row, o.track);
     if (o.label === null) cell(row, 'Unknown', 'unknown'); else cell(row, o.label);
     cell(row, fmt(o.score, 3));
@@ -44,7 +44,12 @@ function renderMemory(s) {
     cell(row, c.views);
     cell(row, c.last_taught_ms ? new Date(c.last_taught_ms).toLocaleTimeString() : '-');
   });
+  // The completion list is rebuilt only when the categories change: rebuilding it at every update
+  // would close the browser's suggestion popup while the person types.
+  const labels = s.memory.map((c) => c.label).join('\n');
   const list = $('categories');
+  if (list.dataset.labels === labels) return;
+  list.dataset.labels = labels;
   list.replaceChildren();
   for (const c of s.memory) {
     const option = document.createElement('option');
@@ -115,8 +120,48 @@ function drawTop(s) {
   }
 }
 
+// The camera image (GET /api/camera.png: the newest frame with the objects' boxes drawn on it):
+// asked again when the last one has arrived, at most 5 times a second, every 2 s while there is none.
+let cameraLoading = false, cameraNext = 0;
+function refreshCamera() {
+  const now = Date.now();
+  if (cameraLoading || now < cameraNext) return;
+  cameraLoading = true;
+  cameraNext = now + 200;
+  const q = new URLSearchParams({n: String(now)});
+  if (token) q.set('token', token);
+  $('camera').src = `/api/camera.png?${q}`;
+}
+$('camera').addEventListener('load', () => {
+  cameraLoading = false;
+  $('camera').hidden = false;
+  $('camera-none').hidden = true;
+});
+$('camera').addEventListener('error', () => {
+  cameraLoading = false;
+  cameraNext = Date.now() + 2000;
+  $('camera').hidden = true;
+  $('camera-none').hidden = false;
+});
+// Click an object in the camera image: the smallest box (state.camera) under the pointer.
+$('camera').addEventListener('click', (event) => {
+  const c = state && state.camera;
+  if (!c) return;
+  const r = $('camera').getBoundingClientRect();
+  const u = (event.clientX - r.left) * c.width / r.width;
+  const v = (event.clientY - r.top) * c.height / r.height;
+  let best = null, bestArea = Infinity;
+  for (const b of c.boxes) {
+    const [u0, v0, u1, v1] = b.box;
+    const area = (u1 - u0) * (v1 - v0);
+    if (u >= u0 && u <= u1 && v >= v0 && v <= v1 && area < bestArea) { best = b.track; bestArea = area; }
+  }
+  if (best !== null) select(best);
+});
+
 function render(s) {
   state = s;
+  refreshCamera();
   $('frame').textContent = `frame ${s.frame} (${fmt(s.age_ms, 1)} ms old)`;
   renderObjects(s);
   renderMemory(s);
@@ -130,6 +175,14 @@ function select(track) {
   $('selected').textContent = `track ${track}`;
   if (state) render(state);
 }
+
+// Rows are rebuilt at every update (up to the frame rate), so a press and its release can land on two
+// different row elements and no click event reaches either: select on the press, delegated from the
+// table body, which stays.
+$('objects').tBodies[0].addEventListener('pointerdown', (event) => {
+  const row = event.target.closest('tr');
+  if (row && row.dataset.track !== undefined) select(Number(row.dataset.track));
+});
 
 $('top').addEventListener('click', (event) => {
   const canvas = $('top');
@@ -177,7 +230,7 @@ for (const button of document.querySelectorAll('#action button')) {
 }
 
 function connect() {
-  const q = new URLSearchParams({hz: '10'});
+  const q = new URLSearchParams({hz: params.get('hz') || '10'});  // the page's ?hz= chooses the rate
   if (token) q.set('token', token);
   const ws = new WebSocket(`${location.protocol === 'https:' ? 'wss' : 'ws'}://${location.host}/api/events?${q}`);
   ws.onopen = () => { $('status').textContent = 'live'; };

@@ -1,0 +1,317 @@
+// Does the web view slow the robot? The embedded tabletop graph on the 45 real Kinect frames of
+// mOSD's learning split (../shared/data/mosd_learn, looped, read ahead), paced at 30 Hz as the
+// Kinect paces it (one engine thread, the instructor off), run twice in the same
+// iteration: once alone, once with the web view's server (ui/) serving Debian's headless Chromium,
+// which has the page open at ?hz=30: the state over the WebSocket at 30 Hz and the camera image
+// (GET /api/camera.png, drawn on the backend's thread) at up to 5 Hz; then the same with a program
+// polling the API instead of the browser (with and without the camera image), which is the
+// server's share alone. Reported: the frame-to-labels
+// latency (source stamp -> frame fully processed, the engine's histogram) p50 / p99 / max of each
+// run, and their p99 ratio (the bar: within 5 %). Skipped without /usr/bin/chromium.
+//
+// usage: ui_latency_bench [--benchmark_...] (ORTHOFLOW_UI_BENCH_FRAMES: frames per run, default
+// 450)
+#include <benchmark/benchmark.h>
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <limits>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "engine/engine.hpp"
+#include "engine/graph.hpp"
+#include "graphs/embedded_graphs.hpp"
+#include "graphs/objects_output.hpp"
+#include "graphs/tabletop.hpp"
+#include "ui/camera_view.hpp"
+#include "ui/graph_backend.hpp"
+#include "ui/ui_client.hpp"
+#include "ui/ui_server.hpp"
+
+extern char** environ;
+
+namespace {
+
+namespace oe = orthoflow::engine;
+namespace og = orthoflow::graphs;
+namespace ou = orthoflow::ui;
+
+constexpr const char* CHROMIUM = "/usr/bin/chromium";
+
+std::uint64_t frames_per_run() {
+  const char* n = std::getenv("ORTHOFLOW_UI_BENCH_FRAMES");
+  return n != nullptr ? std::strtoull(n, nullptr, 10) : 450;
+}
+
+struct Latency {
+  double p50_us = 0, p99_us = 0, max_us = 0, frames = 0, misses = 0;
+};
+
+// Headless Chromium on @p url for as long as this lives.
+class Browser {
+ public:
+  explicit Browser(const std::string& url) {
+    profile_ = (std::filesystem::temp_directory_path() /
+                ("orthoflow_ui_bench_" + std::to_string(::getpid())))
+                   .string();
+    const std::string profile_arg = "--user-data-dir=" + profile_;
+    std::vector<std::string> args = {CHROMIUM,
+                                     "--headless=new",
+                                     "--no-sandbox",
+                                     "--disable-gpu",
+                                     "--disable-dev-shm-usage",
+                                     profile_arg,
+                                     "--window-size=1280,1100",
+                                     url};
+    std::vector<char*> argv;
+    for (std::string& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    posix_spawn_file_actions_t files;
+    posix_spawn_file_actions_init(&files);
+    posix_spawn_file_actions_addopen(&files, 1, "/dev/null", O_WRONLY, 0);
+    posix_spawn_file_actions_addopen(&files, 2, "/dev/null", O_WRONLY, 0);
+    posix_spawnattr_t attr;
+    posix_spawnattr_init(&attr);
+    posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETPGROUP);  // its own group: killed as one
+    posix_spawnattr_setpgroup(&attr, 0);
+    if (posix_spawn(&pid_, CHROMIUM, &files, &attr, argv.data(), environ) != 0) pid_ = -1;
+    posix_spawn_file_actions_destroy(&files);
+    posix_spawnattr_destroy(&attr);
+  }
+  ~Browser() {
+    if (pid_ > 0) {
+      ::kill(-pid_, SIGTERM);
+      int status = 0;
+      ::waitpid(pid_, &status, 0);
+    }
+    std::error_code ignored;
+    std::filesystem::remove_all(profile_, ignored);
+  }
+  Browser(const Browser&) = delete;
+  Browser& operator=(const Browser&) = delete;
+  [[nodiscard]] bool running() const noexcept { return pid_ > 0; }
+
+ private:
+  pid_t pid_ = -1;
+  std::string profile_;
+};
+
+// A program polling the API as the page does: GET /api/state at 30 Hz and GET /api/camera.png at
+// 5 Hz (the server's work without a browser's rendering beside the graph).
+class Poller {
+ public:
+  Poller(std::uint16_t port, bool camera) {
+    thread_ = std::thread([this, port, camera] {
+      const ou::ClientTarget target{"127.0.0.1", port, "", 2000};
+      for (int tick = 0; !stop_.load(); ++tick) {
+        (void)ou::send_ui_request(target, "GET", "/api/state", "");
+        if (camera && tick % 6 == 0)
+          (void)ou::send_ui_request(target, "GET", "/api/camera.png", "");
+        std::this_thread::sleep_for(std::chrono::microseconds(33'333));
+      }
+    });
+  }
+  ~Poller() {
+    stop_.store(true);
+    thread_.join();
+  }
+  Poller(const Poller&) = delete;
+  Poller& operator=(const Poller&) = delete;
+
+ private:
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
+enum class Viewer { NONE, BROWSER, PROGRAM, PROGRAM_STATE_ONLY };
+
+// One run of the graph at 30 Hz; with a viewer, the web view and that viewer on it.
+// @p camera_images gets the images the frame path copied for the viewer.
+Latency run_once(Viewer viewer, std::uint64_t frames, std::uint64_t& camera_images) {
+  const bool with_browser = viewer != Viewer::NONE;
+  auto spec = oe::parse_graph(std::string(og::embedded_tabletop_yaml()), "embedded:tabletop.yaml");
+  if (!spec) return {};
+  for (auto& node : spec->nodes) {
+    if (node.kind == "recognise") node.params.assign("instructor", "0");
+    if (node.kind == "synthetic_source") {  // real Kinect frames, read ahead, looped
+      node.kind = "pcd_source";
+      node.params = {};
+      node.params.assign("dir", std::string(ORTHOFLOW_SHARED_DIR) + "/data/mosd_learn");
+      node.params.assign("loop", "1");
+    }
+  }
+  spec->period_ns = 1'000'000'000 / 30;
+  auto learning = og::LearningService::open({});
+  og::SessionLog log(nullptr);
+  og::ObjectsHub hub;
+  const auto registry = og::make_tabletop_registry(**learning, log, &hub);
+  auto graph = oe::build_graph(*spec, registry);
+  if (!graph) return {};
+  oe::Engine engine(**graph, {1});
+  std::unique_ptr<ou::GraphBackend> backend;
+  std::unique_ptr<ou::UiServer> server;
+  std::unique_ptr<Browser> browser;
+  std::unique_ptr<Poller> poller;
+  if (with_browser) {
+    auto opened = ou::GraphBackend::open(**learning, hub);
+    if (!opened) return {};
+    backend = std::move(*opened);
+    backend->set_telemetry(&engine.stats());
+    ou::UiServerConfig config;  // loopback, port 0
+    config.max_stream_hz = 30.0;
+    auto started = ou::UiServer::start(config, *backend);
+    if (!started) return {};
+    server = std::move(*started);
+    if (viewer == Viewer::BROWSER) {
+      browser = std::make_unique<Browser>(server->url() + "?hz=30");
+      if (!browser->running()) return {};
+    } else {
+      poller = std::make_unique<Poller>(server->port(), viewer == Viewer::PROGRAM);
+    }
+    // The browser's start (a second or more) is not the robot's steady state: wait until the
+    // page runs (it asked for a camera image), then a little more.
+    const auto now = [] { return std::chrono::steady_clock::now().time_since_epoch().count(); };
+    const std::int64_t until = now() + 30'000'000'000;
+    while (viewer != Viewer::PROGRAM_STATE_ONLY && !hub.camera().wanted(now()) && now() < until)
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    if (viewer != Viewer::PROGRAM_STATE_ONLY && !hub.camera().wanted(now())) return {};
+    std::this_thread::sleep_for(std::chrono::seconds(1));
+  }
+  oe::RunOptions limits;
+  limits.max_frames = frames;
+  engine.run(limits);
+  const auto& stats = engine.stats();
+  Latency l;
+  l.p50_us = static_cast<double>(stats.frame_latency.percentile(0.5)) / 1e3;
+  l.p99_us = static_cast<double>(stats.frame_latency.percentile(0.99)) / 1e3;
+  l.max_us = static_cast<double>(stats.frame_latency.max()) / 1e3;
+  l.frames = static_cast<double>(stats.frames_done.load());
+  l.misses = static_cast<double>(stats.deadline_misses.load());
+  camera_images = hub.camera().copied();
+  browser.reset();
+  poller.reset();
+  server.reset();
+  backend.reset();
+  return l;
+}
+
+// range(0): 0 = Debian's headless Chromium on the page, 1 = a program polling the state and the
+// camera image as the page does, 2 = a program polling the state only.
+void BM_FrameLatencyWithAViewer(benchmark::State& state) {
+  const Viewer viewer = state.range(0) == 0   ? Viewer::BROWSER
+                        : state.range(0) == 1 ? Viewer::PROGRAM
+                                              : Viewer::PROGRAM_STATE_ONLY;
+  if (viewer == Viewer::BROWSER && ::access(CHROMIUM, X_OK) != 0) {
+    state.SkipWithError("no /usr/bin/chromium (apt-get install chromium)");
+    return;
+  }
+  const std::uint64_t frames = frames_per_run();
+  Latency alone, watched;
+  std::uint64_t images = 0, none = 0;
+  for (auto _ : state) {
+    alone = run_once(Viewer::NONE, frames, none);
+    watched = run_once(viewer, frames, images);
+  }
+  if (alone.frames == 0 || watched.frames == 0) {
+    state.SkipWithError("a run did not start (graph, server or browser)");
+    return;
+  }
+  state.counters["alone_p50_us"] = alone.p50_us;
+  state.counters["alone_p99_us"] = alone.p99_us;
+  state.counters["alone_max_us"] = alone.max_us;
+  state.counters["ui_p50_us"] = watched.p50_us;
+  state.counters["ui_p99_us"] = watched.p99_us;
+  state.counters["ui_max_us"] = watched.max_us;
+  state.counters["p99_ratio"] = watched.p99_us / alone.p99_us;
+  state.counters["ui_deadline_misses"] = watched.misses;
+  state.counters["camera_images"] = static_cast<double>(images);
+  state.counters["frames"] = watched.frames;
+}
+BENCHMARK(BM_FrameLatencyWithAViewer)
+    ->ArgName("viewer")
+    ->Arg(0)
+    ->Arg(1)
+    ->Arg(2)
+    ->Iterations(1)
+    ->Unit(benchmark::kSecond);
+
+// The frame path's share: one copy of a 640 x 480 colour frame into the tap (320 x 240).
+void BM_CameraTapCopy(benchmark::State& state) {
+  const std::size_t n = 640 * 480;
+  std::vector<float> x(n), y(n), z(n);
+  std::vector<std::uint32_t> rgb(n, 0xFF806040U);
+  for (std::size_t i = 0; i < n; ++i) {
+    z[i] = 1.0F + static_cast<float>(i % 640) * 1e-3F;
+    x[i] = (static_cast<float>(i % 640) - 320.0F) / 525.0F * z[i];
+    y[i] = (static_cast<float>(i / 640) - 240.0F) / 525.0F * z[i];
+  }
+  oe::FrameHeader header;
+  header.width = 640;
+  header.height = 480;
+  oe::FrameView frame;
+  frame.header = &header;
+  frame.cloud.points = {x, y, z};
+  frame.cloud.width = 640;
+  frame.cloud.height = 480;
+  frame.rgb = rgb;
+  og::CameraTap tap;
+  tap.request(0, 0, std::numeric_limits<std::int64_t>::max() / 2);
+  std::int64_t t = 1;
+  for (auto _ : state) {
+    header.frame_id = static_cast<std::uint64_t>(t);
+    benchmark::DoNotOptimize(tap.offer(frame, t++));
+  }
+  og::CameraImage image;
+  (void)tap.take(image, 0);
+  state.counters["pixels"] = static_cast<double>(image.width * image.height);
+}
+BENCHMARK(BM_CameraTapCopy)->Unit(benchmark::kMicrosecond);
+
+// The backend thread's share per image: the pinhole fit and the PNG (colour, 3 boxes).
+void BM_CameraImageDraw(benchmark::State& state) {
+  og::CameraImage image;
+  image.width = 320;
+  image.height = 240;
+  image.frame_id = 1;
+  const std::size_t n = 320 * 240;
+  image.x.resize(n);
+  image.y.resize(n);
+  image.z.resize(n);
+  image.rgb.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const float u = static_cast<float>(i % 320), v = static_cast<float>(i / 320);
+    image.z[i] = 1.0F + 0.3F * v / 240.0F;
+    image.x[i] = (u - 160.0F) / 262.5F * image.z[i];
+    image.y[i] = (v - 120.0F) / 262.5F * image.z[i];
+    image.rgb[i] =
+        0xFF000000U | (static_cast<std::uint32_t>(u) << 16) | static_cast<std::uint32_t>(v);
+  }
+  std::vector<ou::ObjectView> objects(3);
+  for (std::size_t k = 0; k < objects.size(); ++k) {
+    objects[k].track_id = k + 1;
+    const float x0 = -0.3F + 0.2F * static_cast<float>(k);
+    objects[k].bbox_min[0] = x0, objects[k].bbox_min[1] = -0.1F, objects[k].bbox_min[2] = 1.0F;
+    objects[k].bbox_max[0] = x0 + 0.1F, objects[k].bbox_max[1] = 0.05F,
+    objects[k].bbox_max[2] = 1.1F;
+  }
+  std::size_t bytes = 0;
+  for (auto _ : state) {
+    const ou::PinholeFit fit = ou::fit_pinhole(image);
+    benchmark::DoNotOptimize(fit);
+    bytes = ou::render_camera_png(image, objects).size();
+  }
+  state.counters["png_bytes"] = static_cast<double>(bytes);
+}
+BENCHMARK(BM_CameraImageDraw)->Unit(benchmark::kMicrosecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();
