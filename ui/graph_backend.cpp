@@ -100,9 +100,8 @@ UiSnapshot GraphBackend::snapshot() const {
     if (have_latest_) {
       s.frame_id = latest_->frame_id;
       s.age_ns = latest_->age_ns;
-      const std::uint32_t n = std::min(latest_->count, engine::OBJECT_LIST_CAPACITY);
-      for (std::uint32_t k = 0; k < n; ++k) s.objects.push_back(view_of(latest_->objects[k]));
     }
+    s.objects = objects_locked();
     s.events.assign(events_.begin(), events_.end());
     for (const learning::CategorySummary& c : learning_.learner().categories()) {
       const std::string label(c.label.view());
@@ -132,7 +131,6 @@ std::string GraphBackend::camera_png() {
   constexpr std::int64_t KEEP_NS = 3'000'000'000;
   const std::int64_t now = Clock::now().time_since_epoch().count();
   camera_.request(now, 200'000'000, KEEP_NS);
-  camera_wanted_until_ns_.store(now + KEEP_NS);
   for (int wait = 0; wait < 30; ++wait) {
     {
       std::lock_guard<std::mutex> guard(camera_lock_);
@@ -146,7 +144,7 @@ std::string GraphBackend::camera_png() {
 // On the poller thread (a full-size stack: fontconfig, which cairo's text needs, recurses deeply
 // when it first reads its configuration, too deeply for the server's small worker stacks).
 void GraphBackend::draw_camera() {
-  if (Clock::now().time_since_epoch().count() >= camera_wanted_until_ns_.load()) return;
+  if (!camera_.wanted(Clock::now().time_since_epoch().count())) return;
   std::uint64_t have = 0;
   {
     std::lock_guard<std::mutex> guard(camera_lock_);
@@ -163,8 +161,12 @@ void GraphBackend::draw_camera() {
 }
 
 std::vector<ObjectView> GraphBackend::snapshot_objects() const {
-  std::vector<ObjectView> objects;
   std::lock_guard<std::mutex> guard(state_lock_);
+  return objects_locked();
+}
+
+std::vector<ObjectView> GraphBackend::objects_locked() const {
+  std::vector<ObjectView> objects;
   if (!have_latest_) return objects;
   const std::uint32_t n = std::min(latest_->count, engine::OBJECT_LIST_CAPACITY);
   for (std::uint32_t k = 0; k < n; ++k) objects.push_back(view_of(latest_->objects[k]));

@@ -52,6 +52,7 @@ class GraphBackend final : public UiBackend {
   GraphBackend(graphs::LearningService& learning, std::unique_ptr<graphs::LearningClient> client,
                std::unique_ptr<graphs::ObjectsSubscription> objects, graphs::CameraTap& camera);
   [[nodiscard]] std::vector<ObjectView> snapshot_objects() const;
+  [[nodiscard]] std::vector<ObjectView> objects_locked() const;  // @pre state_lock_ held
   void draw_camera();
   void poll_objects() noexcept;
   void record(const UiAction& action, const UiAnswer& answer);
@@ -65,8 +66,7 @@ class GraphBackend final : public UiBackend {
   graphs::CameraImage camera_image_;  // guarded by camera_lock_: the last image taken
   PinholeFit camera_fit_;             // guarded by camera_lock_: its camera
   std::string camera_png_;            // guarded by camera_lock_: it drawn, with the objects
-  std::atomic<std::int64_t> camera_wanted_until_ns_{0};
-  std::mutex client_lock_;  // LearningClient is thread-compatible: one action at a time
+  std::mutex client_lock_;            // LearningClient is thread-compatible: one action at a time
   mutable std::mutex state_lock_;
   std::unique_ptr<engine::ObjectListPayload> latest_;   // guarded by state_lock_
   bool have_latest_ = false;                            // guarded by state_lock_
