@@ -13,21 +13,43 @@ FUZZ_SECONDS="${FUZZ_SECONDS:-60}"
 PRESETS="${PRESETS:-release asan}"
 passed=0
 failed=0
+failures=""  # "preset/test" names, printed again at the very end where a truncated log still shows them
+timings=""   # one "stage: seconds" line per stage
 logdir=$(mktemp -d)
 start=$(date +%s)
 
+# note_time STAGE SINCE: records how long STAGE took since the epoch second SINCE.
+note_time() { timings="$timings$1: $(( $(date +%s) - $2 )) s"$'\n'; }
+
 # run_ctest_preset NAME: configure, build and test one preset; adds its counts to the totals.
 run_ctest_preset() {
-  local preset=$1 log="$logdir/$1.log"
+  local preset=$1 log="$logdir/$1.log" t0
+  t0=$(date +%s)
   echo "=== preset $preset: configure and build"
   if ! { cmake --preset "$preset" >"$logdir/$preset.configure.log" && cmake --build --preset "$preset"; }; then
     cat "$logdir/$preset.configure.log"
     echo "preset $preset: build FAILED"
     failed=$((failed + 1))
+    failures="$failures$preset: build"$'\n'
     return
   fi
+  note_time "$preset build" "$t0"
+  t0=$(date +%s)
   echo "=== preset $preset: ctest"
   ctest --preset "$preset" 2>&1 | tee "$log"
+  note_time "$preset ctest" "$t0"
+  # The failed tests' names from ctest's own list ("  12 - name (Failed)"), and the end of each one's
+  # output from ctest's LastTest.log, printed again at the very end (a truncated CI log keeps its tail).
+  local names n
+  names=$(sed -n '/The following tests FAILED:/,$p' "$log" | sed -n -E 's/^[[:space:]]+[0-9]+ - (.*)$/\1/p')
+  while IFS= read -r n; do
+    [ -n "$n" ] || continue
+    failures="$failures$preset: $n"$'\n'
+    echo "## $preset: $n" >>"$logdir/failure_tails.txt"
+    awk -v t=" Testing: ${n%% (*}" 'substr($0, length($0) - length(t) + 1) == t {on = 1; next}
+      on && /^<end of output>/ {exit} on' "build/$preset/Testing/Temporary/LastTest.log" 2>/dev/null |
+      tail -n 25 >>"$logdir/failure_tails.txt"
+  done <<<"$names"
   local line total nfail
   line=$(grep -E "tests passed, [0-9]+ tests failed out of [0-9]+" "$log" | tail -1)
   if [ -z "$line" ]; then
@@ -49,7 +71,8 @@ run_fuzzers() {
     failed=$((failed + 1))
     return
   fi
-  local f
+  local f t0
+  t0=$(date +%s)
   for f in build/fuzz/tests/fuzz/fuzz_*; do
     [ -x "$f" ] || continue
     echo "=== fuzzing $(basename "$f") for ${FUZZ_SECONDS}s"
@@ -58,8 +81,10 @@ run_fuzzers() {
     else
       echo "fuzzer $(basename "$f") FAILED"
       failed=$((failed + 1))
+      failures="${failures}fuzz: $(basename "$f")"$'\n'
     fi
   done
+  note_time "fuzz" "$t0"
 }
 
 # check_deb BUILD_DIR ARCH: cpack -G DEB into BUILD_DIR/deb, then the file name and its Architecture field.
@@ -70,6 +95,7 @@ check_deb() {
     cat "$logdir/cpack_$arch.log"
     echo "package $arch: cpack FAILED"
     failed=$((failed + 1))
+    failures="${failures}package $arch: cpack"$'\n'
     return
   fi
   deb=$(ls "$dir"/deb/orthoflow_*_"$arch".deb 2>/dev/null | head -1)
@@ -80,6 +106,7 @@ check_deb() {
   else
     echo "package $arch: no orthoflow_*_$arch.deb holding /usr/bin/orthoflow"
     failed=$((failed + 1))
+    failures="${failures}package $arch: contents"$'\n'
   fi
 }
 
@@ -93,6 +120,14 @@ run_aarch64() {
 for p in $PRESETS; do run_ctest_preset "$p"; done
 if [ "$FUZZ_SECONDS" -gt 0 ]; then run_fuzzers; fi
 if [ "${AARCH64:-1}" != 0 ]; then run_aarch64; fi
+echo "--- time per stage"
+printf "%s" "$timings"
+if [ -n "$failures" ]; then
+  echo "--- the end of each failed test's output"
+  cat "$logdir/failure_tails.txt" 2>/dev/null
+  echo "--- FAILED"
+  printf "%s" "$failures"
+fi
 rm -rf "$logdir"
 echo "elapsed: $(( $(date +%s) - start )) s"
 echo "tests: $passed passed, $failed failed"

@@ -29,7 +29,7 @@ import urllib.request
 import zlib
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "apps"))
-from cli_check import expect, run  # noqa: E402
+from cli_check import expect, run, start_ui_run, stop_run  # noqa: E402
 
 cli, work = sys.argv[1], pathlib.Path(sys.argv[2])
 chromium = shutil.which("chromium") or shutil.which("chromium-browser")
@@ -45,6 +45,27 @@ db = work / "memory"
 graph = work / "tabletop.yaml"
 source = pathlib.Path(__file__).resolve().parents[2] / "graphs" / "tabletop.yaml"
 graph.write_text(source.read_text().replace("instructor: 1", "instructor: 0"))
+
+# Each step is printed as it starts (flushed, so a killed run still shows where it was), and the
+# whole session has a deadline well inside ctest's TIMEOUT: a stuck browser or server ends the test
+# with the step it was on, the server's output, and every process it started stopped.
+START = time.time()
+DEADLINE_S = 200
+current_step = "start"
+
+
+def step(what):
+    global current_step
+    current_step = what
+    print(f"[{time.time() - START:6.1f} s] {what}", flush=True)
+
+
+def out_of_time(signum, frame):
+    raise SystemExit(f"FAIL: the session took over {DEADLINE_S} s; it was at: {current_step}")
+
+
+signal.signal(signal.SIGALRM, out_of_time)
+signal.alarm(DEADLINE_S)
 
 
 def free_port():
@@ -72,8 +93,13 @@ class Browser:
 
     def __init__(self, driver_url):
         self.base = driver_url
+        # No background networking, updates, sync or first-run work: the machines this runs on have
+        # no network beyond loopback, and Chromium's own attempts to reach it only slow it down.
         options = {"binary": chromium,
                    "args": ["--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
+                            "--disable-quic", "--no-first-run", "--no-default-browser-check",
+                            "--disable-background-networking", "--disable-component-update",
+                            "--disable-sync", "--disable-extensions",
                             "--window-size=1280,1100", f"--user-data-dir={work / 'profile'}"]}
         caps = {"capabilities": {"alwaysMatch": {"browserName": "chrome", "goog:chromeOptions": options,
                                                  "goog:loggingPrefs": {"browser": "ALL"}}}}
@@ -89,6 +115,7 @@ class Browser:
         return reply["value"]
 
     def go(self, url):
+        step(f"open {url.split('?')[0]}")
         self.command("POST", "/url", {"url": url})
 
     def script(self, code, *args):
@@ -137,6 +164,7 @@ class Browser:
                            ".map((r) => [...r.cells].map((c) => c.textContent));")
 
     def wait(self, what, condition, seconds=30):
+        step(f"wait for {what}")
         deadline = time.time() + seconds
         while time.time() < deadline:
             value = condition()
@@ -209,34 +237,25 @@ ORANGE = (245, 127, 23)   # the selected object's outline in the top view (ui/as
 
 
 def start_robot():
-    return subprocess.Popen([cli, "run", "--graph", str(graph), "--frames", "3000", "--rate", "30",
-                             "--db", str(db), "--ui", "127.0.0.1:0", "--ui-token-file", str(work / "ui.token")],
-                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    step("start orthoflow run --ui")
+    return start_ui_run(cli, graph, db, work / "ui.token")
 
 
-def url_of(robot):
-    for line in robot.stdout:
-        if line.startswith("ui: http://"):
-            return line.split()[1].split("/?")[0]
-    return None
+def stop(robot, check=True):
+    step("stop orthoflow run")
+    return stop_run(robot, check)
 
 
-def stop(robot):
-    robot.send_signal(signal.SIGINT)
-    out, _ = robot.communicate(timeout=60)
-    expect(robot.returncode == 0, f"run exited {robot.returncode}: {out}")
-
-
-robot = start_robot()
+robot, url = start_robot()
 driver_port = free_port()
 driver = subprocess.Popen([chromedriver, f"--port={driver_port}"], stdout=subprocess.DEVNULL,
                           stderr=subprocess.DEVNULL)
 browser = None
 try:
-    url = url_of(robot)
     expect(url is not None, "run --ui printed no URL")
     auth = {"Authorization": f"Bearer {TOKEN}"}
 
+    step("wait for chromedriver")
     deadline = time.time() + 30
     while True:
         try:
@@ -246,6 +265,7 @@ try:
             pass
         expect(time.time() < deadline, "chromedriver did not start")
         time.sleep(0.1)
+    step("start a Chromium session")
     browser = Browser(f"http://127.0.0.1:{driver_port}")
 
     # Without the token the WebSocket upgrade is refused: the page never goes live.
@@ -256,6 +276,7 @@ try:
     browser.errors()  # the refused upgrade is logged; start clean
 
     # A still, described object to work on, chosen through the API (as a script would).
+    step("choose a still, described object over the API")
     track = None
     deadline = time.time() + 60
     while track is None and time.time() < deadline:
@@ -407,8 +428,7 @@ try:
 
     # Restart the robot on the same memory: the page, reloaded, shows what was stored.
     stop(robot)
-    robot = start_robot()
-    url = url_of(robot)
+    robot, url = start_robot()
     expect(url is not None, "the restarted run printed no URL")
     browser.go(f"{url}/?token={TOKEN}")
     browser.wait("the page to go live after the restart", lambda: browser.text("#status") == "live")
@@ -416,12 +436,29 @@ try:
                           lambda: [r for r in browser.rows("memory") if r[0] == "gamma"])
     expect(memory[0][1] == "1" and [r[0] for r in browser.rows("memory")] == ["gamma"],
            f"memory after the restart: {browser.rows('memory')}")
-finally:
-    if browser:
-        browser.quit()
-    driver.terminate()
-    driver.wait(timeout=30)
+except BaseException:
+    # The failure is reported by the exception; first stop everything and show the server's end.
+    signal.alarm(0)
+    print(f"failed at: {current_step}; the end of orthoflow run's output:", flush=True)
+    try:
+        print(stop(robot, check=False)[-3000:], flush=True)
+    except (ValueError, OSError) as e:  # already stopped and read
+        print(f"(none: {e})", flush=True)
+    raise
+else:
     stop(robot)
+finally:
+    signal.alarm(0)
+    try:
+        if browser:
+            browser.quit()
+    except OSError:
+        pass
+    driver.terminate()
+    try:
+        driver.wait(timeout=30)
+    except subprocess.TimeoutExpired:
+        driver.kill()
 
 listing = run(cli, "memory", "--db", db, "list").stdout
 expect("gamma" in listing and "alpha" not in listing and "beta" not in listing,

@@ -8,13 +8,11 @@ import json
 import os
 import pathlib
 import shutil
-import signal
-import subprocess
 import sys
 import time
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "apps"))
-from cli_check import expect, run  # noqa: E402
+from cli_check import expect, run, start_ui_run, stop_run  # noqa: E402
 
 cli, work = sys.argv[1], pathlib.Path(sys.argv[2])
 shutil.rmtree(work, ignore_errors=True)
@@ -27,15 +25,8 @@ graph = work / "tabletop.yaml"
 source = pathlib.Path(__file__).resolve().parents[2] / "graphs" / "tabletop.yaml"
 graph.write_text(source.read_text().replace("instructor: 1", "instructor: 0"))
 
-robot = subprocess.Popen([cli, "run", "--graph", str(graph), "--frames", "3000", "--rate", "30",
-                          "--db", str(db), "--ui", "127.0.0.1:0", "--ui-token-file", str(token)],
-                         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+robot, url = start_ui_run(cli, graph, db, token)
 try:
-    url = None
-    for line in robot.stdout:
-        if line.startswith("ui: http://"):
-            url = line.split()[1].split("/?")[0]
-            break
     expect(url is not None, "run --ui printed no URL")
     auth = ["--url", url, "--token-file", token]
 
@@ -91,10 +82,11 @@ try:
     expect("no_such_track" in p.stderr, p.stderr)
     refused = json.loads(run(cli, "teach", *auth, "4000000000", "gamma", "--json", code=30).stdout)
     expect(refused["outcome"] == "no_such_track", f"--json on a refusal: {refused}")
-finally:
-    robot.send_signal(signal.SIGINT)
-    out, _ = robot.communicate(timeout=60)
-expect(robot.returncode == 0, f"run exited {robot.returncode}: {out}")
+except BaseException:
+    print(stop_run(robot, check=False)[-3000:], flush=True)  # the server's end, beside the failure
+    raise
+else:
+    stop_run(robot)
 
 # Usage errors and an unreachable robot.
 run(cli, "teach", "--url", "https://127.0.0.1:1", "1", "x", code=106)
