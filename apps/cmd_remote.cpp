@@ -112,10 +112,12 @@ void run_remote(const std::string& command, const RemoteOptions& o) {
          EXIT_REFUSED);
   if (reply->status != 200) {
     if (o.json) std::cout << doc.dump() << "\n";
-    const std::string why = doc.contains("error")     ? text_of(doc["error"])
-                            : doc.contains("outcome") ? text_of(doc["outcome"])
-                                                      : doc.dump();
-    fail(command, "refused (HTTP " + std::to_string(reply->status) + "): " + why, EXIT_REFUSED);
+    // "refused (HTTP 404, unknown_label): no category of that name in the memory": the outcome
+    // for scripts, the error for people.
+    const std::string outcome = doc.contains("outcome") ? ", " + text_of(doc["outcome"]) : "";
+    const std::string why = doc.contains("error") ? text_of(doc["error"]) : doc.dump();
+    fail(command, "refused (HTTP " + std::to_string(reply->status) + outcome + "): " + why,
+         EXIT_REFUSED);
   }
   if (o.json) {
     std::cout << doc.dump() << "\n";

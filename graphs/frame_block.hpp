@@ -66,8 +66,9 @@ struct ObjectRecord {
   float score = 0.0F;
   Text nearest;  ///< the best category even when the answer is Unknown
   Text runner_up;
-  bool taught = false;  ///< this view was taught in this frame
-  Text taught_as;       ///< ... under this label
+  float runner_up_score = 0.0F;  ///< the runner-up's decision value (same scale as score)
+  bool taught = false;           ///< this view was taught in this frame
+  Text taught_as;                ///< ... under this label
 };
 
 /// @brief Why a frame produced nothing (or less than it should). Plain data: set on the frame path

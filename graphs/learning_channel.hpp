@@ -70,8 +70,9 @@ struct LearningAck {
   bool unknown = true;  ///< ASK
   core::Text nearest;   ///< ASK: the nearest category even when the answer is Unknown (score is its
                         ///< decision value: the L2 distance for plain nearest neighbour)
-  core::Text runner_up;        ///< ASK: the second-nearest category (empty when fewer than two)
-  std::uint64_t frame_id = 0;  ///< the frame that handled it
+  core::Text runner_up;          ///< ASK: the second-nearest category (empty when fewer than two)
+  float runner_up_score = 0.0F;  ///< ASK: its decision value, on the scale of score
+  std::uint64_t frame_id = 0;    ///< the frame that handled it
   [[nodiscard]] bool ok() const noexcept {
     return outcome == Outcome::STORED || outcome == Outcome::LEARNED ||
            outcome == Outcome::ANSWERED;

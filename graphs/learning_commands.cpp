@@ -78,6 +78,7 @@ void LessonDesk::answer(const FrameBlock& block, std::int64_t k, LearningAck ack
   ack.score = o.score;
   ack.nearest = o.nearest;
   ack.runner_up = o.runner_up;
+  ack.runner_up_score = o.runner_up_score;
   service_.acknowledge(ack);
 }
 

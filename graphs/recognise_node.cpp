@@ -92,12 +92,14 @@ class Recognise final : public engine::Node {
       o.score = known->score;
       o.nearest = known->nearest;
       o.runner_up = known->runner_up;
+      o.runner_up_score = known->runner_up_score;
       return;
     }
     const auto prediction = service_.learner().ask(descriptor, scratch_);
     o.recognised = true;
     o.score = prediction.score;
     o.runner_up.assign(prediction.runner_up.view());
+    o.runner_up_score = prediction.runner_up_score;
     o.nearest.assign(prediction.label.view());
     Text answer;
     if (!prediction.unknown) answer.assign(prediction.label.view());
@@ -118,6 +120,7 @@ class Recognise final : public engine::Node {
     t.score = o.score;
     t.nearest = o.nearest;
     t.runner_up = o.runner_up;
+    t.runner_up_score = o.runner_up_score;
   }
 
   void instruct(const FrameBlock& block, std::uint64_t frame) noexcept {

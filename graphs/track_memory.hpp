@@ -36,6 +36,7 @@ struct TrackMemory {
   Text label;                 ///< its smoothed answer (empty: Unknown)
   float score = 0.0F;
   Text nearest, runner_up;
+  float runner_up_score = 0.0F;
 };
 
 /// @brief The memories of up to MAX_OBJECTS tracks (the least recently seen is reused).

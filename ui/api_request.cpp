@@ -117,6 +117,9 @@ Result<ApiRequest, ApiError> decode_events(const RawRequest& request) {
   ApiRequest decoded;
   decoded.kind = Kind::EVENTS;
   bool present = false;
+  const std::string_view camera = query_value(request.query, "camera", &present);
+  if (present && camera != "0" && camera != "1") return refuse(400, "'camera' must be 0 or 1");
+  decoded.camera = camera == "1";
   const std::string_view text = query_value(request.query, "hz", &present);
   if (!present) return decoded;
   double hz = 0.0;

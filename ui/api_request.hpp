@@ -65,7 +65,8 @@ struct ApiRequest {
   std::uint32_t track = 0;        ///< TEACH, CORRECT, ASK: >= 1
   core::Text label;               ///< TEACH, CORRECT, FORGET: checked with core::check_label
   double hz = DEFAULT_STREAM_HZ;  ///< EVENTS: requested rate (> 0; the server clamps it)
-  std::string_view asset;         ///< ASSET: the path to look up
+  bool camera = false;     ///< EVENTS: ?camera=1, the client shows the camera image: keep it coming
+  std::string_view asset;  ///< ASSET: the path to look up
 };
 
 /// @brief "state", "events", "teach", ...

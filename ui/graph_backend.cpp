@@ -5,6 +5,8 @@
 #include <exception>
 #include <thread>
 
+#include "ui/background_thread.hpp"
+
 namespace orthoflow::ui {
 
 namespace {
@@ -74,7 +76,8 @@ GraphBackend::~GraphBackend() {
 // Takes the newest list from the subscription's ring into a scratch copy, then swaps it in under
 // the lock, so a reader never waits for more than a pointer swap.
 void GraphBackend::poll_objects() noexcept {
-  prepare_camera_fonts();  // now, not at the first image: the graph is warming up
+  make_this_thread_background();  // the camera image is drawn here: the graph goes first
+  prepare_camera_fonts();         // now, not at the first image: the graph is warming up
   auto scratch = std::make_unique<engine::ObjectListPayload>();
   while (!stop_.load()) {
     bool got = false;
@@ -111,7 +114,7 @@ UiSnapshot GraphBackend::snapshot() const {
   }
   {
     std::lock_guard<std::mutex> guard(camera_lock_);
-    if (camera_fit_.ok && camera_image_.frame_id != 0) {
+    if (!camera_png_.empty()) {  // an image is there to fetch; boxes when its camera is known
       s.camera.frame_id = camera_image_.frame_id;
       s.camera.width = camera_image_.width;
       s.camera.height = camera_image_.height;
@@ -124,21 +127,20 @@ UiSnapshot GraphBackend::snapshot() const {
   return s;
 }
 
-std::string GraphBackend::camera_png() {
-  // Asking keeps the tap copying (at most 5 images per second, the rate the page asks at) for the
-  // next 3 s; the poller thread draws each new image. The first request waits up to 300 ms for the
-  // first image.
+// Asking keeps the tap copying (at most 5 images per second, the rate the page asks at) for the
+// next 3 s; the poller thread draws each new image.
+void GraphBackend::want_camera() {
   constexpr std::int64_t KEEP_NS = 3'000'000'000;
-  const std::int64_t now = Clock::now().time_since_epoch().count();
-  camera_.request(now, 200'000'000, KEEP_NS);
-  for (int wait = 0; wait < 30; ++wait) {
-    {
-      std::lock_guard<std::mutex> guard(camera_lock_);
-      if (!camera_png_.empty()) return camera_png_;
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
-  return {};
+  camera_.request(Clock::now().time_since_epoch().count(), 200'000'000, KEEP_NS);
+}
+
+// A program's first request waits up to 300 ms for the first image.
+std::string GraphBackend::camera_png() {
+  want_camera();
+  std::unique_lock<std::mutex> guard(camera_lock_);
+  camera_drawn_.wait_for(guard, std::chrono::milliseconds(300),
+                         [this] { return !camera_png_.empty(); });
+  return camera_png_;
 }
 
 // On the poller thread (a full-size stack: fontconfig, which cairo's text needs, recurses deeply
@@ -157,7 +159,10 @@ void GraphBackend::draw_camera() {
   std::lock_guard<std::mutex> guard(camera_lock_);
   camera_image_ = std::move(image);
   camera_fit_ = fit;
-  if (!png.empty()) camera_png_ = std::move(png);
+  if (!png.empty()) {
+    camera_png_ = std::move(png);
+    camera_drawn_.notify_all();
+  }
 }
 
 std::vector<ObjectView> GraphBackend::snapshot_objects() const {

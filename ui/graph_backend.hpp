@@ -7,6 +7,7 @@
 /// telemetry; actions go through one LearningClient of the learning channel and wait for their
 /// LearningAck. Nothing here runs on the frame path.
 #include <atomic>
+#include <condition_variable>
 #include <deque>
 #include <map>
 #include <memory>
@@ -47,6 +48,7 @@ class GraphBackend final : public UiBackend {
   /// @brief The newest camera image from the hub's tap with the newest objects drawn on it (the
   /// objects may be a frame or two younger than the image: the tap copies at most 5 images/s).
   [[nodiscard]] std::string camera_png() override;
+  void want_camera() override;
 
  private:
   GraphBackend(graphs::LearningService& learning, std::unique_ptr<graphs::LearningClient> client,
@@ -63,10 +65,11 @@ class GraphBackend final : public UiBackend {
   std::unique_ptr<graphs::ObjectsSubscription> objects_;
   graphs::CameraTap& camera_;
   mutable std::mutex camera_lock_;
-  graphs::CameraImage camera_image_;  // guarded by camera_lock_: the last image taken
-  PinholeFit camera_fit_;             // guarded by camera_lock_: its camera
-  std::string camera_png_;            // guarded by camera_lock_: it drawn, with the objects
-  std::mutex client_lock_;            // LearningClient is thread-compatible: one action at a time
+  graphs::CameraImage camera_image_;      // guarded by camera_lock_: the last image taken
+  PinholeFit camera_fit_;                 // guarded by camera_lock_: its camera
+  std::string camera_png_;                // guarded by camera_lock_: it drawn, with the objects
+  std::condition_variable camera_drawn_;  // notified when camera_png_ changes
+  std::mutex client_lock_;  // LearningClient is thread-compatible: one action at a time
   mutable std::mutex state_lock_;
   std::unique_ptr<engine::ObjectListPayload> latest_;   // guarded by state_lock_
   bool have_latest_ = false;                            // guarded by state_lock_

@@ -108,6 +108,10 @@ class UiBackend {
   /// @brief The camera image with the objects drawn on it, as a PNG; "" when there is none (no
   /// frame yet, or a source without a pixel grid). Asking keeps the images coming for a while.
   [[nodiscard]] virtual std::string camera_png() { return {}; }
+  /// @brief A viewer shows the camera image: keep drawing images for a while (the stream calls it
+  /// for its clients that asked for the camera, so that the state says when an image is there
+  /// before the page asks for one).
+  virtual void want_camera() {}
 };
 
 }  // namespace orthoflow::ui

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 
+#include "ui/background_thread.hpp"
 #include "ui/ui_json.hpp"
 
 namespace orthoflow::ui {
@@ -29,12 +30,12 @@ EventStream::~EventStream() {
   thread_.join();
 }
 
-bool EventStream::add(void* client, double hz) {
+bool EventStream::add(void* client, double hz, bool camera) {
   {
     std::lock_guard<std::mutex> guard(lock_);
     if (clients_.size() >= max_clients_) return false;
     const double rate = clamp(hz);
-    clients_.push_back({client, static_cast<std::int64_t>(1e9 / rate), now_ns(), false});
+    clients_.push_back({client, static_cast<std::int64_t>(1e9 / rate), now_ns(), camera, false});
   }
   wake_.notify_all();
   return true;
@@ -64,13 +65,19 @@ bool EventStream::any_due(std::int64_t now) const {
 // state), then write it to every client due by now. A client's next time advances by its period
 // from its previous time, so its rate does not drift with the document's cost.
 void EventStream::run() {
+  make_this_thread_background();
   std::unique_lock<std::mutex> guard(lock_);
   while (!stop_) {
     if (!any_due(now_ns())) {
       wake_.wait_for(guard, std::chrono::milliseconds(2));
       continue;
     }
+    const std::int64_t due = now_ns();
+    const bool camera = std::any_of(clients_.begin(), clients_.end(), [&](const Client& c) {
+      return !c.failed && c.camera && c.next_ns <= due;
+    });
     guard.unlock();
+    if (camera) backend_.want_camera();
     const std::string document = state_json(backend_.snapshot());
     guard.lock();
     const std::int64_t now = now_ns();

@@ -29,9 +29,10 @@ class EventStream {
 
   /// @brief The rate a client asking for @p hz gets: min(hz, max_hz).
   [[nodiscard]] double clamp(double hz) const noexcept { return hz < max_hz_ ? hz : max_hz_; }
-  /// @brief Adds @p client at clamp(@p hz); its first document goes out at once.
+  /// @brief Adds @p client at clamp(@p hz); its first document goes out at once. With @p camera,
+  /// each document it is due sends the backend want_camera() first.
   /// @return false when max_clients are streaming.
-  bool add(void* client, double hz);
+  bool add(void* client, double hz, bool camera = false);
   /// @brief Removes @p client; when it returns no write to it is in progress or will start.
   void remove(void* client);
   [[nodiscard]] std::size_t clients() const;
@@ -42,6 +43,7 @@ class EventStream {
     void* id = nullptr;
     std::int64_t period_ns = 0;
     std::int64_t next_ns = 0;
+    bool camera = false;
     bool failed = false;
   };
   void run();

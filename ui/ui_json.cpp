@@ -3,6 +3,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <string_view>
 
 #include "engine/object_list_payload.hpp"
 
@@ -52,6 +53,33 @@ Json telemetry_json(const UiSnapshot& s) {
           {"drops", s.drops},
           {"frame_p99_us", static_cast<double>(s.frame_p99_ns) * 1e-3},
           {"nodes", std::move(nodes)}};
+}
+
+// What a refused action means, for the person who asked (the outcome names it for programs).
+std::string_view refusal_text(Outcome outcome) {
+  switch (outcome) {
+    case Outcome::NO_SUCH_TRACK:
+      return "no object with that track in the current frame (it left the view)";
+    case Outcome::NOT_DESCRIBED:
+      return "the object has no descriptor in this frame (too few points); try again";
+    case Outcome::BAD_LABEL:
+      return "the label is empty or too long";
+    case Outcome::REJECTED:
+      return "the learner refused the object's views (not finite, or the wrong length)";
+    case Outcome::UNKNOWN_LABEL:
+      return "no category of that name in the memory";
+    case Outcome::WRITE_FAILED:
+      return "the memory could not be written: nothing was stored";
+    case Outcome::BUSY:
+      return "the memory's writer is behind: nothing was stored; send again";
+    case Outcome::NOTHING_TO_UNDO:
+      return "no lesson left to undo (or the memory changed since)";
+    case Outcome::STORED:
+    case Outcome::LEARNED:
+    case Outcome::ANSWERED:
+      break;
+  }
+  return "refused";
 }
 
 // The objects' boxes in the last camera image, or null before one was served.
@@ -130,14 +158,15 @@ std::string answer_json(const UiAction& action, const UiAnswer& answer, bool dur
   if (action.kind == Kind::ASK && ok) {
     doc["answer"] = answer.ack.unknown ? Json(nullptr) : Json(std::string(answer.ack.label.view()));
     doc["score"] = number_or_null(answer.ack.score);
-    // The learner's nearest categories: the best one with its decision value (also when the answer
-    // is Unknown), then the runner-up by name (the channel carries no second score).
+    // The learner's nearest categories, each with its decision value: the best one (also when the
+    // answer is Unknown), then the runner-up.
     Json nearest = Json::array();
     if (!answer.ack.nearest.empty())
       nearest.push_back({{"label", std::string(answer.ack.nearest.view())},
                          {"score", number_or_null(answer.ack.score)}});
     if (!answer.ack.runner_up.empty())
-      nearest.push_back({{"label", std::string(answer.ack.runner_up.view())}, {"score", nullptr}});
+      nearest.push_back({{"label", std::string(answer.ack.runner_up.view())},
+                         {"score", number_or_null(answer.ack.runner_up_score)}});
     doc["nearest"] = std::move(nearest);
   } else if (action.kind == Kind::UNDO) {
     doc["label"] = acked && !answer.ack.label.empty() ? Json(std::string(answer.ack.label.view()))
@@ -149,8 +178,7 @@ std::string answer_json(const UiAction& action, const UiAnswer& answer, bool dur
     doc["error"] = !acked ? (answer.status == UiAnswer::Status::QUEUE_FULL
                                  ? "the learning channel is full; send again"
                                  : "no acknowledgement in time (is the graph running?)")
-                          : "the learning channel answered " +
-                                std::string(graphs::to_string(answer.ack.outcome));
+                          : std::string(refusal_text(answer.ack.outcome));
   }
   return doc.dump(-1, ' ', false, Json::error_handler_t::replace);
 }

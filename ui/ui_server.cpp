@@ -6,6 +6,7 @@
 #include <string_view>
 #include <vector>
 
+#include "ui/background_thread.hpp"
 #include "ui/ui_assets.hpp"
 #include "ui/ui_json.hpp"
 
@@ -131,6 +132,10 @@ Result<std::unique_ptr<UiServer>, std::string> UiServer::start(UiServerConfig co
                            nullptr};
   mg_callbacks callbacks{};
   callbacks.log_message = [](const mg_connection*, const char*) { return 1; };  // answered here
+  callbacks.init_thread = [](const mg_context*, int) -> void* {  // master, workers, timer
+    make_this_thread_background();
+    return nullptr;
+  };
   s->ctx_ = mg_start(&callbacks, s, options);
   if (s->ctx_ == nullptr) return err("cannot listen on " + ports + " (in use, or no such address)");
   mg_server_port bound[4]{};
@@ -243,7 +248,9 @@ void UiServer::ws_ready(mg_connection* conn) {
   std::vector<HttpHeader> headers;
   const auto request_result = decode_request(raw_request(mg_get_request_info(conn), headers));
   const double hz = request_result ? request_result->hz : DEFAULT_STREAM_HZ;
-  if (stream_->add(conn, hz)) mg_set_user_connection_data(conn, conn);  // marks it as streaming
+  const bool camera = request_result && request_result->camera;
+  if (stream_->add(conn, hz, camera))
+    mg_set_user_connection_data(conn, conn);  // marks it as streaming
 }
 
 void UiServer::ws_close(const mg_connection* conn) {

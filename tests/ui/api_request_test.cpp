@@ -154,6 +154,15 @@ TEST(ApiRequest, StreamRateMustBeAPositiveNumber) {
   EXPECT_DOUBLE_EQ(decode("GET", "/api/events", "", "hz=1000")->hz, 1000.0);  // clamped later
 }
 
+TEST(ApiRequest, StreamCameraFlagIsZeroOrOne) {
+  EXPECT_FALSE(decode("GET", "/api/events")->camera);
+  EXPECT_TRUE(decode("GET", "/api/events", "", "hz=5&camera=1")->camera);
+  EXPECT_DOUBLE_EQ(decode("GET", "/api/events", "", "camera=1&hz=5")->hz, 5.0);
+  EXPECT_FALSE(decode("GET", "/api/events", "", "camera=0")->camera);
+  for (const char* q : {"camera=", "camera=2", "camera=yes", "camera=1&hz=0"})
+    EXPECT_EQ(status_of(decode("GET", "/api/events", "", q)), 400) << q;
+}
+
 TEST(ApiRequest, QueryAndHeaderHelpers) {
   bool present = false;
   EXPECT_EQ(query_value("a=1&token=xyz&b", "token", &present), "xyz");

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "engine/object_list_payload.hpp"
+#include "tests/support/pinhole_image.hpp"
 #include "ui/camera_view.hpp"
 
 namespace orthoflow::ui {
@@ -20,25 +21,13 @@ constexpr double FX = 262.5, FY = 262.5, CX = 159.75, CY = 119.75;  // a Kinect 
 
 // A camera looking at a wall 1.5 m away with a box-shaped object in front, at 320 x 240.
 graphs::CameraImage wall(bool colour) {
-  graphs::CameraImage image;
-  image.width = 320;
-  image.height = 240;
+  graphs::CameraImage image =
+      test::pinhole_image(320, 240, FX, CX, CY, [](std::uint32_t i, std::uint32_t j) {
+        return (i > 100 && i < 140 && j > 80 && j < 160) ? 1.0F : 1.5F;
+      });
   image.frame_id = 9;
   image.step = 2;
-  const std::size_t n = 320 * 240;
-  image.x.resize(n);
-  image.y.resize(n);
-  image.z.resize(n);
-  if (colour) image.rgb.assign(n, 0xFF336699U);
-  for (std::uint32_t j = 0; j < 240; ++j) {
-    for (std::uint32_t i = 0; i < 320; ++i) {
-      const std::size_t k = j * 320 + i;
-      const float z = (i > 100 && i < 140 && j > 80 && j < 160) ? 1.0F : 1.5F;
-      image.z[k] = z;
-      image.x[k] = static_cast<float>((i - CX) / FX * z);
-      image.y[k] = static_cast<float>((j - CY) / FY * z);
-    }
-  }
+  if (colour) image.rgb.assign(image.z.size(), 0xFF336699U);
   image.z[5] = std::numeric_limits<float>::quiet_NaN();  // a hole
   return image;
 }

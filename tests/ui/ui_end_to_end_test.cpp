@@ -134,6 +134,27 @@ void teach_ask_forget(graphs::LearningService& learning, const std::string& lear
   EXPECT_EQ(asked["nearest"][0]["label"], "alpha");
   EXPECT_EQ(asked["nearest"][0]["score"], asked["score"]);
 
+  // With a second category the answer names the runner-up with its own decision value: not nearer
+  // than the answer (lower is nearer). Then the second category is forgotten again.
+  std::uint64_t other = 0;
+  for (const Json& o : (*labelled)["objects"]) {
+    if (o["described"].get<bool>() && !o["fragment"].get<bool>() && o["track"] != track)
+      other = o["track"].get<std::uint64_t>();
+  }
+  if (other != 0) {
+    ASSERT_EQ(post(port, "/api/teach", {{"track", other}, {"label", "beta"}}, 200)["outcome"],
+              learned);
+    const Json two = post(port, "/api/ask", {{"track", track}}, 200);
+    ASSERT_EQ(two["nearest"].size(), 2U) << two.dump();
+    EXPECT_EQ(two["nearest"][0]["label"], "alpha");  // its own views
+    EXPECT_EQ(two["nearest"][1]["label"], "beta");
+    ASSERT_TRUE(two["nearest"][1]["score"].is_number()) << two.dump();
+    EXPECT_GE(two["nearest"][1]["score"].get<double>(), two["nearest"][0]["score"].get<double>());
+    EXPECT_EQ(post(port, "/api/forget", {{"label", "beta"}}, 200)["outcome"], learned);
+  } else {
+    ADD_FAILURE() << "only one described object: the runner-up is not checked";
+  }
+
   // The stream carries the same state.
   std::string frame;
   const auto upgrade = test::websocket_first_frame(port, "/api/events?hz=30", frame);

@@ -22,7 +22,9 @@ class CountingBackend : public UiBackend {
     return s;
   }
   UiAnswer submit(const UiAction&, int) override { return {}; }
+  void want_camera() override { ++camera_wanted; }
   mutable std::atomic<std::uint64_t> snapshots{0};
+  std::atomic<std::uint64_t> camera_wanted{0};
 };
 
 struct Received {
@@ -67,6 +69,30 @@ TEST(EventStream, EachClientAtItsRateCappedAtTheFrameRate) {
   EXPECT_EQ(got.count[&fast], after_remove[&fast]);  // removed: nothing more
   EXPECT_EQ(got.count[&broken], 1);                  // a failed write is not retried
   EXPECT_EQ(stream.clients(), 2U);
+}
+
+// A client that shows the camera keeps the backend drawing images: want_camera() before each of
+// its documents; a client without the camera asks for none.
+TEST(EventStream, OnlyCameraClientsKeepTheCameraWanted) {
+  CountingBackend backend;
+  std::atomic<int> written{0};
+  int plain = 0, viewer = 0;
+  EventStream stream(backend, 20.0, 2, [&](void*, std::string_view) {
+    ++written;
+    return true;
+  });
+  ASSERT_TRUE(stream.add(&plain, 20.0));
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  EXPECT_GT(written.load(), 0);
+  EXPECT_EQ(backend.camera_wanted.load(), 0U);
+  ASSERT_TRUE(stream.add(&viewer, 10.0, /*camera=*/true));
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  EXPECT_GE(backend.camera_wanted.load(), 1U);
+  stream.remove(&viewer);
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  const std::uint64_t after = backend.camera_wanted.load();
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  EXPECT_EQ(backend.camera_wanted.load(), after);  // only the plain client is left
 }
 
 }  // namespace

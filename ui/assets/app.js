@@ -120,14 +120,17 @@ function drawTop(s) {
   }
 }
 
-// The camera image (GET /api/camera.png: the newest frame with the objects' boxes drawn on it):
-// asked again when the last one has arrived, at most 5 times a second, every 2 s while there is none.
-let cameraLoading = false, cameraNext = 0;
-function refreshCamera() {
+// The camera image (GET /api/camera.png: the newest frame with the objects' boxes drawn on it).
+// The stream (opened with camera=1) keeps the server drawing images and says in state.camera which
+// frame the newest one shows; the page fetches it only when that frame is new and the last one has
+// arrived, at most 5 times a second, so it never asks for an image the server does not have.
+let cameraLoading = false, cameraNext = 0, cameraFrame = 0;
+function refreshCamera(s) {
   const now = Date.now();
-  if (cameraLoading || now < cameraNext) return;
+  if (!s.camera || s.camera.frame === cameraFrame || cameraLoading || now < cameraNext) return;
   cameraLoading = true;
   cameraNext = now + 200;
+  cameraFrame = s.camera.frame;
   const q = new URLSearchParams({n: String(now)});
   if (token) q.set('token', token);
   $('camera').src = `/api/camera.png?${q}`;
@@ -161,7 +164,7 @@ $('camera').addEventListener('click', (event) => {
 
 function render(s) {
   state = s;
-  refreshCamera();
+  refreshCamera(s);
   $('frame').textContent = `frame ${s.frame} (${fmt(s.age_ms, 1)} ms old)`;
   renderObjects(s);
   renderMemory(s);
@@ -215,7 +218,7 @@ async function act(action) {
       if (near.length > 0) text += `; nearest: ${near.join(', ')}`;
     }
     if (action === 'undo' && answer.ok) text += `: ${answer.views} view(s) of "${answer.label}" taken back`;
-    if (!answer.ok && answer.error) text += ` (${answer.error})`;
+    if (!answer.ok && answer.error && answer.outcome) text += ` (${answer.error})`;  // else shown above
     if (answer.ok && answer.outcome === 'stored') text += ' (on disk)';
     $('answer').textContent = text;
     $('answer').className = answer.ok ? 'good' : 'bad';
@@ -230,7 +233,8 @@ for (const button of document.querySelectorAll('#action button')) {
 }
 
 function connect() {
-  const q = new URLSearchParams({hz: params.get('hz') || '10'});  // the page's ?hz= chooses the rate
+  // The page's ?hz= chooses the rate; camera=1 keeps the camera images coming while it is open.
+  const q = new URLSearchParams({hz: params.get('hz') || '10', camera: '1'});
   if (token) q.set('token', token);
   const ws = new WebSocket(`${location.protocol === 'https:' ? 'wss' : 'ws'}://${location.host}/api/events?${q}`);
   ws.onopen = () => { $('status').textContent = 'live'; };
