@@ -4,8 +4,6 @@
 #include <sys/syscall.h>
 #include <unistd.h>
 
-#include <cerrno>
-
 namespace orthoflow::ui {
 
 namespace {
@@ -18,9 +16,6 @@ bool make_this_thread_background() noexcept {
   return ::setpriority(PRIO_PROCESS, this_thread_id(), BACKGROUND_NICE) == 0;
 }
 
-int this_thread_nice() noexcept {
-  errno = 0;
-  return ::getpriority(PRIO_PROCESS, this_thread_id());
-}
+int this_thread_nice() noexcept { return ::getpriority(PRIO_PROCESS, this_thread_id()); }
 
 }  // namespace orthoflow::ui

@@ -147,22 +147,17 @@ std::string GraphBackend::camera_png() {
 // when it first reads its configuration, too deeply for the server's small worker stacks).
 void GraphBackend::draw_camera() {
   if (!camera_.wanted(Clock::now().time_since_epoch().count())) return;
-  std::uint64_t have = 0;
-  {
-    std::lock_guard<std::mutex> guard(camera_lock_);
-    have = camera_image_.frame_id;
-  }
   graphs::CameraImage image;
-  if (!camera_.take(image, have)) return;
+  if (!camera_.take(image, camera_taken_)) return;
+  camera_taken_ = image.frame_id;  // tried once, drawn or not
   const PinholeFit fit = fit_pinhole(image);
   std::string png = render_camera_png(image, snapshot_objects());
+  if (png.empty()) return;  // not drawn: keep the last image, its camera and its PNG together
   std::lock_guard<std::mutex> guard(camera_lock_);
   camera_image_ = std::move(image);
   camera_fit_ = fit;
-  if (!png.empty()) {
-    camera_png_ = std::move(png);
-    camera_drawn_.notify_all();
-  }
+  camera_png_ = std::move(png);
+  camera_drawn_.notify_all();
 }
 
 std::vector<ObjectView> GraphBackend::snapshot_objects() const {

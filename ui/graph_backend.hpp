@@ -68,6 +68,7 @@ class GraphBackend final : public UiBackend {
   graphs::CameraImage camera_image_;      // guarded by camera_lock_: the last image taken
   PinholeFit camera_fit_;                 // guarded by camera_lock_: its camera
   std::string camera_png_;                // guarded by camera_lock_: it drawn, with the objects
+  std::uint64_t camera_taken_ = 0;        // poller thread only: the last image taken from the tap
   std::condition_variable camera_drawn_;  // notified when camera_png_ changes
   std::mutex client_lock_;  // LearningClient is thread-compatible: one action at a time
   mutable std::mutex state_lock_;

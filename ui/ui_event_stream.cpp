@@ -56,11 +56,6 @@ std::uint64_t EventStream::sent() const {
   return sent_;
 }
 
-bool EventStream::any_due(std::int64_t now) const {
-  return std::any_of(clients_.begin(), clients_.end(),
-                     [&](const Client& c) { return !c.failed && c.next_ns <= now; });
-}
-
 // One tick: wait until a client is due, make the document without the lock (the backend copies the
 // state), then write it to every client due by now. A client's next time advances by its period
 // from its previous time, so its rate does not drift with the document's cost.
@@ -68,14 +63,17 @@ void EventStream::run() {
   make_this_thread_background();
   std::unique_lock<std::mutex> guard(lock_);
   while (!stop_) {
-    if (!any_due(now_ns())) {
+    bool due = false, camera = false;  // a client is due; one of the due shows the camera
+    const std::int64_t tick = now_ns();
+    for (const Client& c : clients_) {
+      if (c.failed || c.next_ns > tick) continue;
+      due = true;
+      camera = camera || c.camera;
+    }
+    if (!due) {
       wake_.wait_for(guard, std::chrono::milliseconds(2));
       continue;
     }
-    const std::int64_t due = now_ns();
-    const bool camera = std::any_of(clients_.begin(), clients_.end(), [&](const Client& c) {
-      return !c.failed && c.camera && c.next_ns <= due;
-    });
     guard.unlock();
     if (camera) backend_.want_camera();
     const std::string document = state_json(backend_.snapshot());

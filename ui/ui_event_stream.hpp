@@ -47,7 +47,6 @@ class EventStream {
     bool failed = false;
   };
   void run();
-  [[nodiscard]] bool any_due(std::int64_t now_ns) const;
 
   UiBackend& backend_;
   double max_hz_;
