@@ -28,6 +28,8 @@
 #include "graphs/embedded_graphs.hpp"
 #include "graphs/frame_block.hpp"
 #include "graphs/labels_writer.hpp"
+#include "graphs/learning_ipc_bridge.hpp"
+#include "graphs/learning_payloads.hpp"
 #include "graphs/tabletop.hpp"
 
 namespace orthoflow::apps {
@@ -55,6 +57,8 @@ struct RunOptions {
   std::string snapshot;
   std::string telemetry_json;
   bool publish_objects = false;  // every frame's objects to orthoflow/<graph>/objects over iceoryx
+  bool ipc_learning =
+      false;  // learning commands in, acks and status out over iceoryx (and objects)
   std::string on_bad_frame = "skip";  // skip: count and report; fail: also exit 2
   int threads = 0;
   std::string ui;             // --ui [ADDR:]PORT: the web view beside the graph (empty: off)
@@ -220,7 +224,7 @@ void run(const RunOptions& o) {
   if (!spec) fail(engine::to_string(spec.error()), EXIT_BAD_INPUT);
   override_source(*spec, o);
   apply_rate(*spec, o.rate);
-  if (o.publish_objects) add_objects_publisher(*spec);
+  if (o.publish_objects || o.ipc_learning) add_objects_publisher(*spec);
   auto learning = graphs::LearningService::open(learning_settings(*spec, o));
   if (!learning) fail(learning.error(), EXIT_FAILURE_GENERIC);
   for (const std::string& warning : (*learning)->open_warnings()) {
@@ -262,11 +266,28 @@ void run(const RunOptions& o) {
   if (!o.ui.empty()) {
     ui = start_run_ui(o.ui, o.ui_token_file, **learning, objects, engine.stats(), spec->period_ns);
   }
+  // --ipc-learning: the graph's objects publisher registered this process with RouDi.
+  std::unique_ptr<graphs::LearningIpcBridge> bridge;
+  if (o.ipc_learning) {
+    auto opened = graphs::LearningIpcBridge::open(spec->name, **learning, engine.stats());
+    if (!opened) fail("--ipc-learning: " + opened.error(), EXIT_FAILURE_GENERIC);
+    bridge = std::move(*opened);
+    std::cout << "run: learning commands on " << graphs::learning_commands_topic(spec->name)
+              << ", answers on " << graphs::learning_acks_topic(spec->name) << "\n";
+    std::cout.flush();
+  }
   // --publish-objects: a lost RouDi ends the run within ~100 ms (docs/IPC.md), exit 22 below.
   const auto reason = run_watching_roudi(engine, {o.frames, &g_run_stop});
   std::signal(SIGINT, previous_int);
   std::signal(SIGTERM, previous_term);
   ui.reset();  // the server and its learning client go before the graph's results are read
+  if (bridge) {
+    const graphs::LearningIpcCounters& c = bridge->counters();
+    std::cout << "ipc learning: " << c.commands.load() << " commands (" << c.invalid.load()
+              << " invalid, " << c.timeouts.load() << " unanswered), " << c.acks.load()
+              << " answers, " << c.statuses.load() << " statuses published\n";
+    bridge.reset();
+  }
   (*learning)->flush();
   if (log.json() != nullptr) log.json()->flush();
   if (labels) report_labels(*labels, o);
@@ -322,6 +343,10 @@ void add_run_command(CLI::App& app) {
   cmd->add_flag(
       "--publish-objects", o->publish_objects,
       "publish every frame's objects on the iceoryx topic orthoflow/<graph>/objects (needs RouDi)");
+  cmd->add_flag("--ipc-learning", o->ipc_learning,
+                "also take learning commands from other processes over iceoryx (orthoflow ui; "
+                "orthoflow/<graph>/learning_commands, answers on .../learning_acks, memory and "
+                "telemetry on .../status; implies --publish-objects; docs/IPC.md)");
   cmd->add_option("--threads", o->threads, "arena threads (0 = all cores)")
       ->check(CLI::Range(0, 1024));
   auto* ui = cmd->add_option("--ui", o->ui,

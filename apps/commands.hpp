@@ -51,6 +51,8 @@ void add_remote_commands(CLI::App& app);
 /// @brief `run`: the tabletop graph on the embedded session or a given source; summary, JSON lines,
 /// snapshot.
 void add_run_command(CLI::App& app);
+/// @brief `orthoflow ui`: the web view over a graph in another process (apps/run_ui.cpp).
+void add_ui_command(CLI::App& app);
 /// @brief `evaluate --dataset DIR --protocol ...`: cross-validation, simulated teacher, context
 /// change, robustness.
 void add_evaluate_command(CLI::App& app);

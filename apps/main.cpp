@@ -15,6 +15,7 @@ int main(int argc, char** argv) {
   orthoflow::apps::add_memory_command(app);
   orthoflow::apps::add_ipc_command(app);
   orthoflow::apps::add_run_command(app);
+  orthoflow::apps::add_ui_command(app);
   orthoflow::apps::add_remote_commands(app);
   orthoflow::apps::add_evaluate_command(app);
   orthoflow::apps::add_evaluate_segmentation_command(app);

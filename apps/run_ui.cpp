@@ -1,10 +1,20 @@
 #include "apps/run_ui.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <csignal>
 #include <iostream>
+#include <thread>
 
 #include "apps/commands.hpp"
+#include "apps/graph_run.hpp"
+#include "engine/ipc_pubsub.hpp"
+#include "engine/ipc_runtime.hpp"
 #include "ui/graph_backend.hpp"
+#include "ui/ipc_backend.hpp"
 #include "ui/ui_server.hpp"
 
 namespace orthoflow::apps {
@@ -22,9 +32,90 @@ class RunningUi final : public RunUi {
   }
 };
 
-[[noreturn]] void fail(const std::string& message, int code) {
-  std::cerr << "run: --ui: " << message << "\n";
+[[noreturn]] void fail(const std::string& message, int code, const char* who = "run: --ui") {
+  std::cerr << who << ": " << message << "\n";
   throw CLI::RuntimeError(code);
+}
+
+// Starts the server for @p backend and prints its URL (and the token when one is needed).
+std::unique_ptr<ui::UiServer> start_server(const std::string& listen, const std::string& token_file,
+                                           double max_stream_hz, ui::UiBackend& backend,
+                                           const char* who) {
+  ui::UiServerConfig config;
+  if (auto parsed = ui::parse_listen(listen, config); !parsed)
+    fail(parsed.error(), EXIT_USAGE, who);
+  if (!token_file.empty()) {
+    auto token_result = ui::read_token_file(token_file);
+    if (!token_result) fail(token_result.error(), EXIT_USAGE, who);
+    config.token = *token_result;
+  }
+  config.max_stream_hz = max_stream_hz;
+  auto server_result = ui::UiServer::start(config, backend);
+  if (!server_result) fail(server_result.error(), EXIT_FAILURE_GENERIC, who);
+  auto server = std::move(*server_result);
+  std::cout << "ui: " << server->url() << "\n";
+  if (!server->token().empty()) {
+    std::cout << "ui: bearer token " << server->token()
+              << " (Authorization: Bearer <token>, or ?token=<token> in the page's URL)\n";
+  }
+  std::cout.flush();
+  return server;
+}
+
+std::atomic<bool> g_ui_stop{false};
+extern "C" void on_ui_signal(int /*signal*/) { g_ui_stop.store(true, std::memory_order_relaxed); }
+
+struct UiOptions {
+  std::string graph = "tabletop";
+  std::string listen;
+  std::string token_file;
+  double seconds = 0;  // 0: until a signal
+};
+
+// `orthoflow ui`: the web view in a process of its own, over a graph that runs with
+// --ipc-learning. Ends on SIGINT / SIGTERM (exit 0), after --seconds, or when RouDi is lost (22).
+void run_standalone_ui(const UiOptions& o) {
+  constexpr const char* WHO = "ui";
+  auto init = engine::init_ipc_runtime("orthoflow_ui_" + std::to_string(::getpid()));
+  if (!init) {
+    fail(to_string(init.error()),
+         init.error().code == engine::IpcError::Code::ROUDI_UNREACHABLE ? EXIT_NO_ROUDI
+                                                                        : EXIT_FAILURE_GENERIC,
+         WHO);
+  }
+  auto backend = ui::IpcBackend::open(o.graph);
+  if (!backend) fail(backend.error(), EXIT_FAILURE_GENERIC, WHO);
+  g_ui_stop.store(false);
+  auto previous_int = std::signal(SIGINT, on_ui_signal);
+  auto previous_term = std::signal(SIGTERM, on_ui_signal);
+  auto server = start_server(o.listen, o.token_file, 30.0, **backend, WHO);
+  std::cout << "ui: graph '" << o.graph << "' over iceoryx (start it with orthoflow run "
+            << "--ipc-learning)\n";
+  std::cout.flush();
+  const auto start = std::chrono::steady_clock::now();
+  bool said_connected = false;
+  while (!g_ui_stop.load() && !engine::ipc_roudi_lost() && engine::probe_roudi()) {
+    if (o.seconds > 0 &&
+        std::chrono::steady_clock::now() - start > std::chrono::duration<double>(o.seconds))
+      break;
+    if ((*backend)->connected() != said_connected) {
+      said_connected = !said_connected;
+      std::cout << "ui: graph '" << o.graph << "' " << (said_connected ? "connected" : "lost")
+                << "\n";
+      std::cout.flush();
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  server.reset();
+  const bool lost = engine::ipc_roudi_lost() || !engine::probe_roudi();
+  const ui::IpcBackendCounters& c = (*backend)->counters();
+  std::cout << "ui: " << c.object_lists.load() << " object lists, " << c.statuses.load()
+            << " statuses, " << c.acks.load() << " acknowledgements taken, " << c.rejected.load()
+            << " payloads rejected\n";
+  backend->reset();
+  std::signal(SIGINT, previous_int);
+  std::signal(SIGTERM, previous_term);
+  if (lost) fail(roudi_lost_text("serving the web view"), EXIT_ROUDI_LOST, WHO);
 }
 
 }  // namespace
@@ -38,30 +129,38 @@ std::string check_ui_listen(const std::string& value) {
 std::unique_ptr<RunUi> start_run_ui(const std::string& listen, const std::string& token_file,
                                     graphs::LearningService& learning, graphs::ObjectsHub& hub,
                                     const engine::GraphStats& stats, std::int64_t period_ns) {
-  ui::UiServerConfig config;
-  if (auto parsed = ui::parse_listen(listen, config); !parsed) fail(parsed.error(), EXIT_USAGE);
-  if (!token_file.empty()) {
-    auto token_result = ui::read_token_file(token_file);
-    if (!token_result) fail(token_result.error(), EXIT_USAGE);
-    config.token = *token_result;
-  }
   const double frame_hz = period_ns > 0 ? 1e9 / static_cast<double>(period_ns) : 30.0;
-  config.max_stream_hz = std::min(30.0, frame_hz);
   auto running = std::make_unique<RunningUi>();
   auto backend_result = ui::GraphBackend::open(learning, hub);
   if (!backend_result) fail(backend_result.error(), EXIT_FAILURE_GENERIC);
   running->backend = std::move(*backend_result);
   running->backend->set_telemetry(&stats);
-  auto server_result = ui::UiServer::start(config, *running->backend);
-  if (!server_result) fail(server_result.error(), EXIT_FAILURE_GENERIC);
-  running->server = std::move(*server_result);
-  std::cout << "ui: " << running->server->url() << "\n";
-  if (!running->server->token().empty()) {
-    std::cout << "ui: bearer token " << running->server->token()
-              << " (Authorization: Bearer <token>, or ?token=<token> in the page's URL)\n";
-  }
-  std::cout.flush();
+  running->server =
+      start_server(listen, token_file, std::min(30.0, frame_hz), *running->backend, "run: --ui");
   return running;
+}
+
+void add_ui_command(CLI::App& app) {
+  auto o = std::make_shared<UiOptions>();
+  auto* cmd = app.add_subcommand(
+      "ui",
+      "Serve the live web view and its JSON API for a graph running in another process (orthoflow "
+      "run --ipc-learning) over iceoryx (needs RouDi)");
+  cmd->add_option("--listen", o->listen,
+                  "[ADDR:]PORT to serve on (default address 127.0.0.1; another address needs the "
+                  "bearer token printed at start; ui/README.md)")
+      ->required()
+      ->check(check_ui_listen);
+  cmd->add_option("--graph", o->graph, "the graph's name (its topics orthoflow/<graph>/...)")
+      ->check([](const std::string& v) {
+        return engine::parse_topic("orthoflow/" + v + "/objects") ? std::string{}
+                                                                  : "not a topic name part";
+      });
+  cmd->add_option("--token-file", o->token_file,
+                  "read the bearer token from FILE instead of generating one");
+  cmd->add_option("--seconds", o->seconds, "stop after S seconds (default: at SIGINT / SIGTERM)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->callback([o] { run_standalone_ui(*o); });
 }
 
 }  // namespace orthoflow::apps

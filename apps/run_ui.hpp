@@ -1,7 +1,9 @@
 #pragma once
 /// @file
 /// @brief `orthoflow run --ui [ADDR:]PORT [--ui-token-file FILE]`: the web view's server beside the
-/// graph (ui/ui_server.hpp), over the run's learning service, objects hub and telemetry.
+/// graph (ui/ui_server.hpp), over the run's learning service, objects hub and telemetry; and
+/// `orthoflow ui --listen [ADDR:]PORT`, the same server in a process of its own over iceoryx
+/// (ui/ipc_backend.hpp; add_ui_command in commands.hpp).
 #include <cstdint>
 #include <memory>
 #include <string>

@@ -13,38 +13,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-std::int64_t unix_ms() {
-  return std::chrono::duration_cast<std::chrono::milliseconds>(
-             std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
-
-ObjectView view_of(const engine::ObjectEntry& e) {
-  ObjectView o;
-  o.track_id = e.track_id;
-  o.unknown = e.unknown != 0;
-  o.label = o.unknown ? std::string{} : std::string(e.label.view());
-  o.score = e.score;
-  std::memcpy(o.centroid, e.centroid, sizeof o.centroid);
-  std::memcpy(o.bbox_min, e.bbox_min, sizeof o.bbox_min);
-  std::memcpy(o.bbox_max, e.bbox_max, sizeof o.bbox_max);
-  o.point_count = e.point_count;
-  o.flags = e.flags;
-  return o;
-}
-
-std::string outcome_text(const UiAnswer& a) {
-  switch (a.status) {
-    case UiAnswer::Status::ACKNOWLEDGED:
-      return std::string(graphs::to_string(a.ack.outcome));
-    case UiAnswer::Status::QUEUE_FULL:
-      return "queue_full";
-    case UiAnswer::Status::TIMEOUT:
-      return "timeout";
-  }
-  return "?";
-}
-
 }  // namespace
 
 Result<std::unique_ptr<GraphBackend>, std::string> GraphBackend::open(
@@ -105,12 +73,12 @@ UiSnapshot GraphBackend::snapshot() const {
       s.age_ns = latest_->age_ns;
     }
     s.objects = objects_locked();
-    s.events.assign(events_.begin(), events_.end());
-    for (const learning::CategorySummary& c : learning_.learner().categories()) {
-      const std::string label(c.label.view());
-      const auto it = last_taught_ms_.find(label);
-      s.memory.push_back({label, c.views, it == last_taught_ms_.end() ? 0 : it->second});
-    }
+  }
+  s.events = events_.events();
+  for (const learning::CategorySummary& c : learning_.learner().categories()) {
+    std::string label(c.label.view());
+    const std::int64_t taught = events_.last_taught_ms(label);
+    s.memory.push_back({std::move(label), c.views, taught});
   }
   {
     std::lock_guard<std::mutex> guard(camera_lock_);
@@ -166,11 +134,7 @@ std::vector<ObjectView> GraphBackend::snapshot_objects() const {
 }
 
 std::vector<ObjectView> GraphBackend::objects_locked() const {
-  std::vector<ObjectView> objects;
-  if (!have_latest_) return objects;
-  const std::uint32_t n = std::min(latest_->count, engine::OBJECT_LIST_CAPACITY);
-  for (std::uint32_t k = 0; k < n; ++k) objects.push_back(view_of(latest_->objects[k]));
-  return objects;
+  return have_latest_ ? object_views(*latest_) : std::vector<ObjectView>{};
 }
 
 void GraphBackend::add_telemetry(UiSnapshot& s) const {
@@ -212,32 +176,8 @@ UiAnswer GraphBackend::submit(const UiAction& action, int timeout_ms) {
       }
     }
   }
-  record(action, answer);
+  events_.record(action, answer);
   return answer;
-}
-
-void GraphBackend::record(const UiAction& action, const UiAnswer& answer) {
-  using Kind = graphs::LearningCommand::Kind;
-  const bool ok = answer.status == UiAnswer::Status::ACKNOWLEDGED && answer.ack.ok();
-  EventView e;
-  e.time_ms = unix_ms();
-  e.action = std::string(graphs::to_string(action.kind));
-  e.track = ok && action.kind != Kind::FORGET && action.kind != Kind::UNDO ? answer.ack.track_id
-                                                                           : action.track;
-  e.label = action.kind == Kind::ASK || action.kind == Kind::UNDO
-                ? std::string(answer.ack.label.view())
-                : std::string(action.label.view());
-  e.outcome = outcome_text(answer);
-  e.ok = ok;
-  e.views = answer.ack.views;
-  e.frame_id = answer.ack.frame_id;
-  std::lock_guard<std::mutex> guard(state_lock_);
-  e.id = next_event_++;
-  if (ok && (action.kind == Kind::TEACH || action.kind == Kind::CORRECT))
-    last_taught_ms_[e.label] = e.time_ms;
-  if (ok && action.kind == Kind::FORGET) last_taught_ms_.erase(e.label);
-  events_.push_back(std::move(e));
-  if (events_.size() > MAX_UI_EVENTS) events_.pop_front();
 }
 
 }  // namespace orthoflow::ui

@@ -8,8 +8,6 @@
 /// LearningAck. Nothing here runs on the frame path.
 #include <atomic>
 #include <condition_variable>
-#include <deque>
-#include <map>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -20,13 +18,11 @@
 #include "engine/telemetry.hpp"
 #include "graphs/learning_service.hpp"
 #include "graphs/objects_output.hpp"
+#include "ui/backend_support.hpp"
 #include "ui/camera_view.hpp"
 #include "ui/ui_backend.hpp"
 
 namespace orthoflow::ui {
-
-/// @brief Recent events kept for the page.
-inline constexpr std::size_t MAX_UI_EVENTS = 32;
 
 /// @note Thread-safe. @pre destroyed before @p learning and @p hub (and before the engine whose
 /// telemetry it reads).
@@ -57,7 +53,6 @@ class GraphBackend final : public UiBackend {
   [[nodiscard]] std::vector<ObjectView> objects_locked() const;  // @pre state_lock_ held
   void draw_camera();
   void poll_objects() noexcept;
-  void record(const UiAction& action, const UiAnswer& answer);
   void add_telemetry(UiSnapshot& s) const;
 
   graphs::LearningService& learning_;
@@ -72,11 +67,9 @@ class GraphBackend final : public UiBackend {
   std::condition_variable camera_drawn_;  // notified when camera_png_ changes
   std::mutex client_lock_;  // LearningClient is thread-compatible: one action at a time
   mutable std::mutex state_lock_;
-  std::unique_ptr<engine::ObjectListPayload> latest_;   // guarded by state_lock_
-  bool have_latest_ = false;                            // guarded by state_lock_
-  std::deque<EventView> events_;                        // guarded by state_lock_
-  std::map<std::string, std::int64_t> last_taught_ms_;  // guarded by state_lock_
-  std::uint64_t next_event_ = 1;                        // guarded by state_lock_
+  std::unique_ptr<engine::ObjectListPayload> latest_;  // guarded by state_lock_
+  bool have_latest_ = false;                           // guarded by state_lock_
+  EventLog events_;
   std::atomic<const engine::GraphStats*> stats_{nullptr};
   std::atomic<bool> stop_{false};
   std::thread poller_;

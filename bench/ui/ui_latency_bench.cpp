@@ -32,6 +32,7 @@
 #include "graphs/objects_output.hpp"
 #include "graphs/tabletop.hpp"
 #include "tests/support/pinhole_image.hpp"
+#include "ui/background_thread.hpp"
 #include "ui/camera_view.hpp"
 #include "ui/graph_backend.hpp"
 #include "ui/ui_client.hpp"
@@ -113,11 +114,14 @@ class Browser {
 };
 
 // A program polling the API as the page does: GET /api/state at 30 Hz and GET /api/camera.png at
-// 5 Hz (the server's work without a browser's rendering beside the graph).
+// 5 Hz (the server's work without a browser's rendering beside the graph); with @p niced, from a
+// thread at nice 19 (a client that yields the CPU to the graph, as one on another machine takes
+// none of the robot's).
 class Poller {
  public:
-  Poller(std::uint16_t port, bool camera) {
-    thread_ = std::thread([this, port, camera] {
+  Poller(std::uint16_t port, bool camera, bool niced) {
+    thread_ = std::thread([this, port, camera, niced] {
+      if (niced) ou::make_this_thread_background();
       const ou::ClientTarget target{"127.0.0.1", port, "", 2000};
       for (int tick = 0; !stop_.load(); ++tick) {
         (void)ou::send_ui_request(target, "GET", "/api/state", "");
@@ -139,7 +143,7 @@ class Poller {
   std::thread thread_;
 };
 
-enum class Viewer { NONE, BROWSER, PROGRAM, PROGRAM_STATE_ONLY, BROWSER_NICED };
+enum class Viewer { NONE, BROWSER, PROGRAM, PROGRAM_STATE_ONLY, BROWSER_NICED, PROGRAM_NICED };
 
 // One run of the graph at 30 Hz; with a viewer, the web view and that viewer on it.
 // @p camera_images gets the images the frame path copied for the viewer.
@@ -183,7 +187,8 @@ Latency run_once(Viewer viewer, std::uint64_t frames, std::uint64_t& camera_imag
           std::make_unique<Browser>(server->url() + "?hz=30", viewer == Viewer::BROWSER_NICED);
       if (!browser->running()) return {};
     } else {
-      poller = std::make_unique<Poller>(server->port(), viewer == Viewer::PROGRAM);
+      poller = std::make_unique<Poller>(server->port(), viewer != Viewer::PROGRAM_STATE_ONLY,
+                                        viewer == Viewer::PROGRAM_NICED);
     }
     // The browser's start (a second or more) is not the robot's steady state: wait until the
     // page runs (it asked for a camera image), then a little more.
@@ -213,10 +218,11 @@ Latency run_once(Viewer viewer, std::uint64_t frames, std::uint64_t& camera_imag
 }
 
 // range(0): 0 = Debian's headless Chromium on the page, 1 = a program polling the state and the
-// camera image as the page does, 2 = a program polling the state only, 3 = Chromium at nice 19.
+// camera image as the page does, 2 = a program polling the state only, 3 = Chromium at nice 19,
+// 4 = viewer 1 from a thread at nice 19.
 void BM_FrameLatencyWithAViewer(benchmark::State& state) {
   constexpr Viewer VIEWERS[] = {Viewer::BROWSER, Viewer::PROGRAM, Viewer::PROGRAM_STATE_ONLY,
-                                Viewer::BROWSER_NICED};
+                                Viewer::BROWSER_NICED, Viewer::PROGRAM_NICED};
   const Viewer viewer = VIEWERS[static_cast<std::size_t>(state.range(0))];
   const bool browser = viewer == Viewer::BROWSER || viewer == Viewer::BROWSER_NICED;
   if (browser && ::access(CHROMIUM, X_OK) != 0) {
@@ -251,6 +257,7 @@ BENCHMARK(BM_FrameLatencyWithAViewer)
     ->Arg(1)
     ->Arg(2)
     ->Arg(3)
+    ->Arg(4)
     ->Iterations(1)
     ->Unit(benchmark::kSecond);
 
