@@ -6,7 +6,7 @@ set -euo pipefail
 PACKAGES=(
   cmake ninja-build g++ pkg-config git
   libeigen3-dev libxsimd-dev libtbb-dev libyaml-cpp-dev nlohmann-json3-dev libcli11-dev
-  liblzf-dev libcairo2-dev libleveldb-dev libusb-1.0-0-dev
+  liblzf-dev libcairo2-dev libpng-dev libleveldb-dev libusb-1.0-0-dev
   libcivetweb-dev  # the web view's HTTP + WebSocket server (ui/, `orthoflow run --ui`)
   iceoryx libiceoryx-posh-dev libiceoryx-hoofs-dev
   libgtest-dev libgmock-dev libbenchmark-dev

@@ -9,6 +9,7 @@
 #include <memory>
 
 #include "engine/object_list_payload.hpp"
+#include "ui/png_encode.hpp"
 
 namespace orthoflow::ui {
 
@@ -50,11 +51,6 @@ std::uint32_t depth_colour(float z, float z0, float z1) noexcept {
   const auto g = static_cast<std::uint32_t>(200.0F * (1.0F - 0.5F * t));
   const auto b = static_cast<std::uint32_t>(80.0F + 175.0F * t);
   return (r << 16) | (g << 8) | b;
-}
-
-cairo_status_t append_png(void* closure, const unsigned char* data, unsigned int length) {
-  static_cast<std::string*>(closure)->append(reinterpret_cast<const char*>(data), length);
-  return CAIRO_STATUS_SUCCESS;
 }
 
 struct SurfaceFree {
@@ -195,10 +191,9 @@ std::string render_camera_png(const graphs::CameraImage& image,
     cairo_show_text(g.get(), text);
   }
   g.reset();
-  std::string png;
-  if (cairo_surface_write_to_png_stream(surface.get(), append_png, &png) != CAIRO_STATUS_SUCCESS)
-    return {};
-  return png;
+  cairo_surface_flush(surface.get());
+  return encode_rgb24_png(cairo_image_surface_get_data(surface.get()),
+                          cairo_image_surface_get_stride(surface.get()), image.width, image.height);
 }
 
 }  // namespace orthoflow::ui

@@ -18,10 +18,14 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cairo.h>
+
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <limits>
+#include <random>
 #include <string>
 #include <thread>
 #include <vector>
@@ -35,6 +39,7 @@
 #include "ui/background_thread.hpp"
 #include "ui/camera_view.hpp"
 #include "ui/graph_backend.hpp"
+#include "ui/png_encode.hpp"
 #include "ui/ui_client.hpp"
 #include "ui/ui_server.hpp"
 
@@ -319,6 +324,47 @@ void BM_CameraImageDraw(benchmark::State& state) {
   state.counters["png_bytes"] = static_cast<double>(bytes);
 }
 BENCHMARK(BM_CameraImageDraw)->Unit(benchmark::kMicrosecond);
+
+cairo_status_t append_to(void* closure, const unsigned char* data, unsigned int length) {
+  static_cast<std::string*>(closure)->append(reinterpret_cast<const char*>(data), length);
+  return CAIRO_STATUS_SUCCESS;
+}
+
+// The PNG of a camera-like 320 x 240 image (a smooth scene plus +-8 levels of sensor noise per
+// channel, seeded: what a Kinect's colour looks like to zlib, unlike BM_CameraImageDraw's clean
+// gradient): range(0) 0 = cairo's own writer (zlib's default level; the web view before), 1 =
+// ui/png_encode (libpng, level 1, SUB filter; the web view now). Compare their times in one run.
+void BM_PngEncode(benchmark::State& state) {
+  constexpr int W = 320, H = 240;
+  cairo_surface_t* surface = cairo_image_surface_create(CAIRO_FORMAT_RGB24, W, H);
+  cairo_surface_flush(surface);
+  unsigned char* pixels = cairo_image_surface_get_data(surface);
+  const int stride = cairo_image_surface_get_stride(surface);
+  std::mt19937 random(42);
+  std::uniform_int_distribution<int> noise(-8, 8);
+  auto level = [&](int base) {
+    return static_cast<std::uint32_t>(std::clamp(base + noise(random), 0, 255));
+  };
+  for (int j = 0; j < H; ++j) {
+    auto* row = reinterpret_cast<std::uint32_t*>(pixels + j * stride);
+    for (int i = 0; i < W; ++i)
+      row[i] = (level(60 + i / 2) << 16) | (level(90 + j / 3) << 8) | level(120 + (i + j) / 5);
+  }
+  cairo_surface_mark_dirty(surface);
+  std::size_t bytes = 0;
+  for (auto _ : state) {
+    std::string png;
+    if (state.range(0) == 0)
+      cairo_surface_write_to_png_stream(surface, append_to, &png);
+    else
+      png = ou::encode_rgb24_png(pixels, stride, W, H);
+    bytes = png.size();
+    benchmark::DoNotOptimize(png.data());
+  }
+  cairo_surface_destroy(surface);
+  state.counters["png_bytes"] = static_cast<double>(bytes);
+}
+BENCHMARK(BM_PngEncode)->ArgName("libpng_level1")->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 
