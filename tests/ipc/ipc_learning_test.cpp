@@ -59,7 +59,14 @@ TEST(IpcLearning, StandaloneUiTeachesAsksAndUndoesOnAGraphInAnotherProcess) {
         const std::string url = url_in(file_text("/tmp/ui.out"));
         box.check(!url.empty(), "the ui prints its URL");
         if (url.empty()) return;
-        std::this_thread::sleep_for(1500ms);  // the synthetic session's objects are tracked
+        bool tracked = false;  // the session's bottle is track 2 once the tracker has it
+        for (int k = 0; k < 100 && !tracked; ++k) {
+          const ProcResult state = remote(box, {"state", "--url", url});
+          tracked = state.exit_code == 0 && state.out.find("  track 2  ") != std::string::npos;
+          if (!tracked) std::this_thread::sleep_for(200ms);
+        }
+        box.check(tracked, "the page shows track 2");
+        std::this_thread::sleep_for(300ms);  // a few frames on: described and key-viewed
 
         const ProcResult teach = remote(box, {"teach", "--url", url, "2", "flask"});
         box.check(teach.exit_code == 0 && teach.out.find("as \"flask\"") != std::string::npos &&
@@ -83,8 +90,10 @@ TEST(IpcLearning, StandaloneUiTeachesAsksAndUndoesOnAGraphInAnotherProcess) {
         box.check(forget.exit_code == 30 && forget.err.find("unknown_label") != std::string::npos,
                   "forgetting an unknown category is refused with the graph's reason", forget);
         const ProcResult undo = remote(box, {"undo", "--url", url});
-        box.check(undo.exit_code == 0 && undo.out.find("flask") != std::string::npos,
-                  "undo takes the lesson back", undo);
+        // The session's scripted instructor teaches too, and undo takes back the newest lesson of
+        // any sender: flask's, or one of the instructor's taught since.
+        box.check(undo.exit_code == 0 && undo.out.find("took back ") != std::string::npos,
+                  "undo takes the newest lesson back", undo);
 
         ::kill(run, SIGINT);
         const ProcResult r = box.wait(run, 20s);
