@@ -99,7 +99,16 @@ struct Rig {
   std::function<void(UsbTimeout)> wait;
   std::int64_t next_ns = 0;
 
-  void open(ControllerOptions options = {}) {
+  // These tests run the controller on the real clock, one cycle per 10 ms, with the watchdog fed
+  // every cycle; on a loaded machine (CI, two cores, -j2) one cycle once stalled past the default
+  // 100 ms and the watchdog rightly stopped the homing (the watchdog's own tests run on a test
+  // clock, tests/drivers). None here tests the watchdog: it gets 1 s.
+  static ControllerOptions relaxed_watchdog() {
+    ControllerOptions options;
+    options.command_timeout_ns = 1'000'000'000;
+    return options;
+  }
+  void open(ControllerOptions options = relaxed_watchdog()) {
     auto usb_result = LibusbTransport::create();
     ASSERT_TRUE(usb_result.has_value()) << to_string(usb_result.error());
     usb = std::move(usb_result).value();
