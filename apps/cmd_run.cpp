@@ -86,7 +86,10 @@ void add_objects_publisher(engine::GraphSpec& spec) {
   engine::NodeSpec publish;
   publish.name = "publish_objects";
   publish.kind = "ipc_publish";
-  publish.params.assign("topic", "orthoflow/" + spec.name + "/objects");
+  const auto topics = graphs::graph_topics(spec.name);
+  if (!topics)
+    fail("--publish-objects: graph name '" + spec.name + "': " + topics.error(), EXIT_USAGE);
+  publish.params.assign("topic", topics->objects.str());
   publish.params.assign("type", "objects");
   publish.params.assign("max_bytes", std::to_string(sizeof(engine::ObjectListPayload)));
   spec.edges.push_back(engine::EdgeSpec{output->name, "objects", publish.name, "in", 0});

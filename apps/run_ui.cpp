@@ -11,8 +11,8 @@
 
 #include "apps/commands.hpp"
 #include "apps/graph_run.hpp"
-#include "engine/ipc_pubsub.hpp"
 #include "engine/ipc_runtime.hpp"
+#include "graphs/learning_ipc_bridge.hpp"
 #include "ui/graph_backend.hpp"
 #include "ui/ipc_backend.hpp"
 #include "ui/ui_server.hpp"
@@ -153,8 +153,8 @@ void add_ui_command(CLI::App& app) {
       ->check(check_ui_listen);
   cmd->add_option("--graph", o->graph, "the graph's name (its topics orthoflow/<graph>/...)")
       ->check([](const std::string& v) {
-        return engine::parse_topic("orthoflow/" + v + "/objects") ? std::string{}
-                                                                  : "not a topic name part";
+        auto topics = graphs::graph_topics(v);
+        return topics ? std::string{} : topics.error();
       });
   cmd->add_option("--token-file", o->token_file,
                   "read the bearer token from FILE instead of generating one");

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstring>
+#include <utility>
 #include <vector>
 
 #include "engine/ipc_pubsub.hpp"
@@ -49,6 +50,19 @@ void fill_status(const LearningService& learning, const engine::GraphStats& stat
 
 }  // namespace
 
+Result<GraphTopics, std::string> graph_topics(const std::string& graph) {
+  GraphTopics topics;
+  for (auto [topic, name] : {std::pair{&topics.objects, "orthoflow/" + graph + "/objects"},
+                             std::pair{&topics.commands, learning_commands_topic(graph)},
+                             std::pair{&topics.acks, learning_acks_topic(graph)},
+                             std::pair{&topics.status, status_topic(graph)}}) {
+    auto parsed = engine::parse_topic(name);
+    if (!parsed) return err(engine::to_string(parsed.error()));
+    *topic = std::move(*parsed);
+  }
+  return topics;
+}
+
 struct LearningIpcBridge::Pending {
   std::uint64_t sequence = 0;  // the learning client's
   std::uint64_t client = 0, request = 0;
@@ -58,30 +72,21 @@ struct LearningIpcBridge::Pending {
 
 Result<std::unique_ptr<LearningIpcBridge>, std::string> LearningIpcBridge::open(
     const std::string& graph, LearningService& learning, const engine::GraphStats& stats) {
-  auto topic = [](const std::string& text) -> Result<engine::IpcTopic, std::string> {
-    auto t = engine::parse_topic(text);
-    if (!t) return err(engine::to_string(t.error()));
-    return *t;
-  };
-  auto commands_topic = topic(learning_commands_topic(graph));
-  auto acks_topic = topic(learning_acks_topic(graph));
-  auto status_topic_name = topic(status_topic(graph));
-  if (!commands_topic) return err(commands_topic.error());
-  if (!acks_topic) return err(acks_topic.error());
-  if (!status_topic_name) return err(status_topic_name.error());
+  auto topics = graph_topics(graph);
+  if (!topics) return err(topics.error());
   auto pools = engine::query_roudi_pools(std::chrono::milliseconds(2000));
   if (!pools) return err(engine::to_string(pools.error()));
   auto commands = engine::IpcSubscriber::create(
-      *commands_topic,
+      topics->commands,
       {{LEARNING_COMMAND_TYPE_ID, LEARNING_IPC_VERSION}, engine::IpcPolicy::QUEUE, 64, 0});
   if (!commands) return err(engine::to_string(commands.error()));
   auto acks = engine::IpcPublisher::create(
-      *acks_topic,
+      topics->acks,
       {{LEARNING_ACK_TYPE_ID, LEARNING_IPC_VERSION}, sizeof(LearningAckPayload), 0, false}, *pools);
   if (!acks) return err(engine::to_string(acks.error()));
   // History 1: a viewer that starts later sees the memory at once.
   auto status = engine::IpcPublisher::create(
-      *status_topic_name, {{STATUS_TYPE_ID, LEARNING_IPC_VERSION}, sizeof(StatusPayload), 1, false},
+      topics->status, {{STATUS_TYPE_ID, LEARNING_IPC_VERSION}, sizeof(StatusPayload), 1, false},
       *pools);
   if (!status) return err(engine::to_string(status.error()));
   auto client = learning.connect();

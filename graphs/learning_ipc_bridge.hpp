@@ -16,15 +16,21 @@
 #include <thread>
 
 #include "core/result.hpp"
+#include "engine/ipc_pubsub.hpp"
 #include "engine/telemetry.hpp"
 #include "graphs/learning_service.hpp"
 
-namespace orthoflow::engine {
-class IpcPublisher;
-class IpcSubscriber;
-}  // namespace orthoflow::engine
-
 namespace orthoflow::graphs {
+
+/// @brief The iceoryx topics a graph run with --ipc-learning offers: orthoflow/<graph>/objects,
+/// the learning_payloads.hpp topics. The one place both ends (this bridge and ui::IpcBackend) name
+/// them.
+struct GraphTopics {
+  engine::IpcTopic objects, commands, acks, status;
+};
+/// @brief The topics of graph @p graph. Errors: @p graph is not a topic name part (1..100 of
+/// [A-Za-z0-9_.-]).
+[[nodiscard]] Result<GraphTopics, std::string> graph_topics(const std::string& graph);
 
 /// @brief What the bridge did, readable from any thread.
 struct LearningIpcCounters {

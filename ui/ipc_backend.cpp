@@ -7,6 +7,7 @@
 
 #include "engine/ipc_pubsub.hpp"
 #include "engine/ipc_runtime.hpp"
+#include "graphs/learning_ipc_bridge.hpp"
 #include "ui/background_thread.hpp"
 
 namespace orthoflow::ui {
@@ -17,20 +18,12 @@ using Clock = std::chrono::steady_clock;
 
 std::int64_t now_ns() { return Clock::now().time_since_epoch().count(); }
 
-Result<engine::IpcTopic, std::string> topic_of(const std::string& text) {
-  auto t = engine::parse_topic(text);
-  if (!t) return err(engine::to_string(t.error()));
-  return *t;
-}
-
-Result<std::unique_ptr<engine::IpcSubscriber>, std::string> subscribe(const std::string& topic,
+Result<std::unique_ptr<engine::IpcSubscriber>, std::string> subscribe(const engine::IpcTopic& topic,
                                                                       engine::IpcPayloadType type,
                                                                       engine::IpcPolicy policy,
                                                                       std::uint64_t depth,
                                                                       std::uint64_t history) {
-  auto t = topic_of(topic);
-  if (!t) return err(t.error());
-  auto s = engine::IpcSubscriber::create(*t, {type, policy, depth, history});
+  auto s = engine::IpcSubscriber::create(topic, {type, policy, depth, history});
   if (!s) return err(engine::to_string(s.error()));
   return std::move(*s);
 }
@@ -56,24 +49,22 @@ std::uint64_t random_client_id() {
 }  // namespace
 
 Result<std::unique_ptr<IpcBackend>, std::string> IpcBackend::open(const std::string& graph) {
-  auto objects = subscribe("orthoflow/" + graph + "/objects",
-                           {engine::OBJECT_LIST_TYPE_ID, engine::OBJECT_LIST_VERSION},
-                           engine::IpcPolicy::LATEST, 1, 0);
+  auto topics = graphs::graph_topics(graph);
+  if (!topics) return err(topics.error());
+  auto objects =
+      subscribe(topics->objects, {engine::OBJECT_LIST_TYPE_ID, engine::OBJECT_LIST_VERSION},
+                engine::IpcPolicy::LATEST, 1, 0);
   if (!objects) return err(objects.error());
-  auto status =
-      subscribe(graphs::status_topic(graph), {graphs::STATUS_TYPE_ID, graphs::LEARNING_IPC_VERSION},
-                engine::IpcPolicy::LATEST, 1, 1);
+  auto status = subscribe(topics->status, {graphs::STATUS_TYPE_ID, graphs::LEARNING_IPC_VERSION},
+                          engine::IpcPolicy::LATEST, 1, 1);
   if (!status) return err(status.error());
-  auto acks = subscribe(graphs::learning_acks_topic(graph),
-                        {graphs::LEARNING_ACK_TYPE_ID, graphs::LEARNING_IPC_VERSION},
+  auto acks = subscribe(topics->acks, {graphs::LEARNING_ACK_TYPE_ID, graphs::LEARNING_IPC_VERSION},
                         engine::IpcPolicy::QUEUE, 64, 0);
   if (!acks) return err(acks.error());
-  auto commands_topic = topic_of(graphs::learning_commands_topic(graph));
-  if (!commands_topic) return err(commands_topic.error());
   auto pools = engine::query_roudi_pools(std::chrono::milliseconds(2000));
   if (!pools) return err(engine::to_string(pools.error()));
   auto commands = engine::IpcPublisher::create(
-      *commands_topic,
+      topics->commands,
       {{graphs::LEARNING_COMMAND_TYPE_ID, graphs::LEARNING_IPC_VERSION},
        sizeof(graphs::LearningCommandPayload),
        0,
