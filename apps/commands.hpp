@@ -48,6 +48,13 @@ void add_ipc_command(CLI::App& app);
 /// 31 unreachable).
 void add_remote_commands(CLI::App& app);
 
+/// @brief `calibrate hand-eye|simulate-samples`: the camera's pose in the arm's base frame
+/// (apps/cmd_calibrate.cpp).
+void add_calibrate_command(CLI::App& app);
+/// @brief `grasp --robot-frames F --objects RUN.jsonl`: grasp plans of a run's objects
+/// (apps/cmd_grasp.cpp).
+void add_grasp_command(CLI::App& app);
+
 /// @brief `run`: the tabletop graph on the embedded session or a given source; summary, JSON lines,
 /// snapshot.
 void add_run_command(CLI::App& app);

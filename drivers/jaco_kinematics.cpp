@@ -258,6 +258,16 @@ Eigen::Isometry3d forward_kinematics(const JointAngles& actuator_deg,
   return chain(geometry, vec(actuator_deg) * DEG).tip;
 }
 
+ChainFrames forward_kinematics_frames(const JointAngles& actuator_deg,
+                                      const ArmGeometry& geometry) noexcept {
+  ChainFrames frames;
+  frames[0] = Eigen::Isometry3d::Identity();
+  for (std::size_t i = 0; i < 6; ++i) {
+    frames[i + 1] = frames[i] * dh_transform(geometry.rows[i], actuator_deg[i] * DEG);
+  }
+  return frames;
+}
+
 const char* to_string(IkError error) noexcept {
   switch (error) {
     case IkError::NOT_FINITE:

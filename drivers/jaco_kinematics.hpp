@@ -77,6 +77,13 @@ inline constexpr double CONTINUOUS_BOUND_DEG = 10000.0;
 [[nodiscard]] Eigen::Isometry3d forward_kinematics(const JointAngles& actuator_deg,
                                                    const ArmGeometry& geometry) noexcept;
 
+/// @brief The base frame (identity) and the six DH frames, frame k after row k: frame 6 is the
+/// end effector (forward_kinematics). What a link model of the arm is built on.
+using ChainFrames = std::array<Eigen::Isometry3d, 7>;
+/// @brief The frames of the chain at @p actuator_deg on @p geometry. @pre finite angles.
+[[nodiscard]] ChainFrames forward_kinematics_frames(const JointAngles& actuator_deg,
+                                                    const ArmGeometry& geometry) noexcept;
+
 /// @brief Why the IK found no solution.
 enum class IkError : std::uint8_t {
   NOT_FINITE,   ///< the target or the seed holds NaN or infinity

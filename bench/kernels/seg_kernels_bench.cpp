@@ -10,6 +10,7 @@
 #include <random>
 #include <vector>
 
+#include "bench/kernels/bench_cloud.hpp"
 #include "kernels/crop.hpp"
 #include "kernels/depth_projection.hpp"
 #include "kernels/euclidean_cluster.hpp"
@@ -22,22 +23,9 @@ namespace ok = orthoflow::kernels;
 
 namespace {
 
-struct Cloud {
-  std::vector<float> x, y, z;
-  ok::PointsView view() const { return {x, y, z}; }
-};
+using orthoflow::bench::Cloud;
 
-Cloud make(std::size_t n) {
-  std::mt19937 rng(1);
-  std::uniform_real_distribution<float> c(-1.0F, 1.0F);
-  Cloud out;
-  for (std::size_t i = 0; i < n; ++i) {
-    out.x.push_back(i % 10 == 0 ? std::numeric_limits<float>::quiet_NaN() : c(rng));
-    out.y.push_back(c(rng));
-    out.z.push_back(c(rng) + 1.0F);
-  }
-  return out;
-}
+Cloud make(std::size_t n) { return orthoflow::bench::random_cube(n, 1.0F, 1.0F); }
 
 template <bool SIMD>
 void BM_CropBox(benchmark::State& state) {

@@ -25,12 +25,13 @@ ALLOWED = {
     "simulation": ["core", "memory_pool", "kernels", "formats", "drivers"],
     "drivers": ["core", "memory_pool", "kernels"],
     "learning": ["core", "memory_pool", "kernels"],
+    "manipulation": ["core", "memory_pool", "kernels", "drivers"],
     "evaluation": ["core", "memory_pool", "kernels", "formats", "simulation", "learning"],
     "graphs": ["core", "memory_pool", "kernels", "engine", "formats", "simulation", "drivers", "learning"],
     "ui": ["core", "memory_pool", "kernels", "engine", "formats", "simulation", "drivers", "learning",
            "graphs"],
     "apps": ["core", "memory_pool", "kernels", "engine", "formats", "simulation", "drivers", "learning",
-             "evaluation", "graphs", "ui"],
+             "evaluation", "graphs", "ui", "manipulation"],
 }
 # Top-level folders beside the product that product code never includes (STYLE rule 1).
 NOT_PRODUCT = ["tests", "bench", "toolchains", "docs", "scripts", "deploy", "config"]

@@ -77,6 +77,20 @@ TEST(JacoKinematics, HomeMatchesKinovasDocumentedHomePose) {
               angle_between(fk.linear(), expected.linear()) / DEG);
 }
 
+// The chain's frames: the base first, the tool last, equal to forward_kinematics on both models;
+// the shoulder sits D1 = 0.2755 m above the base.
+TEST(JacoKinematics, ChainFramesEndAtTheToolPose) {
+  const JointAngles q{250.0, 200.0, 80.0, 200.0, 100.0, 30.0};
+  for (const ArmGeometry* g : {&jaco2_geometry(), &jaco_v1_geometry()}) {
+    const ChainFrames f = forward_kinematics_frames(q, *g);
+    EXPECT_TRUE(f[0].isApprox(Eigen::Isometry3d::Identity()));
+    EXPECT_LT((f[6].matrix() - forward_kinematics(q, *g).matrix()).cwiseAbs().maxCoeff(), 1e-12);
+    EXPECT_NEAR(f[1].translation().z(), 0.2755, 1e-12);
+    EXPECT_NEAR(f[1].translation().head<2>().norm(), 0.0, 1e-12);
+    EXPECT_NEAR((f[2].translation() - f[1].translation()).norm(), 0.41, 1e-12) << "the upper arm";
+  }
+}
+
 TEST(JacoKinematics, Jaco2MatchesKinovasUrdf) {
   std::mt19937 rng(7);
   double worst_m = 0.0, worst_rad = 0.0;

@@ -1,0 +1,46 @@
+#include "manipulation/arm_body.hpp"
+
+#include <cmath>
+
+namespace orthoflow::manipulation {
+namespace {
+
+kernels::Capsule capsule(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                         double radius) noexcept {
+  return {{static_cast<float>(a.x()), static_cast<float>(a.y()), static_cast<float>(a.z())},
+          {static_cast<float>(b.x()), static_cast<float>(b.y()), static_cast<float>(b.z())},
+          static_cast<float>(radius)};
+}
+
+}  // namespace
+
+std::size_t arm_body_capsules(const drivers::jaco::JointAngles& joints,
+                              const Eigen::Isometry3d& base_from_camera, const ArmBodyModel& model,
+                              const drivers::jaco::ArmGeometry& geometry,
+                              std::span<kernels::Capsule, ARM_BODY_CAPSULES> out) noexcept {
+  const Eigen::Isometry3d camera_from_base = base_from_camera.inverse(Eigen::Isometry);
+  const drivers::jaco::ChainFrames frames =
+      drivers::jaco::forward_kinematics_frames(joints, geometry);
+  std::size_t n = 0;
+  for (std::size_t k = 0; k < 6; ++k) {
+    const drivers::jaco::DhRow& row = geometry.rows[k];
+    const double radius = model.link_radius_m[k] + model.margin_m;
+    const Eigen::Vector3d start = frames[k].translation();
+    const Eigen::Vector3d knee = start + row.d_m * frames[k].linear().col(2);
+    const Eigen::Vector3d end = frames[k + 1].translation();
+    if (std::abs(row.d_m) > 0.0) {
+      out[n++] = capsule(camera_from_base * start, camera_from_base * knee, radius);
+    }
+    if (std::abs(row.a_m) > 0.0) {
+      out[n++] = capsule(camera_from_base * knee, camera_from_base * end, radius);
+    }
+  }
+  const Eigen::Isometry3d& tool = frames[6];
+  const Eigen::Vector3d axis = tool.linear().col(2);
+  out[n++] = capsule(camera_from_base * (tool.translation() - model.hand_back_m * axis),
+                     camera_from_base * (tool.translation() + model.hand_front_m * axis),
+                     model.hand_radius_m + model.margin_m);
+  return n;
+}
+
+}  // namespace orthoflow::manipulation

@@ -1,0 +1,43 @@
+#pragma once
+/// @file
+/// @brief The JACO's body as capsules (thesis: C_robot; issue 21, item 4): one capsule per segment
+/// of the kinematic skeleton (each DH row's d along the previous z, then its a along the new x) and
+/// one for the hand around the tool point, each inflated by a margin, placed in the camera frame.
+/// kernels::capsule_mask then removes the arm's points from a depth frame before segmentation.
+///
+/// The radii are conservative planning values for the JACO2 (its links are 7-11 cm across), not
+/// vendor figures; the margin also covers the joint-state latency and the calibration error.
+/// No allocation; deterministic.
+#include <array>
+#include <cstddef>
+#include <span>
+
+#include <Eigen/Geometry>
+
+#include "drivers/jaco_kinematics.hpp"
+#include "kernels/capsule_mask.hpp"
+
+namespace orthoflow::manipulation {
+
+/// @brief The link model.
+struct ArmBodyModel {
+  /// Radius of DH row k's segments (row 1: the base column; row 2: the upper arm; ...).
+  std::array<double, 6> link_radius_m{0.055, 0.045, 0.045, 0.04, 0.04, 0.04};
+  double hand_radius_m = 0.06;  ///< the hand with its fingers open, around the tool axis
+  double hand_back_m = 0.10;    ///< the hand's capsule starts this far behind the tool point
+  double hand_front_m = 0.04;   ///< and ends this far beyond it (the fingertips)
+  double margin_m = 0.02;       ///< every radius inflated by this
+};
+
+/// @brief Two segments per DH row and the hand.
+inline constexpr std::size_t ARM_BODY_CAPSULES = 13;
+
+/// @brief The arm's capsules at @p joints in the camera frame (@p base_from_camera from the robot
+/// frames file), written to @p out. Zero-length segments are left out. @return the count written.
+/// @pre finite joints and transform.
+[[nodiscard]] std::size_t arm_body_capsules(
+    const drivers::jaco::JointAngles& joints, const Eigen::Isometry3d& base_from_camera,
+    const ArmBodyModel& model, const drivers::jaco::ArmGeometry& geometry,
+    std::span<kernels::Capsule, ARM_BODY_CAPSULES> out) noexcept;
+
+}  // namespace orthoflow::manipulation

@@ -1,0 +1,99 @@
+"""`orthoflow calibrate hand-eye|simulate-samples` and `orthoflow grasp` (issue 21): the camera's pose
+recovered from a simulated rig's samples file within 2 mm and 0.5 degrees, refusals of bad sample
+files with the line, and grasp plans of the embedded session's objects in the arm's base frame."""
+import json
+import math
+import os
+import re
+import sys
+import tempfile
+
+from cli_check import expect, run
+
+cli, source_dir = sys.argv[1], sys.argv[2]
+EXIT_BAD_INPUT, EXIT_FAILURE = 2, 1
+frames_yaml = os.path.join(source_dir, "config", "robot_frames_synthetic.yaml")
+
+
+def frames_of(path):
+    text = open(path).read()
+    t = [float(v) for v in re.search(r"translation_m: \[([^\]]*)\]", text).group(1).split(",")]
+    q = [float(v) for v in re.search(r"rotation_wxyz: \[([^\]]*)\]", text).group(1).split(",")]
+    return t, q
+
+
+def angle_between(q1, q2):
+    dot = abs(sum(a * b for a, b in zip(q1, q2)))
+    return 2.0 * math.degrees(math.acos(min(1.0, dot)))
+
+
+with tempfile.TemporaryDirectory() as tmp:
+    for kind in ("pose", "point"):
+        samples, truth, out = (os.path.join(tmp, f"{kind}.{e}") for e in ("jsonl", "truth.yaml", "yaml"))
+        extra = ["--points", "--count", "60"] if kind == "point" else []
+        run(cli, "calibrate", "simulate-samples", "--out", samples, "--truth", truth, "--seed", "7", *extra)
+        expect(open(samples).readline().startswith("# SIMULATED"), "the samples file says it is simulated")
+        r = json.loads(run(cli, "calibrate", "hand-eye", "--samples", samples, "--out", out, "--json").stdout)
+        (t_est, q_est), (t_true, q_true) = frames_of(out), frames_of(truth)
+        err_mm = 1e3 * math.dist(t_est, t_true)
+        err_deg = angle_between(q_est, q_true)
+        expect(err_mm < 2.0 and err_deg < 0.5, f"{kind}: {err_mm:.2f} mm, {err_deg:.3f} deg")
+        expect(r["kind"] == ("target_point" if kind == "point" else "target_pose") and r["samples"] >= 50, f"{r}")
+        expect(0.5 < r["rms_position_mm"] < 4.0 and not r["likely_outlier"], f"residual: {r}")
+        print(f"{kind} samples: camera within {err_mm:.2f} mm and {err_deg:.3f} deg")
+
+    # One observation 5 cm off: named by its line.
+    samples = os.path.join(tmp, "pose.jsonl")
+    lines = open(samples).read().splitlines()
+    bad = json.loads(lines[12])
+    bad["target"]["position"][0] += 0.05
+    lines[12] = json.dumps(bad)
+    open(samples, "w").write("\n".join(lines) + "\n")
+    p = run(cli, "calibrate", "hand-eye", "--samples", samples)
+    expect("line 13 is far off the others" in p.stdout, f"outlier: {p.stdout}")
+
+    # Bad files: the line and the reason; nothing written.
+    broken = os.path.join(tmp, "broken.jsonl")
+    open(broken, "w").write(lines[1] + "\n" + '{"joints": [1, 2, 3], "target_point": [0, 0, 1]}\n')
+    p = run(cli, "calibrate", "hand-eye", "--samples", broken, "--out", os.path.join(tmp, "no.yaml"),
+            code=EXIT_BAD_INPUT)
+    expect("broken.jsonl:2: joints: expected 6 actuator angles" in p.stderr, f"broken: {p.stderr}")
+    expect(not os.path.exists(os.path.join(tmp, "no.yaml")), "nothing written for a bad file")
+    mixed = os.path.join(tmp, "mixed.jsonl")
+    point_line = open(os.path.join(tmp, "point.jsonl")).read().splitlines()[1]
+    open(mixed, "w").write(lines[1] + "\n" + point_line + "\n")
+    p = run(cli, "calibrate", "hand-eye", "--samples", mixed, code=EXIT_BAD_INPUT)
+    expect("mixes target poses and target points" in p.stderr, f"mixed: {p.stderr}")
+    still = os.path.join(tmp, "still.jsonl")
+    open(still, "w").write((lines[1] + "\n") * 10)
+    p = run(cli, "calibrate", "hand-eye", "--samples", still, code=EXIT_FAILURE)
+    expect("do not determine the camera" in p.stderr, f"degenerate: {p.stderr}")
+    p = run(cli, "calibrate", "hand-eye", "--samples", os.path.join(tmp, "none.jsonl"), code=EXIT_BAD_INPUT)
+    expect("cannot open" in p.stderr, p.stderr)
+
+    # Grasps of the embedded session's objects, in the arm's base frame.
+    objects = os.path.join(tmp, "run.jsonl")
+    run(cli, "run", "--frames", "20", "--json-out", objects)
+    plan = json.loads(run(cli, "grasp", "--robot-frames", frames_yaml, "--objects", objects, "--json").stdout)
+    expect(plan["frame"] == 19 and len(plan["objects"]) >= 3, f"plan: {plan['frame']}, {len(plan['objects'])}")
+    expect(abs(plan["table"]["normal"][2] - 1.0) < 0.01 and abs(plan["table"]["offset_m"]) < 0.01,
+           f"the session's table is the base's z = 0 plane: {plan['table']}")
+    expect(plan["planned"] >= 1, f"at least one object has a grasp: {plan}")
+    for o in plan["objects"]:
+        if "grasp" in o:
+            g = o["grasp"]
+            expect(abs(math.dist(g["pre_grasp_m"], g["grasp_m"]) - 0.15) < 1e-9, f"pre-grasp distance: {g}")
+            expect(g["width_m"] + 0.005 <= g["opening_m"] <= 0.14 + 1e-12, f"opening: {g}")
+        else:
+            reasons = [r["reason"] for r in o.get("rejected", [])] + [o.get("refused", "")]
+            expect(any(reasons), f"an object without a grasp says why: {o}")
+    text = run(cli, "grasp", "--robot-frames", frames_yaml, "--objects", objects, "--frame", "3").stdout
+    expect(text.startswith("frame 3: "), text)
+    p = run(cli, "grasp", "--robot-frames", samples, "--objects", objects, code=EXIT_BAD_INPUT)
+    expect("robot frames" in p.stderr, p.stderr)
+    p = run(cli, "grasp", "--robot-frames", frames_yaml, "--objects", objects, "--frame", "999", code=EXIT_BAD_INPUT)
+    expect("no frame 999" in p.stderr, p.stderr)
+    open(broken, "w").write('{"objects": 1}\n')
+    p = run(cli, "grasp", "--robot-frames", frames_yaml, "--objects", broken, code=EXIT_BAD_INPUT)
+    expect("broken.jsonl:1: objects: not a list" in p.stderr, p.stderr)
+print("ok")
