@@ -172,7 +172,7 @@ class Browser:
                 return value
             time.sleep(0.1)
         sys.exit(f"FAIL: waited {seconds} s for {what}; page answer: {self.text('#answer')!r}, "
-                 f"status: {self.text('#status')!r}")
+                 f"status: {self.text('#status')!r}, selected: {self.text('#selected')!r}")
 
     def errors(self):
         """The browser console's SEVERE entries since the last call (chromedriver's log endpoint)."""
@@ -359,12 +359,24 @@ try:
     browser.go(f"{url}/?token={TOKEN}")
     browser.wait("the camera image", lambda: browser.script(
         "const c = document.getElementById('camera'); return !c.hidden && c.complete && c.naturalWidth;") == 320)
+    # The page selects the smallest box under the pointer, and another object's box may lie inside
+    # this one's (an object in front of it): click the point of the box nearest its centre that no
+    # smaller box comes within 8 pixels of.
     where = browser.wait(f"track {track} boxed in the camera image", lambda: browser.script(
         "const c = document.getElementById('camera'); const r = c.getBoundingClientRect();"
         "const s = state && state.camera; if (!s) return null;"
         "const b = s.boxes.find((b) => b.track === arguments[0]); if (!b) return null;"
-        "return {x: Math.round(((b.box[0] + b.box[2]) / 2) * r.width / s.width - r.width / 2),"
-        "        y: Math.round(((b.box[1] + b.box[3]) / 2) * r.height / s.height - r.height / 2)};", track))
+        "const area = (q) => (q.box[2] - q.box[0]) * (q.box[3] - q.box[1]);"
+        "const m = 8;"  # pixels of slack: the boxes move a little from frame to frame
+        "const inside = (q, u, v) => u >= q.box[0] - m && u <= q.box[2] + m && v >= q.box[1] - m && v <= q.box[3] + m;"
+        "let best = null, bestD = Infinity;"
+        "for (let i = 1; i < 10; ++i) for (let j = 1; j < 10; ++j) {"
+        "  const u = b.box[0] + (b.box[2] - b.box[0]) * i / 10, v = b.box[1] + (b.box[3] - b.box[1]) * j / 10;"
+        "  if (s.boxes.some((q) => q.track !== b.track && area(q) < area(b) && inside(q, u, v))) continue;"
+        "  const d = Math.abs(i - 5) + Math.abs(j - 5); if (d < bestD) { bestD = d; best = [u, v]; } }"
+        "if (!best) return null;"
+        "return {x: Math.round(best[0] * r.width / s.width - r.width / 2),"
+        "        y: Math.round(best[1] * r.height / s.height - r.height / 2)};", track))
     image = {Browser.ELEMENT: browser.find("#camera")}
     browser.command("POST", "/actions", {"actions": [{"type": "pointer", "id": "mouse", "actions": [
         {"type": "pointerMove", "origin": image, "x": where["x"], "y": where["y"]},
@@ -403,11 +415,14 @@ try:
     deadline, found = time.time() + 10, None
     while found is None and time.time() < deadline:
         time.sleep(0.5)  # a camera image drawn after the label arrived
+        labelled_js = "return state.objects.filter((o) => o.label !== null).map((o) => o.track);"
+        before = set(browser.script(labelled_js))
         view = browser.script(
             "const c = document.getElementById('camera'); const r = c.getBoundingClientRect();"
             "const s = state.camera; return s ? {sx: r.width / s.width, sy: r.height / s.height,"
             "boxes: s.boxes} : null;")
         width, height, rows = read_png(browser.screenshot(work / "camera.png", "#camera"))
+        labelled = before | set(browser.script(labelled_js))
         if view is None:
             continue
         shares = {b["track"]: green_share(rows, width, height, (view["sx"], view["sy"]), b["box"])
@@ -415,8 +430,10 @@ try:
         if shares.get(track, 0) >= 0.8:
             found = shares
     expect(found is not None, f"no green box around track {track} in the camera screenshot")
-    # The control: the boxes of the objects nobody taught are not green.
-    expect(all(v < 0.2 for t, v in found.items() if t != track), f"green shares per track: {found}")
+    # The control: the boxes of the objects the page shows as Unknown (before and after the
+    # screenshot) are not green. Another object may rightly be recognised as gamma.
+    expect(all(v < 0.2 for t, v in found.items() if t not in labelled),
+           f"green shares per track: {found}, labelled: {sorted(labelled)}")
     found = (round(found[track] * 100), len(found))
     expect(found is not None, f"no green box around track {track} in the camera screenshot")
     _, _, top = read_png(browser.screenshot(work / "top_view.png", "#top"))
@@ -426,7 +443,10 @@ try:
     print(f"screenshots: track {track}'s box edge {found[0]}% green (the other {found[1] - 1} boxes not), "
           f"top view {orange} orange pixels")
 
-    # Restart the robot on the same memory: the page, reloaded, shows what was stored.
+    # Restart the robot on the same memory: the page, reloaded, shows what was stored (as many
+    # views as the teach stored: a track that moved and stopped again has two key views).
+    stored = [r for r in browser.rows("memory") if r[0] == "gamma"]
+    expect(len(stored) == 1 and int(stored[0][1]) >= 1, f"memory before the restart: {browser.rows('memory')}")
     stop(robot)
     robot, url = start_robot()
     expect(url is not None, "the restarted run printed no URL")
@@ -434,7 +454,7 @@ try:
     browser.wait("the page to go live after the restart", lambda: browser.text("#status") == "live")
     memory = browser.wait("gamma in the memory after the restart",
                           lambda: [r for r in browser.rows("memory") if r[0] == "gamma"])
-    expect(memory[0][1] == "1" and [r[0] for r in browser.rows("memory")] == ["gamma"],
+    expect(memory[0][1] == stored[0][1] and [r[0] for r in browser.rows("memory")] == ["gamma"],
            f"memory after the restart: {browser.rows('memory')}")
 except BaseException:
     # The failure is reported by the exception; first stop everything and show the server's end.
