@@ -134,7 +134,8 @@ const char* to_string(GraspRejection reason) noexcept {
 const char* to_string(ObjectRejection reason) noexcept {
   switch (reason) {
     case ObjectRejection::NOT_FINITE:
-      return "the object's box or the table holds NaN or infinity";
+      return "the object's box, the table or the seed holds NaN or infinity, or the table's normal "
+             "is zero";
     case ObjectRejection::NOT_RIGID:
       return "the object's frame is not a rotation";
     case ObjectRejection::BAD_EXTENTS:

@@ -121,7 +121,7 @@ struct GraspPlan {
 
 /// @brief Why an object gets no plan at all.
 enum class ObjectRejection : std::uint8_t {
-  NOT_FINITE,    ///< the box or the table holds NaN or infinity
+  NOT_FINITE,    ///< the box, table or seed holds NaN or infinity, or the normal is zero
   NOT_RIGID,     ///< the box's rotation is not a rotation
   BAD_EXTENTS,   ///< an edge length is negative, or every one is zero
   INSIDE_TABLE,  ///< the box reaches deeper into the table than max_penetration_m
