@@ -176,9 +176,8 @@ void run_simulate(const SimulateArgs& a) {
   if (!file) fail(a.out + ": cannot write", EXIT_FAILURE_GENERIC);
   file << "# SIMULATED samples (orthoflow calibrate simulate-samples --seed " << a.seed
        << "): not a robot\n";
-  const drivers::jaco::JointAngles home{275.0, 167.5, 57.5, 240.0, 82.5, 75.0};
   for (std::size_t i = 0; i < a.count; ++i) {
-    drivers::jaco::JointAngles q = home;
+    drivers::jaco::JointAngles q = drivers::jaco::HOME_JOINTS;
     for (double& v : q) v += jog(rng);
     const Isometry3d target = x.inverse() * drivers::jaco::forward_kinematics(q) * y;
     const Vector3d position =

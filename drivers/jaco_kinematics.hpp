@@ -71,6 +71,11 @@ inline constexpr double CONTINUOUS_BOUND_DEG = 10000.0;
 /// [19, 341], the others continuous (+-CONTINUOUS_BOUND_DEG). @pre none.
 [[nodiscard]] JointLimits jaco_joint_limits() noexcept;
 
+/// @brief HOME of the 6-DOF JACO2 in actuator degrees: Kinova's documented Home (j2n6s300.srdf,
+/// 275.3, 167.6, 57.4, 240.8, 82.8, 75.8) rounded to half degrees. The simulated arm's HOME and the
+/// default IK seed of the planners. @pre none.
+inline constexpr JointAngles HOME_JOINTS{275.0, 167.5, 57.5, 240.0, 82.5, 75.0};
+
 /// @brief The end effector's transform in the base frame for @p actuator_deg (JACO2). @pre finite.
 [[nodiscard]] Eigen::Isometry3d forward_kinematics(const JointAngles& actuator_deg) noexcept;
 /// @brief The same on @p geometry. @pre finite angles.

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <numbers>
 
+#include "manipulation/rigid.hpp"
+
 namespace orthoflow::manipulation {
 namespace {
 
@@ -177,11 +179,8 @@ Result<GraspPlan, ObjectRejection> plan_grasp(const ObjectBox& box,
       !options_finite(options)) {
     return err(ObjectRejection::NOT_FINITE);
   }
+  if (!is_rigid(box.base_from_object, RIGID_TOLERANCE)) { return err(ObjectRejection::NOT_RIGID); }
   const Matrix3d r = box.base_from_object.linear();
-  if ((r.transpose() * r - Matrix3d::Identity()).cwiseAbs().maxCoeff() > RIGID_TOLERANCE ||
-      r.determinant() < 0.0) {
-    return err(ObjectRejection::NOT_RIGID);
-  }
   if ((box.extents.array() < 0.0).any() || box.extents.maxCoeff() <= 0.0) {
     return err(ObjectRejection::BAD_EXTENTS);
   }

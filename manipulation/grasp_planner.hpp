@@ -136,8 +136,8 @@ struct GraspOptions {
   double pre_grasp_distance_m = 0.15;  ///< thesis: d_pre-grasp = 0.15 m
   double max_penetration_m = 0.02;     ///< a box bottom this far below the table is refused
   double reach_m = 0.90;  ///< shoulder to tool at full stretch (JACO2: 0.41 + 0.21 + 0.28)
-  drivers::jaco::JointAngles seed{275.0, 167.5, 57.5, 240.0, 82.5, 75.0};  ///< current joints
-  const drivers::jaco::ArmGeometry* geometry = nullptr;                    ///< null: the JACO2
+  drivers::jaco::JointAngles seed = drivers::jaco::HOME_JOINTS;  ///< the current joints
+  const drivers::jaco::ArmGeometry* geometry = nullptr;          ///< null: the JACO2
   drivers::jaco::JointLimits limits = drivers::jaco::jaco_joint_limits();
   drivers::jaco::IkTolerance tolerance{};
 };

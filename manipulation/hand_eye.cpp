@@ -9,6 +9,8 @@
 
 #include <Eigen/Dense>
 
+#include "manipulation/rigid.hpp"
+
 namespace orthoflow::manipulation {
 namespace {
 
@@ -30,11 +32,6 @@ constexpr double RIGID_TOLERANCE = 1e-6;
 constexpr double JACOBIAN_STEP = 1e-7;
 
 bool finite(const Isometry3d& t) noexcept { return t.matrix().allFinite(); }
-bool rigid(const Isometry3d& t) noexcept {
-  const Matrix3d r = t.linear();
-  return (r.transpose() * r - Matrix3d::Identity()).cwiseAbs().maxCoeff() < RIGID_TOLERANCE &&
-         r.determinant() > 0.0;
-}
 
 Vector3d log_so3(const Matrix3d& r) noexcept {
   const Eigen::AngleAxisd aa(r);
@@ -125,8 +122,10 @@ std::optional<HandEyeError> check_samples(std::span<const Sample> samples, std::
     if (!ok) { return HandEyeError::NOT_FINITE; }
   }
   for (const Sample& s : samples) {
-    bool ok = rigid(s.base_from_gripper);
-    if constexpr (std::is_same_v<Sample, PoseSample>) { ok = ok && rigid(s.camera_from_target); }
+    bool ok = is_rigid(s.base_from_gripper, RIGID_TOLERANCE);
+    if constexpr (std::is_same_v<Sample, PoseSample>) {
+      ok = ok && is_rigid(s.camera_from_target, RIGID_TOLERANCE);
+    }
     if (!ok) { return HandEyeError::NOT_RIGID; }
   }
   return std::nullopt;

@@ -167,10 +167,6 @@ Result<std::optional<CalibrationLine>, std::string> parse_calibration_line(
       CalibrationLine{PointSample{base_from_gripper, point.value()}}};
 }
 
-}  // namespace orthoflow::manipulation
-
-namespace orthoflow::manipulation {
-
 Result<PerceivedFrame, std::string> parse_run_line(std::string_view line) {
   const nlohmann::json j = nlohmann::json::parse(line, nullptr, false);
   if (j.is_discarded() || !j.is_object()) { return err(std::string("not a JSON object")); }

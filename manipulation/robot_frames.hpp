@@ -61,10 +61,6 @@ struct CalibrationLine {
 [[nodiscard]] Result<std::optional<CalibrationLine>, std::string> parse_calibration_line(
     std::string_view line, const drivers::jaco::ArmGeometry& geometry);
 
-}  // namespace orthoflow::manipulation
-
-namespace orthoflow::manipulation {
-
 /// @brief One object of a line of `orthoflow run --json-out` (the fields the planner uses).
 struct PerceivedObject {
   std::uint64_t track = 0;

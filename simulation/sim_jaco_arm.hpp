@@ -140,9 +140,9 @@ struct SimJacoConfig {
   /// Start pose; nullopt: home_joints in READY_STANDBY, else retract_joints.
   std::optional<drivers::jaco::JointAngles> start_joints{};
   std::array<double, drivers::jaco::FINGERS> start_fingers{};
-  /// HOME and RETRACT in actuator degrees: illustrative poses inside jaco_joint_limits(), not
-  /// Kinova's values.
-  drivers::jaco::JointAngles home_joints{275.0, 167.5, 57.5, 240.0, 82.5, 75.0};
+  /// HOME and RETRACT in actuator degrees, inside jaco_joint_limits(): HOME is Kinova's documented
+  /// Home rounded (drivers::jaco::HOME_JOINTS); RETRACT is illustrative, not Kinova's value.
+  drivers::jaco::JointAngles home_joints = drivers::jaco::HOME_JOINTS;
   drivers::jaco::JointAngles retract_joints{270.0, 210.0, 30.0, 270.0, 90.0, 90.0};
   /// Top joint speeds in deg/s (JACO2: about 36 on joints 1-3, 48 on 4-6).
   std::array<double, drivers::jaco::JOINTS> max_joint_speed_deg_s{36.0, 36.0, 36.0,

@@ -62,7 +62,7 @@ TEST(ArmBody, TheArmsPointsAreRemovedAndNothingBeyondTheMargin) {
   std::normal_distribution<double> normal(0.0, 1.0);
   std::size_t arm_points = 0, far_points = 0, near_points = 0;
   for (int pose = 0; pose < 20; ++pose) {
-    drivers::jaco::JointAngles q{275.0, 167.5, 57.5, 240.0, 82.5, 75.0};
+    drivers::jaco::JointAngles q = drivers::jaco::HOME_JOINTS;
     for (double& a : q) a += jog(rng);
     q[1] = std::clamp(q[1], 50.0, 310.0);
     q[2] = std::clamp(q[2], 22.0, 338.0);
@@ -126,7 +126,7 @@ TEST(ArmBody, TheMarginAndTheHandAreHonoured) {
   ArmBodyModel model;
   model.margin_m = 0.0;
   std::array<kernels::Capsule, ARM_BODY_CAPSULES> caps{};
-  const drivers::jaco::JointAngles home{275.0, 167.5, 57.5, 240.0, 82.5, 75.0};
+  const drivers::jaco::JointAngles home = drivers::jaco::HOME_JOINTS;
   const std::size_t n =
       arm_body_capsules(home, Isometry3d::Identity(), model, drivers::jaco::jaco2_geometry(), caps);
   ASSERT_EQ(n, 7U);

@@ -58,7 +58,7 @@ Isometry3d jitter(const Isometry3d& t, double position_m, double rotation_rad,
 // Arm poses around HOME: every joint within +-45 degrees, as a person would jog the arm around the
 // workspace while the camera keeps the target in view.
 std::vector<Isometry3d> arm_poses(std::size_t count, std::mt19937_64& rng) {
-  const drivers::jaco::JointAngles home{275.0, 167.5, 57.5, 240.0, 82.5, 75.0};
+  const drivers::jaco::JointAngles home = drivers::jaco::HOME_JOINTS;
   std::uniform_real_distribution<double> u(-45.0, 45.0);
   std::vector<Isometry3d> poses;
   for (std::size_t i = 0; i < count; ++i) {
