@@ -232,6 +232,10 @@ struct StatePublisher {
   std::unique_ptr<engine::IpcPublisher> publisher;
   std::atomic<bool> roudi_alive{true};
   std::atomic<std::uint64_t> published{0};
+  /// The simulated arm's clock starts at 0: its states are stamped on the host's steady clock
+  /// when they are published (within one 10 ms cycle of the read; the simulation is paced to the
+  /// wall clock), the clock a real arm's transport and every frame stamp use.
+  bool host_stamps = false;
 
   void publish(const jaco::ArmSnapshot& s) noexcept {
     if (!roudi_alive.load(std::memory_order_acquire)) {
@@ -245,7 +249,10 @@ struct StatePublisher {
     p.flags = (s.estop ? engine::ARM_ESTOP : 0U) | (s.fault ? engine::ARM_FAULT : 0U);
     p.arm_state = static_cast<std::int32_t>(s.arm_state);
     p.cycle = s.cycle;
-    p.stamp_ns = s.stamp_ns;
+    p.stamp_ns = host_stamps ? std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                   std::chrono::steady_clock::now().time_since_epoch())
+                                   .count()
+                             : s.stamp_ns;
     p.control = static_cast<std::uint32_t>(s.control);
     p.last_stop = static_cast<std::uint32_t>(s.last_stop);
     p.watchdog_stops = s.watchdog_stops;
@@ -291,6 +298,7 @@ void run_state(const ArmArgs& a) {
   std::vector<jaco::StateCallback> subscribers;
   if (a.publish) {
     ipc = make_state_publisher();
+    ipc->host_stamps = a.sim;
     subscribers.push_back([p = ipc.get()](const jaco::ArmSnapshot& s) { p->publish(s); });
   }
   auto arm = start_arm(a, std::move(subscribers));

@@ -24,6 +24,7 @@
 #include "engine/graph.hpp"
 #include "engine/ipc_runtime.hpp"
 #include "engine/object_list_payload.hpp"
+#include "graphs/body_filter_node.hpp"
 #include "graphs/descriptor_params.hpp"
 #include "graphs/embedded_graphs.hpp"
 #include "graphs/frame_block.hpp"
@@ -63,6 +64,10 @@ struct RunOptions {
   int threads = 0;
   std::string ui;             // --ui [ADDR:]PORT: the web view beside the graph (empty: off)
   std::string ui_token_file;  // --ui-token-file FILE
+  std::string robot_frames;   // --robot-frames FILE: the robot-body filter in front of preprocess
+  std::string arm_state_topic = "orthoflow/jaco/state";
+  double arm_state_age_ms = 50.0;
+  std::string exclude_zones;  // --exclude-zones: C_instructor capsules, camera frame
 };
 
 [[noreturn]] void fail(const std::string& message, int code) {
@@ -227,6 +232,18 @@ void run(const RunOptions& o) {
   if (!spec) fail(engine::to_string(spec.error()), EXIT_BAD_INPUT);
   override_source(*spec, o);
   apply_rate(*spec, o.rate);
+  if (!o.robot_frames.empty() || !o.exclude_zones.empty()) {
+    engine::ParamMap body;
+    if (o.robot_frames.empty()) {
+      body.assign("arm", "none");
+    } else {
+      body.assign("robot_frames", o.robot_frames);
+      body.assign("state_topic", o.arm_state_topic);
+      body.assign("max_state_age_ms", std::to_string(o.arm_state_age_ms));
+    }
+    if (!o.exclude_zones.empty()) body.assign("exclude", o.exclude_zones);
+    if (auto ok = graphs::insert_body_filter(*spec, body); !ok) fail(ok.error(), EXIT_USAGE);
+  }
   if (o.publish_objects || o.ipc_learning) add_objects_publisher(*spec);
   auto learning = graphs::LearningService::open(learning_settings(*spec, o));
   if (!learning) fail(learning.error(), EXIT_FAILURE_GENERIC);
@@ -317,6 +334,22 @@ void add_run_command(CLI::App& app) {
                   "synthetic:SEED, pcd:DIR, kinect[:SERIAL] (the camera over USB) or "
                   "kinect-sim[:SEED] (the simulated camera) (default: the graph's source)");
   cmd->add_option("--frames", o->frames, "stop after N frames (synthetic: session length)");
+  cmd->add_option(
+      "--robot-frames", o->robot_frames,
+      "robot frames file (base_from_camera): removes the arm from every frame before "
+      "segmentation, from its joint states on --arm-state-topic (docs/MANIPULATION.md)");
+  cmd->add_option("--arm-state-topic", o->arm_state_topic,
+                  "iceoryx topic of the arm's joint states (default orthoflow/jaco/state, what "
+                  "`orthoflow arm state --follow --publish` sends)");
+  cmd->add_option("--arm-state-age-ms", o->arm_state_age_ms,
+                  "a frame whose arm state is further than this from its time is dropped (default "
+                  "50)")
+      ->check(CLI::Range(1.0, 1000.0));
+  cmd->add_option(
+      "--exclude-zones", o->exclude_zones,
+      "instructor zones (C_instructor): 'ax,ay,az,bx,by,bz,r;...' capsules in the camera "
+      "frame (m) whose points are removed before segmentation, so a person's hand there "
+      "is never taught");
   cmd->add_option("--rate", o->rate,
                   "source rate in Hz, or max (no pacing, no deadline); default: the graph's period")
       ->check(check_rate);

@@ -26,7 +26,7 @@ struct alignas(64) ArmStatePayload {
   std::uint32_t flags;      ///< ARM_* bits
   std::int32_t arm_state;   ///< JACO.md 7.3 retract mode (6 NOINIT, 1 HOME, 3 RETRACT, ...)
   std::uint64_t cycle;      ///< the driver's control cycle (100 Hz)
-  std::int64_t stamp_ns;    ///< driver clock when the joints were read
+  std::int64_t stamp_ns;    ///< host steady clock (CLOCK_MONOTONIC, as frame stamps) at the read
   std::uint32_t control;    ///< drivers::jaco::ControlState (0 idle, 1 moving, ...)
   std::uint32_t last_stop;  ///< drivers::jaco::StopReason of the last motion
   std::uint64_t reserved1;

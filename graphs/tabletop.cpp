@@ -1,6 +1,7 @@
 #include "graphs/tabletop.hpp"
 
 #include "engine/ipc_nodes.hpp"
+#include "graphs/body_filter_node.hpp"
 #include "graphs/kinect_source.hpp"
 #include "graphs/objects_output.hpp"
 #include "graphs/recognise_node.hpp"
@@ -12,13 +13,15 @@
 namespace orthoflow::graphs {
 
 engine::NodeRegistry make_tabletop_registry(LearningService& learning, SessionLog& log,
-                                            ObjectsHub* objects, LabelsWriter* labels) {
+                                            ObjectsHub* objects, LabelsWriter* labels,
+                                            ArmStateFeed* arm_state) {
   engine::NodeRegistry registry;
   engine::add_generic_nodes(registry);
   engine::add_ipc_nodes(registry);  // ipc_subscribe / ipc_publish: graphs split across processes
   add_source_nodes(registry);
   add_kinect_source(registry);
   add_replay_source(registry);
+  add_body_filter_node(registry, arm_state);
   add_segment_nodes(registry, labels);
   add_track_describe_nodes(registry);
   add_recognise_node(registry, learning);

@@ -2,7 +2,8 @@
 # The whole test suite, as CI runs it (.ci/run calls exactly this):
 #   1. release preset: unit, integration and PCL cross-check tests (ctest);
 #   2. asan preset: the same suite under AddressSanitizer + UndefinedBehaviorSanitizer;
-#   3. fuzz preset: every libFuzzer target for FUZZ_SECONDS (default 60) seconds each;
+#   3. fuzz preset: every libFuzzer target for FUZZ_SECONDS (default 60) seconds each, FUZZ_JOBS
+#      (default 2) at a time;
 #   4. aarch64 preset: cross-built with toolchains/aarch64-linux-gnu.cmake, ctest under qemu, then
 #      `cpack` of the release and aarch64 builds (one check each: orthoflow_<ver>_<arch>.deb).
 #      AARCH64=0 skips the stage.
@@ -63,6 +64,20 @@ run_ctest_preset() {
   failed=$((failed + nfail))
 }
 
+# collect_fuzzer PID NAME: waits for one background fuzzer, prints its log and counts its result.
+collect_fuzzer() {
+  local pid=$1 name=$2
+  if wait "$pid"; then
+    cat "$logdir/$name.fuzz.log"
+    passed=$((passed + 1))
+  else
+    cat "$logdir/$name.fuzz.log"
+    echo "fuzzer $name FAILED"
+    failed=$((failed + 1))
+    failures="${failures}fuzz: $name"$'\n'
+  fi
+}
+
 run_fuzzers() {
   echo "=== preset fuzz: configure and build"
   if ! { cmake --preset fuzz >"$logdir/fuzz.configure.log" && cmake --build --preset fuzz; }; then
@@ -71,19 +86,23 @@ run_fuzzers() {
     failed=$((failed + 1))
     return
   fi
-  local f t0
+  # Two fuzzers at a time: each libFuzzer process is single-threaded and CI has two cores. Each
+  # one's output goes to its own log, printed whole when it ends (never interleaved).
+  local f t0 pids=() names=() i
   t0=$(date +%s)
   for f in build/fuzz/tests/fuzz/fuzz_*; do
     [ -x "$f" ] || continue
     echo "=== fuzzing $(basename "$f") for ${FUZZ_SECONDS}s"
-    if bash tests/fuzz/run_fuzzers.sh "$FUZZ_SECONDS" "$f"; then
-      passed=$((passed + 1))
-    else
-      echo "fuzzer $(basename "$f") FAILED"
-      failed=$((failed + 1))
-      failures="${failures}fuzz: $(basename "$f")"$'\n'
+    bash tests/fuzz/run_fuzzers.sh "$FUZZ_SECONDS" "$f" >"$logdir/$(basename "$f").fuzz.log" 2>&1 &
+    pids+=($!)
+    names+=("$(basename "$f")")
+    if [ ${#pids[@]} -ge "${FUZZ_JOBS:-2}" ]; then
+      collect_fuzzer "${pids[0]}" "${names[0]}"
+      pids=("${pids[@]:1}")
+      names=("${names[@]:1}")
     fi
   done
+  for i in "${!pids[@]}"; do collect_fuzzer "${pids[$i]}" "${names[$i]}"; done
   note_time "fuzz" "$t0"
 }
 

@@ -121,4 +121,53 @@ bool intersect(const Primitive& p, const Vec3& o, const Vec3& d, double t_min, H
   return false;
 }
 
+bool intersect_capsule(const Vec3& a, const Vec3& b, double r, const Vec3& o, const Vec3& d,
+                       double t_min, Hit& best) noexcept {
+  const double len = std::sqrt(dot(d, d));
+  if (!(len > 0.0) || !(r > 0.0)) { return false; }
+  const Vec3 rd = (1.0 / len) * d;  // unit direction: distances below are in metres
+  const Vec3 ba = b - a;
+  const Vec3 oa = o - a;
+  const double baba = dot(ba, ba);
+  const double bard = dot(ba, rd);
+  const double baoa = dot(ba, oa);
+  const double rdoa = dot(rd, oa);
+  const double oaoa = dot(oa, oa);
+  double t = -1.0;
+  Vec3 normal{};
+  // The cylinder's side (not for a sphere, nor for a ray along the axis).
+  const double qa = baba - bard * bard;
+  if (baba > 0.0 && qa > 1e-12 * baba) {
+    const double qb = baba * rdoa - baoa * bard;
+    const double qc = baba * oaoa - baoa * baoa - r * r * baba;
+    const double h = qb * qb - qa * qc;
+    if (h < 0.0) { return false; }  // the infinite cylinder is missed, so are the caps
+    const double ts = (-qb - std::sqrt(h)) / qa;
+    const double y = baoa + ts * bard;
+    if (y > 0.0 && y < baba) {
+      t = ts;
+      normal = (oa + ts * rd) - (y / baba) * ba;
+    }
+  }
+  if (t < 0.0) {  // the end caps: the sphere at a or at b, whichever the side's hit lies beyond
+    for (const Vec3* c : {&a, &b}) {
+      const Vec3 oc = o - *c;
+      const double hb = dot(rd, oc);
+      const double h = hb * hb - (dot(oc, oc) - r * r);
+      if (h <= 0.0) { continue; }
+      const double tc = -hb - std::sqrt(h);
+      if (tc > 0.0 && (t < 0.0 || tc < t)) {
+        t = tc;
+        normal = oc + tc * rd;
+      }
+    }
+  }
+  if (t < 0.0) { return false; }
+  const double t_ray = t / len;  // back to the caller's ray parameter
+  if (t_ray <= t_min || t_ray >= best.t) { return false; }
+  best.t = t_ray;
+  best.normal = normal;
+  return true;
+}
+
 }  // namespace orthoflow::simulation

@@ -50,4 +50,10 @@ struct Hit {
 /// @return true when @p best was updated.
 bool intersect(const Primitive& p, const Vec3& o, const Vec3& d, double t_min, Hit& best) noexcept;
 
+/// @brief Intersects the ray o + t d (t > t_min, d of any non-zero length) with the capsule around
+/// the segment [a, b] of radius @p r (the entry point: rays starting inside find nothing); keeps
+/// the hit only if nearer than @p best. @return true when @p best was updated.
+bool intersect_capsule(const Vec3& a, const Vec3& b, double r, const Vec3& o, const Vec3& d,
+                       double t_min, Hit& best) noexcept;
+
 }  // namespace orthoflow::simulation

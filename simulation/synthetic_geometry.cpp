@@ -8,6 +8,7 @@ namespace {
 
 constexpr std::uint32_t TABLE_RGB = 0xFF8B5A2BU;
 constexpr std::uint32_t FLOOR_RGB = 0xFF707070U;
+constexpr std::uint32_t ROBOT_RGB = 0xFF303438U;  // the JACO's carbon-fibre dark grey
 
 /// Whether the ray can come within @p r of @p c (d need not be unit length).
 bool near_sphere(const Vec3& o, const Vec3& d, const Vec3& c, double r) {
@@ -38,6 +39,25 @@ SceneGeometry::SceneGeometry(const Scene& scene) noexcept
     const double h = o.model.height;
     p.sphere_center = p.origin + (h / 2) * p.az;
     p.sphere_radius = std::hypot(o.model.footprint_radius, h / 2) + 0.01;
+  }
+  for (const BodyCapsule& c : scene.robot) {
+    if (robot_count_ == robot_.size()) { break; }
+    robot_[robot_count_++] = c;
+  }
+}
+
+void SceneGeometry::cast_robot(const Vec3& o, const Vec3& d, double t_min,
+                               SurfaceHit& best) const noexcept {
+  for (std::size_t i = 0; i < robot_count_; ++i) {
+    const BodyCapsule& c = robot_[i];
+    Hit h;
+    h.t = best.t;
+    if (intersect_capsule(c.a, c.b, c.radius, o, d, t_min, h)) {
+      best.t = h.t;
+      best.normal = h.normal;
+      best.label = LABEL_ROBOT;
+      best.rgb = ROBOT_RGB;
+    }
   }
 }
 
@@ -83,6 +103,7 @@ SurfaceHit SceneGeometry::cast(const Vec3& o, const Vec3& d, double t_min,
     }
   }
   cast_objects(o, d, t_min, best);
+  cast_robot(o, d, t_min, best);
   return finish(best, t_max);
 }
 

@@ -1,6 +1,7 @@
 #pragma once
 // Ray casting over a Scene (internal to the synthetic scene generator): the table rectangle, the
-// floor and every object, with per-object bounding spheres to skip most rays cheaply.
+// floor, every object and the robot's body, with per-object bounding spheres to skip most rays
+// cheaply.
 #include <array>
 
 #include "simulation/synthetic_scene.hpp"
@@ -33,10 +34,14 @@ class SceneGeometry {
   };
   void cast_objects(const Vec3& o, const Vec3& d, double t_min, SurfaceHit& best) const noexcept;
 
+  void cast_robot(const Vec3& o, const Vec3& d, double t_min, SurfaceHit& best) const noexcept;
+
   TableFrame table_;
   TableSpec spec_;
   std::array<Pose, MAX_SCENE_OBJECTS> poses_{};
   std::size_t count_ = 0;
+  std::array<BodyCapsule, MAX_SCENE_CAPSULES> robot_{};
+  std::size_t robot_count_ = 0;
 };
 
 /// Depth (metres) the sensor reports for @p hit seen along @p dir: NaN in projector shadows, out of

@@ -23,6 +23,7 @@ void prepare(const DepthIntrinsics& in, kernels::PointCloud& out) {
 void render_scene(const Scene& scene, const RenderOptions& options, core::Rng& rng,
                   kernels::PointCloud& out) {
   OF_ENFORCE(scene.objects.size() <= MAX_SCENE_OBJECTS, "render_scene: too many objects");
+  OF_ENFORCE(scene.robot.size() <= MAX_SCENE_CAPSULES, "render_scene: too many robot capsules");
   const DepthIntrinsics& in = options.intrinsics;
   prepare(in, out);
   const SceneGeometry geo(scene);

@@ -10,9 +10,10 @@
 /// (kinect_depth_model.hpp). What is not: speckle and IR texture, lens distortion, multipath, the
 /// colour camera's offset (colours are per-surface constants), table legs and clutter.
 ///
-/// Labels: 0 = no reading, 1 = table, 2 = floor, OBJECT_LABEL_BASE + id = the object with that id
-/// (make_scene numbers objects by their index; sequences keep an object's id while it lives).
-/// Determinism: all randomness comes from core::Rng; the same seed gives the same bytes.
+/// Labels: 0 = no reading, 1 = table, 2 = floor, 3 = the robot's body, OBJECT_LABEL_BASE + id = the
+/// object with that id (make_scene numbers objects by their index; sequences keep an object's id
+/// while it lives). Determinism: all randomness comes from core::Rng; the same seed gives the same
+/// bytes.
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -28,6 +29,7 @@ namespace orthoflow::simulation {
 inline constexpr std::uint32_t LABEL_NONE = 0;
 inline constexpr std::uint32_t LABEL_TABLE = 1;
 inline constexpr std::uint32_t LABEL_FLOOR = 2;
+inline constexpr std::uint32_t LABEL_ROBOT = 3;  ///< the robot's body (Scene::robot)
 inline constexpr std::uint32_t OBJECT_LABEL_BASE = 100;
 /// @brief Most objects one scene holds (rendering keeps per-object state in a fixed array).
 inline constexpr std::uint32_t MAX_SCENE_OBJECTS = 64;
@@ -66,10 +68,22 @@ struct TableFrame {
 
 [[nodiscard]] TableFrame table_frame(const TableSpec& table) noexcept;
 
+/// @brief Most robot-body capsules one scene holds.
+inline constexpr std::size_t MAX_SCENE_CAPSULES = 32;
+
+/// @brief A part of the robot's body in the sensor frame: the segment [a, b] swept by a sphere of
+/// @p radius (a == b: a sphere). An arm's links are rendered as these (label LABEL_ROBOT).
+struct BodyCapsule {
+  Vec3 a{};
+  Vec3 b{};
+  double radius = 0.0;
+};
+
 /// @brief Everything needed to render a frame, which is also its ground truth.
 struct Scene {
   TableSpec table;
   std::vector<PlacedObject> objects;
+  std::vector<BodyCapsule> robot;  ///< the robot's body in view (at most MAX_SCENE_CAPSULES)
 };
 
 /// @brief How scenes are drawn at random.
@@ -112,7 +126,8 @@ struct RenderOptions {
 /// @brief Renders @p scene into @p out (organized width x height, RGB and LABEL fields), drawing
 /// the noise from @p rng. Allocates only when @p out is not yet that size with those fields, so a
 /// warm cloud is refilled without touching the heap. Sets no FrameInfo (the caller stamps frames).
-/// @pre scene.objects.size() <= MAX_SCENE_OBJECTS. Deterministic; not thread-safe on one @p rng.
+/// @pre scene.objects.size() <= MAX_SCENE_OBJECTS, scene.robot.size() <= MAX_SCENE_CAPSULES.
+/// Deterministic; not thread-safe on one @p rng.
 void render_scene(const Scene& scene, const RenderOptions& options, core::Rng& rng,
                   kernels::PointCloud& out);
 

@@ -27,9 +27,10 @@ ALLOWED = {
     "learning": ["core", "memory_pool", "kernels"],
     "manipulation": ["core", "memory_pool", "kernels", "drivers"],
     "evaluation": ["core", "memory_pool", "kernels", "formats", "simulation", "learning"],
-    "graphs": ["core", "memory_pool", "kernels", "engine", "formats", "simulation", "drivers", "learning"],
+    "graphs": ["core", "memory_pool", "kernels", "engine", "formats", "simulation", "drivers", "learning",
+               "manipulation"],
     "ui": ["core", "memory_pool", "kernels", "engine", "formats", "simulation", "drivers", "learning",
-           "graphs"],
+           "manipulation", "graphs"],
     "apps": ["core", "memory_pool", "kernels", "engine", "formats", "simulation", "drivers", "learning",
              "evaluation", "graphs", "ui", "manipulation"],
 }

@@ -4,6 +4,7 @@
 // against hand-computed hits, and every catalog object against its declared bounding cylinder.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <string>
@@ -201,6 +202,59 @@ TEST(ShapePrimitives, BoxFacesAndNearestHitKeeping) {
 
 // ---- Object catalog
 // -----------------------------------------------------------------------------------
+
+TEST(ShapePrimitives, CapsuleSideCapsAndMisses) {
+  // A capsule along x from (0,0,1) to (0.4,0,1), radius 0.05, seen along +z from the origin.
+  const Vec3 a{0, 0, 1}, b{0.4, 0, 1};
+  Hit h;
+  ASSERT_TRUE(intersect_capsule(a, b, 0.05, {0.2, 0, 0}, {0, 0, 1}, 1e-9, h));
+  EXPECT_NEAR(h.t, 0.95, 1e-12) << "the side, straight on";
+  EXPECT_NEAR(h.normal[2] / std::sqrt(dot(h.normal, h.normal)), -1.0, 1e-12);
+  Hit cap;
+  ASSERT_TRUE(intersect_capsule(a, b, 0.05, {-0.03, 0, 0}, {0, 0, 2}, 1e-9, cap))
+      << "beyond the segment's end: the end sphere (any ray length)";
+  EXPECT_NEAR(cap.t * 2, 1.0 - std::sqrt(0.05 * 0.05 - 0.03 * 0.03), 1e-12);
+  Hit along;
+  ASSERT_TRUE(intersect_capsule(a, b, 0.05, {-1, 0, 1}, {1, 0, 0}, 1e-9, along))
+      << "along the axis: the near end's sphere";
+  EXPECT_NEAR(along.t, 0.95, 1e-12);
+  Hit miss;
+  EXPECT_FALSE(intersect_capsule(a, b, 0.05, {0.2, 0.06, 0}, {0, 0, 1}, 1e-9, miss));
+  EXPECT_FALSE(intersect_capsule(a, b, 0.05, {0.46, 0, 0}, {0, 0, 1}, 1e-9, miss));
+  EXPECT_FALSE(intersect_capsule(a, b, 0.05, {0.2, 0, 1}, {0, 0, 1}, 1e-9, miss)) << "from inside";
+  Hit nearer;
+  nearer.t = 0.5;
+  EXPECT_FALSE(intersect_capsule(a, b, 0.05, {0.2, 0, 0}, {0, 0, 1}, 1e-9, nearer))
+      << "a nearer hit is kept";
+  Hit sphere;
+  ASSERT_TRUE(intersect_capsule(a, a, 0.05, {0, 0, 0}, {0, 0, 1}, 1e-9, sphere)) << "a == b";
+  EXPECT_NEAR(sphere.t, 0.95, 1e-12);
+}
+
+TEST(SyntheticScene, TheRobotsBodyIsRenderedWithItsLabel) {
+  Scene scene = make_scene(SceneConfig{}, 3);
+  scene.objects.clear();
+  const TableFrame t = table_frame(scene.table);
+  const Vec3 above = t.point(0.0, 0.0, 0.15);
+  scene.robot.push_back({above, t.point(0.3, 0.0, 0.15), 0.04});
+  core::Rng rng(1);
+  kernels::PointCloud cloud;
+  render_scene(scene, RenderOptions{}, rng, cloud);
+  std::size_t robot = 0;
+  double worst = 0.0;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    if (cloud.label()[i] != LABEL_ROBOT) continue;
+    ++robot;
+    // every robot point lies on the capsule (to the depth noise)
+    const Vec3 p{cloud.x()[i], cloud.y()[i], cloud.z()[i]};
+    const Vec3 ab = t.point(0.3, 0.0, 0.15) - above;
+    const double s = std::clamp(dot(p - above, ab) / dot(ab, ab), 0.0, 1.0);
+    const Vec3 off = p - (above + s * ab);
+    worst = std::max(worst, std::fabs(std::sqrt(dot(off, off)) - 0.04));
+  }
+  EXPECT_GT(robot, 1000U);
+  EXPECT_LT(worst, 0.015) << "within the Kinect's noise at 1 m";
+}
 
 TEST(ObjectCatalog, NamesRoundTripAndUnknownNamesAreRejected) {
   for (std::size_t i = 0; i < CATEGORY_COUNT; ++i) {
