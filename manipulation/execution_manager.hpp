@@ -1,0 +1,200 @@
+#pragma once
+/// @file
+/// @brief The execution manager (issue 21, item 3; thesis chapter 2): one pick-and-place as a
+/// finite-state machine over primitive operators (go to the initial pose, open, pre-grasp,
+/// approach, close, lift, carry, place, release, retreat), each with a timeout and a success
+/// check from the arm's state and from perception, and aborts that back away safely.
+///
+/// The manager decides; it never talks to the arm itself. Each step() gets the arm's newest state
+/// and perception's newest view of the target and the other objects, and returns at most one arm
+/// request to submit (the caller also feeds the arm's watchdog every cycle, and stops feeding it
+/// when the manager is done). So it runs the same against the real arm, the simulated one, or a
+/// plain sequence of states in a test. No allocation, no blocking, bounded work per step;
+/// deterministic.
+///
+/// Aborts (every one logged with its reason):
+/// - the arm reports a fault or its emergency stop, or refuses a command (the safety layer said
+///   no): stop, nothing more;
+/// - before the object is held (pre-grasp, approach, close): perception older than the limit (the
+///   stale-perception interlock), the target gone or moved, an obstacle near the path, a phase's
+///   timeout: stop, then back away to the pre-grasp pose (open the hand first if it was closing);
+/// - with the object held (lift, carry, place): stale perception, an obstacle or a timeout: stop
+///   and hold; the hand is never opened over an unknown place;
+/// - after the lift, a target that did not rise with the hand (GRASP_MISSED): open, back away.
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+
+#include <Eigen/Geometry>
+
+#include "drivers/jaco_kinematics.hpp"
+
+namespace orthoflow::manipulation {
+
+/// @brief The primitive operators, in order, and the end states.
+enum class Phase : std::uint8_t {
+  IDLE,
+  GO_INITIAL,
+  OPEN,
+  PRE_GRASP,
+  APPROACH,
+  CLOSE,
+  LIFT,
+  CARRY,
+  PLACE,
+  RELEASE,
+  RETREAT,
+  DONE,
+  BACKING_AWAY,  ///< an abort's retreat to the pre-grasp pose
+  ABORTED,
+};
+inline constexpr std::size_t PHASE_COUNT = 14;
+[[nodiscard]] const char* to_string(Phase phase) noexcept;
+
+/// @brief Why a job stopped before DONE (NONE while it runs or when it succeeded).
+enum class AbortReason : std::uint8_t {
+  NONE,
+  TIMEOUT,           ///< a phase took longer than its limit
+  PERCEPTION_STALE,  ///< the newest objects are older than the limit
+  TARGET_LOST,       ///< the target's track is gone
+  TARGET_MOVED,      ///< the target moved away from where the plan put it
+  OBSTACLE,          ///< another object near the hand's path
+  ARM_FAULT,
+  ARM_ESTOP,
+  REFUSED,        ///< the arm (its safety layer) refused a command
+  GRASP_MISSED,   ///< after the lift the target had not risen with the hand
+  STOP_REQUESTED  ///< request_stop()
+};
+[[nodiscard]] const char* to_string(AbortReason reason) noexcept;
+
+/// @brief One pick and place, all in joint space, planned beforehand (make_pick_place_job).
+struct PickPlaceJob {
+  std::uint32_t track_id = 0;
+  Eigen::Vector3d target_centre = Eigen::Vector3d::Zero();  ///< base frame, when planned
+  drivers::jaco::JointAngles initial{}, pre_grasp{}, grasp{}, lift{}, carry{}, place{}, retreat{};
+  double open_fingers = 0.0;   ///< the model's units (0 open)
+  double close_fingers = 0.0;  ///< the model's units
+  double lift_m = 0.10;        ///< how far the lift raises the hand (the grasp check uses half)
+};
+
+/// @brief Limits. Timeouts are per phase, indexed by Phase.
+struct ExecutionLimits {
+  std::array<std::int64_t, PHASE_COUNT> timeout_ns{0,               // IDLE
+                                                   30'000'000'000,  // GO_INITIAL
+                                                   5'000'000'000,   // OPEN
+                                                   20'000'000'000,  // PRE_GRASP
+                                                   10'000'000'000,  // APPROACH
+                                                   5'000'000'000,   // CLOSE
+                                                   10'000'000'000,  // LIFT
+                                                   20'000'000'000,  // CARRY
+                                                   10'000'000'000,  // PLACE
+                                                   5'000'000'000,   // RELEASE
+                                                   10'000'000'000,  // RETREAT
+                                                   0,               // DONE
+                                                   20'000'000'000,  // BACKING_AWAY
+                                                   0};              // ABORTED
+  std::int64_t perception_max_age_ns = 300'000'000;  ///< the stale-perception interlock
+  std::int64_t target_lost_ns = 500'000'000;         ///< the target unseen this long is lost
+  double target_moved_m = 0.03;        ///< the target farther than this from the plan has moved
+  double obstacle_clearance_m = 0.05;  ///< another object's sphere this near the path blocks it
+  double joint_tolerance_deg = 1.0;    ///< a joint goal is reached within this
+  /// A finger goal is reached within this (model units): 2 % of the JACO2's range (its controller
+  /// calls 1 % of it reached).
+  double finger_tolerance = 130.0;
+  double approach_speed = 0.3;  ///< of the speed cap: approach, close, lift, place, backing
+};
+
+/// @brief The arm's newest state, as the manager needs it.
+struct ArmInput {
+  drivers::jaco::JointAngles joints{};
+  std::array<double, 3> fingers{};
+  bool idle = true;  ///< no motion under way (the controller's IDLE)
+  bool fault = false;
+  bool estop = false;
+};
+
+/// @brief Another object, as a sphere in the base frame.
+struct Obstacle {
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  double radius = 0.0;
+};
+
+/// @brief Perception's newest view. @p others: every other tracked object of that frame.
+struct PerceptionInput {
+  std::int64_t stamp_ns = 0;  ///< time of the frame the objects come from (0: none yet)
+  bool target_seen = false;   ///< the target's track is in that frame
+  Eigen::Vector3d target_centre = Eigen::Vector3d::Zero();  ///< base frame
+  std::span<const Obstacle> others{};
+};
+
+/// @brief What to send the arm after a step.
+struct ArmRequest {
+  enum class Kind : std::uint8_t { NONE, MOVE_JOINTS, MOVE_FINGERS, STOP };
+  Kind kind = Kind::NONE;
+  drivers::jaco::JointAngles joints{};
+  double fingers = 0.0;  ///< all three fingers to this
+  double speed_fraction = 1.0;
+};
+
+/// @brief One decision: a phase change and why.
+struct Decision {
+  std::int64_t stamp_ns = 0;
+  Phase from = Phase::IDLE;
+  Phase to = Phase::IDLE;
+  AbortReason reason = AbortReason::NONE;
+  const char* why = "";  ///< static text
+};
+
+class ExecutionManager {
+ public:
+  static constexpr std::size_t LOG_SIZE = 64;  ///< decisions kept (a job takes about 15)
+  explicit ExecutionManager(ExecutionLimits limits = {}) noexcept : limits_(limits) {}
+
+  /// @brief Starts @p job at @p now_ns (GO_INITIAL; the next step() returns its move). @return
+  /// false if a job is running.
+  bool start(const PickPlaceJob& job, std::int64_t now_ns) noexcept;
+  /// @brief The next decision. Call every arm cycle with the newest inputs.
+  [[nodiscard]] ArmRequest step(std::int64_t now_ns, const ArmInput& arm,
+                                const PerceptionInput& perception) noexcept;
+  /// @brief The arm refused the request step() returned: the job aborts (REFUSED).
+  void refused(std::int64_t now_ns) noexcept;
+  /// @brief A person (CLI, the command channel) stops the job: it backs away or holds as for any
+  /// abort.
+  void request_stop(std::int64_t now_ns) noexcept;
+
+  [[nodiscard]] Phase phase() const noexcept { return phase_; }
+  [[nodiscard]] AbortReason abort_reason() const noexcept { return reason_; }
+  [[nodiscard]] bool running() const noexcept {
+    return phase_ != Phase::IDLE && phase_ != Phase::DONE && phase_ != Phase::ABORTED;
+  }
+  /// @brief True while the hand holds (or should hold) the object: LIFT to PLACE.
+  [[nodiscard]] bool holding() const noexcept;
+  /// @brief The decisions so far, oldest first (the last LOG_SIZE).
+  [[nodiscard]] std::size_t decisions(std::span<Decision> out) const noexcept;
+
+ private:
+  ArmRequest enter(Phase next, std::int64_t now_ns, AbortReason reason, const char* why) noexcept;
+  ArmRequest abort(std::int64_t now_ns, AbortReason reason, const char* why) noexcept;
+  [[nodiscard]] bool at_joints(const ArmInput& arm,
+                               const drivers::jaco::JointAngles& goal) const noexcept;
+  [[nodiscard]] bool at_fingers(const ArmInput& arm, double goal) const noexcept;
+  [[nodiscard]] const drivers::jaco::JointAngles* joint_goal(Phase phase) const noexcept;
+  [[nodiscard]] bool path_blocked(const ArmInput& arm,
+                                  std::span<const Obstacle> others) const noexcept;
+
+  ExecutionLimits limits_;
+  PickPlaceJob job_{};
+  Phase phase_ = Phase::IDLE;
+  AbortReason reason_ = AbortReason::NONE;
+  std::int64_t entered_ns_ = 0;
+  std::int64_t target_last_seen_ns_ = 0;
+  bool back_away_after_open_ = false;  ///< an abort while closing: open, then back away
+  bool stop_requested_ = false;
+  std::int64_t stop_requested_ns_ = 0;
+  ArmRequest pending_{};  ///< decided outside step() (start, refused): returned by the next step
+  std::array<Decision, LOG_SIZE> log_{};
+  std::size_t logged_ = 0;
+};
+
+}  // namespace orthoflow::manipulation

@@ -1,0 +1,64 @@
+#include "manipulation/pick_place_job.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace orthoflow::manipulation {
+
+double finger_for_opening(double opening_m, const JobOptions& options) noexcept {
+  const double max_open = options.grasp.hand.max_opening_m;
+  const double share = std::clamp(opening_m / max_open, 0.0, 1.0);
+  return (1.0 - share) * options.finger_closed;
+}
+
+Result<PickPlaceJob, std::string> make_pick_place_job(std::uint32_t track_id,
+                                                      const Eigen::Vector3d& target_centre,
+                                                      const Grasp& grasp,
+                                                      const Eigen::Vector3d& place_centre,
+                                                      const JobOptions& options) noexcept {
+  if (!target_centre.allFinite() || !place_centre.allFinite() ||
+      !grasp.grasp.matrix().allFinite() || !std::isfinite(options.lift_m))
+    return err(std::string("a job needs finite centres, grasp and lift"));
+  const drivers::jaco::ArmGeometry& geometry =
+      options.grasp.geometry != nullptr ? *options.grasp.geometry : drivers::jaco::jaco2_geometry();
+  const SupportPlane& table = options.grasp.table;
+  const Eigen::Vector3d up = table.normal.normalized();
+  PickPlaceJob job;
+  job.track_id = track_id;
+  job.target_centre = target_centre;
+  job.initial = options.initial;
+  job.pre_grasp = grasp.pre_grasp_joints;
+  job.grasp = grasp.grasp_joints;
+  job.lift_m = options.lift_m;
+  job.open_fingers = finger_for_opening(grasp.opening_m, options);
+  job.close_fingers = finger_for_opening(std::max(0.0, grasp.width_m - options.squeeze_m), options);
+  // The place keeps the object's height above the table: the same offset from the grasp centre.
+  Eigen::Vector3d shift = place_centre - target_centre;
+  shift -= shift.dot(up) * up;  // along the table only
+  const Eigen::Isometry3d lift = carry_pose(grasp, table, options.lift_m);
+  Eigen::Isometry3d carry = lift;
+  carry.translation() += shift;
+  Eigen::Isometry3d place = grasp.grasp;
+  place.translation() += shift;
+  Eigen::Isometry3d retreat = place;
+  retreat.translation() -= options.grasp.pre_grasp_distance_m * grasp.approach.normalized();
+  const struct {
+    const char* name;
+    const Eigen::Isometry3d* pose;
+    drivers::jaco::JointAngles* out;
+  } steps[] = {{"lift", &lift, &job.lift},
+               {"carry", &carry, &job.carry},
+               {"place", &place, &job.place},
+               {"retreat", &retreat, &job.retreat}};
+  drivers::jaco::JointAngles seed = grasp.grasp_joints;
+  for (const auto& s : steps) {
+    auto q = drivers::jaco::inverse_kinematics(*s.pose, seed, options.grasp.limits,
+                                               options.grasp.tolerance, geometry);
+    if (!q) return err(std::string(s.name) + ": " + drivers::jaco::to_string(q.error()));
+    *s.out = *q;
+    seed = *q;
+  }
+  return job;
+}
+
+}  // namespace orthoflow::manipulation

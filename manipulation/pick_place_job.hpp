@@ -1,0 +1,39 @@
+#pragma once
+/// @file
+/// @brief A pick-and-place job for the execution manager from a planned grasp: every pose of the
+/// sequence solved in joint space before anything moves (thesis chapter 2): the lift straight up
+/// from the grasp, the carry at that height to above the place, the place straight down, the
+/// retreat back along the approach; the hand's orientation never changes from the grasp on (the
+/// object stays upright). Finger commands from the opening and the width (a linear map of the
+/// finger range onto the hand's opening, a planning approximation, not a vendor figure).
+#include <cstdint>
+#include <string>
+
+#include <Eigen/Geometry>
+
+#include "core/result.hpp"
+#include "manipulation/execution_manager.hpp"
+#include "manipulation/grasp_planner.hpp"
+
+namespace orthoflow::manipulation {
+
+/// @brief What a job needs besides the grasp.
+struct JobOptions {
+  GraspOptions grasp{};  ///< the planner's options: table, hand, limits, geometry
+  drivers::jaco::JointAngles initial = drivers::jaco::HOME_JOINTS;
+  double lift_m = 0.10;           ///< lift and carry height above the grasp
+  double squeeze_m = 0.01;        ///< the fingers close this much narrower than the width
+  double finger_closed = 6400.0;  ///< the model's finger value when closed (JACO2 ~6400)
+};
+
+/// @brief The job for @p grasp of the object @p track_id centred at @p target_centre, placed with
+/// its centre at @p place_centre (base frame; the height comes from the table). @return the step
+/// whose pose the arm does not reach ("carry: ..."), or a non-finite input.
+[[nodiscard]] Result<PickPlaceJob, std::string> make_pick_place_job(
+    std::uint32_t track_id, const Eigen::Vector3d& target_centre, const Grasp& grasp,
+    const Eigen::Vector3d& place_centre, const JobOptions& options) noexcept;
+
+/// @brief Finger value for an opening of @p opening_m (0 open at max_opening_m, closed at 0).
+[[nodiscard]] double finger_for_opening(double opening_m, const JobOptions& options) noexcept;
+
+}  // namespace orthoflow::manipulation

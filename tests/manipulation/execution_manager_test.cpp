@@ -1,0 +1,336 @@
+// The execution manager (manipulation/execution_manager.hpp) driving the simulated JACO through its
+// real controller, in lock step on simulated time (tests/drivers/jaco_test_rig.hpp), in a small
+// world that reacts to the arm: a mug that follows the hand once the fingers close around it, seen
+// by a perception stand-in that reports it every 33 ms with 30 ms of latency. A whole pick and
+// place, then every abort: target moved, lost, stale perception, an obstacle while carrying, a
+// missed grasp, the emergency stop, a refused command, a timeout, a person's stop.
+#include <gtest/gtest.h>
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "manipulation/execution_manager.hpp"
+#include "manipulation/pick_place_job.hpp"
+#include "tests/drivers/jaco_test_rig.hpp"
+
+namespace orthoflow::manipulation {
+namespace {
+
+using Eigen::AngleAxisd;
+using Eigen::Vector3d;
+namespace jaco = drivers::jaco;
+
+ObjectBox mug() {
+  ObjectBox box;
+  box.base_from_object.translation() = Vector3d(0.30, -0.30, 0.05);
+  box.extents = Vector3d(0.08, 0.08, 0.10);
+  return box;
+}
+const Vector3d PLACE(0.05, -0.45, 0.05);
+
+PickPlaceJob mug_job(const JobOptions& options = {}) {
+  auto plan = plan_grasp(mug(), options.grasp);
+  EXPECT_TRUE(plan && plan->best() != nullptr);
+  auto job =
+      make_pick_place_job(7, mug().base_from_object.translation(), *plan->best(), PLACE, options);
+  EXPECT_TRUE(job) << (job ? "" : job.error());
+  return *job;
+}
+
+/// The world around the arm, and the loop that runs the manager against it.
+struct World {
+  explicit World(jaco::ControllerOptions controller = {})
+      : rig(test::JacoRig::home_config(), controller) {}
+  test::JacoRig rig;
+  Vector3d mug = ::orthoflow::manipulation::mug().base_from_object.translation();
+  bool attached = false;
+  bool slippery = false;  ///< the fingers never hold it
+  Vector3d grip_offset = Vector3d::Zero();
+  std::vector<Obstacle> obstacles;
+  bool perceiving = true;   ///< false: perception stops (a dead camera)
+  bool mug_visible = true;  ///< false: the mug's track is gone
+  std::int64_t last_frame_ns = 0;
+  PerceptionInput perception{};
+  std::vector<ArmRequest> sent;
+  int refusals = 0;
+  /// Called every cycle before the manager's step (a test's event).
+  std::function<void(World&, const ExecutionManager&)> event;
+
+  Vector3d tool() const {
+    return jaco::forward_kinematics(rig.controller->snapshot().joints).translation();
+  }
+  ArmInput arm_input() const {
+    const auto s = rig.controller->snapshot();
+    ArmInput a;
+    a.joints = s.joints;
+    a.fingers = {s.fingers[0], s.fingers[1], s.fingers[2]};
+    a.idle = s.control == jaco::ControlState::IDLE;
+    a.fault = s.fault;
+    a.estop = s.estop;
+    return a;
+  }
+  void update_world(const PickPlaceJob& job) {
+    const auto s = rig.controller->snapshot();
+    const bool closed = s.fingers[0] >= job.close_fingers - 100.0;
+    if (!attached && closed && !slippery && (tool() - mug).norm() < 0.04) {
+      attached = true;
+      grip_offset = mug - tool();
+    } else if (attached && !closed) {
+      attached = false;
+    }
+    if (attached) mug = tool() + grip_offset;
+  }
+  void update_perception() {
+    const std::int64_t now = rig.now();
+    if (!perceiving || now - last_frame_ns < 33'000'000) return;
+    last_frame_ns = now;
+    perception.stamp_ns = now - 30'000'000;
+    perception.target_seen = mug_visible;
+    perception.target_centre = mug;
+    perception.others = obstacles;
+  }
+  /// Runs @p job until the manager ends (or @p max_s of simulated time).
+  void run(ExecutionManager& manager, const PickPlaceJob& job, double max_s = 120.0) {
+    ASSERT_TRUE(manager.start(job, rig.now()));
+    const std::int64_t end = rig.now() + static_cast<std::int64_t>(max_s * 1e9);
+    while (rig.now() < end) {
+      update_world(job);
+      update_perception();
+      if (event) event(*this, manager);
+      const ArmRequest r = manager.step(rig.now(), arm_input(), perception);
+      if (r.kind != ArmRequest::Kind::NONE) {
+        sent.push_back(r);
+        jaco::ArmCommand c;
+        c.speed_fraction = r.speed_fraction;
+        if (r.kind == ArmRequest::Kind::MOVE_JOINTS) {
+          c.kind = jaco::ArmCommand::Kind::MOVE_JOINTS;
+          c.joints = r.joints;
+        } else if (r.kind == ArmRequest::Kind::MOVE_FINGERS) {
+          c.kind = jaco::ArmCommand::Kind::MOVE_FINGERS;
+          c.fingers = {r.fingers, r.fingers, r.fingers};
+        } else {
+          c.kind = jaco::ArmCommand::Kind::STOP;
+        }
+        if (!rig.controller->submit(c)) {
+          ++refusals;
+          manager.refused(rig.now());
+        }
+      }
+      // The watchdog is fed while the manager runs, and not after: a finished job lets it expire.
+      rig.cycle(manager.running());
+      if (!manager.running() && r.kind == ArmRequest::Kind::NONE) break;
+    }
+  }
+};
+
+std::vector<Phase> phases_of(const ExecutionManager& m) {
+  std::array<Decision, ExecutionManager::LOG_SIZE> log{};
+  std::vector<Phase> out;
+  const std::size_t n = m.decisions(log);
+  for (std::size_t i = 0; i < n; ++i) out.push_back(log[i].to);
+  return out;
+}
+
+std::string log_text(const ExecutionManager& m) {
+  std::array<Decision, ExecutionManager::LOG_SIZE> log{};
+  std::string out;
+  const std::size_t n = m.decisions(log);
+  for (std::size_t i = 0; i < n; ++i)
+    out += std::to_string(double(log[i].stamp_ns - log[0].stamp_ns) * 1e-9).substr(0, 6) + " s  " +
+           std::string(to_string(log[i].from)) + " -> " + to_string(log[i].to) + " (" +
+           to_string(log[i].reason) + ": " + log[i].why + ")\n";
+  return out;
+}
+
+double joint_distance(const jaco::JointAngles& a, const jaco::JointAngles& b) {
+  double worst = 0.0;
+  for (std::size_t j = 0; j < a.size(); ++j) worst = std::max(worst, std::fabs(a[j] - b[j]));
+  return worst;
+}
+
+TEST(ExecutionManager, PicksAndPlacesTheMugOnTheSimulatedArm) {
+  World world;
+  ExecutionManager manager;
+  const PickPlaceJob job = mug_job();
+  world.run(manager, job);
+  EXPECT_EQ(manager.phase(), Phase::DONE) << log_text(manager);
+  EXPECT_EQ(manager.abort_reason(), AbortReason::NONE);
+  std::printf("%s", log_text(manager).c_str());
+  const std::vector<Phase> expected{
+      Phase::GO_INITIAL, Phase::OPEN,  Phase::PRE_GRASP, Phase::APPROACH, Phase::CLOSE, Phase::LIFT,
+      Phase::CARRY,      Phase::PLACE, Phase::RELEASE,   Phase::RETREAT,  Phase::DONE};
+  EXPECT_EQ(phases_of(manager), expected) << log_text(manager);
+  EXPECT_EQ(world.refusals, 0);
+  EXPECT_FALSE(world.attached) << "released";
+  EXPECT_LT((world.mug - PLACE).norm(), 0.02) << "the mug stands at the place";
+  EXPECT_LT(joint_distance(world.rig.controller->snapshot().joints, job.retreat), 1.0);
+}
+
+TEST(ExecutionManager, TheTargetMovingDuringTheApproachBacksTheArmAway) {
+  World world;
+  ExecutionManager manager;
+  const PickPlaceJob job = mug_job();
+  world.event = [](World& w, const ExecutionManager& m) {
+    if (m.phase() == Phase::APPROACH && !w.attached) w.mug.x() = 0.36;  // pushed 6 cm
+  };
+  world.run(manager, job);
+  EXPECT_EQ(manager.phase(), Phase::ABORTED) << log_text(manager);
+  EXPECT_EQ(manager.abort_reason(), AbortReason::TARGET_MOVED);
+  EXPECT_EQ(phases_of(manager).back(), Phase::ABORTED);
+  EXPECT_NE(std::find(phases_of(manager).begin(), phases_of(manager).end(), Phase::BACKING_AWAY),
+            phases_of(manager).end());
+  EXPECT_LT(joint_distance(world.rig.controller->snapshot().joints, job.pre_grasp), 1.0)
+      << "backed away to the pre-grasp pose";
+}
+
+TEST(ExecutionManager, StalePerceptionStopsTheArmWhereItIs) {
+  World world;
+  ExecutionManager manager;
+  const PickPlaceJob job = mug_job();
+  std::int64_t stalled_at = 0;
+  world.event = [&](World& w, const ExecutionManager& m) {
+    if (m.phase() == Phase::APPROACH && w.perceiving) {
+      w.perceiving = false;  // the camera dies halfway
+      stalled_at = w.rig.now();
+    }
+  };
+  world.run(manager, job);
+  EXPECT_EQ(manager.phase(), Phase::ABORTED) << log_text(manager);
+  EXPECT_EQ(manager.abort_reason(), AbortReason::PERCEPTION_STALE);
+  EXPECT_EQ(world.sent.back().kind, ArmRequest::Kind::STOP);
+  EXPECT_GT(joint_distance(world.rig.controller->snapshot().joints, job.grasp), 1.0)
+      << "it never reached the grasp";
+  // Frames come 30 ms late and every 33 ms: stale 300 ms after the last one, so the stop comes
+  // within 400 ms of the camera's death.
+  std::array<Decision, ExecutionManager::LOG_SIZE> log{};
+  const std::size_t n = manager.decisions(log);
+  EXPECT_LE(log[n - 1].stamp_ns - stalled_at, 400'000'000);
+}
+
+TEST(ExecutionManager, ALostTrackStopsTheArm) {
+  World world;
+  ExecutionManager manager;
+  world.event = [](World& w, const ExecutionManager& m) {
+    if (m.phase() == Phase::PRE_GRASP) w.mug_visible = false;
+  };
+  world.run(manager, mug_job());
+  EXPECT_EQ(manager.abort_reason(), AbortReason::TARGET_LOST) << log_text(manager);
+  EXPECT_EQ(manager.phase(), Phase::ABORTED);
+}
+
+TEST(ExecutionManager, AnObstacleWhileCarryingStopsAndHolds) {
+  World world;
+  ExecutionManager manager;
+  const PickPlaceJob job = mug_job();
+  world.event = [&](World& w, const ExecutionManager& m) {
+    if (m.phase() == Phase::CARRY && w.obstacles.empty()) {
+      // A bowl put down on the way to the place.
+      w.obstacles.push_back({0.5 * (w.mug + PLACE) + Vector3d(0, 0, 0.1), 0.06});
+    }
+  };
+  world.run(manager, job);
+  EXPECT_EQ(manager.abort_reason(), AbortReason::OBSTACLE) << log_text(manager);
+  EXPECT_EQ(manager.phase(), Phase::ABORTED);
+  EXPECT_TRUE(world.attached) << "the hand still holds the mug: never opened over an unknown place";
+  EXPECT_EQ(world.sent.back().kind, ArmRequest::Kind::STOP);
+}
+
+TEST(ExecutionManager, AMissedGraspOpensAndBacksAway) {
+  World world;
+  world.slippery = true;
+  ExecutionManager manager;
+  const PickPlaceJob job = mug_job();
+  world.run(manager, job);
+  EXPECT_EQ(manager.abort_reason(), AbortReason::GRASP_MISSED) << log_text(manager);
+  EXPECT_EQ(manager.phase(), Phase::ABORTED);
+  EXPECT_LT(joint_distance(world.rig.controller->snapshot().joints, job.pre_grasp), 1.0);
+  EXPECT_LT(world.rig.controller->snapshot().fingers[0], job.open_fingers + 100.0) << "opened";
+}
+
+TEST(ExecutionManager, TheEmergencyStopEndsTheJobWithNoFurtherCommand) {
+  World world;
+  ExecutionManager manager;
+  std::size_t sent_before = 0;
+  world.event = [&](World& w, const ExecutionManager& m) {
+    if (m.phase() == Phase::CARRY && !w.rig.controller->snapshot().estop) {
+      w.rig.controller->estop();
+      sent_before = w.sent.size();
+    }
+  };
+  world.run(manager, mug_job());
+  EXPECT_EQ(manager.abort_reason(), AbortReason::ARM_ESTOP) << log_text(manager);
+  EXPECT_EQ(manager.phase(), Phase::ABORTED);
+  ASSERT_EQ(world.sent.size(), sent_before + 1);
+  EXPECT_EQ(world.sent.back().kind, ArmRequest::Kind::STOP) << "only the stop";
+}
+
+TEST(ExecutionManager, ACommandTheSafetyLayerRefusesEndsTheJob) {
+  // A keep-out box over the place: the controller refuses the carry.
+  jaco::ControllerOptions controller;
+  jaco::Box keep_out{{PLACE.x() - 0.1, PLACE.y() - 0.1, 0.0},
+                     {PLACE.x() + 0.1, PLACE.y() + 0.1, 0.5},
+                     core::FixedText<24>::from("the user's place")};
+  ASSERT_TRUE(controller.limits.add_keep_out(keep_out));
+  World world(controller);
+  ExecutionManager manager;
+  world.run(manager, mug_job());
+  EXPECT_EQ(manager.abort_reason(), AbortReason::REFUSED) << log_text(manager);
+  EXPECT_EQ(manager.phase(), Phase::ABORTED);
+  EXPECT_EQ(world.refusals, 1);
+  EXPECT_TRUE(world.attached) << "held, not dropped";
+}
+
+TEST(ExecutionManager, APhaseTimeoutStops) {
+  World world;
+  ExecutionLimits limits;
+  limits.timeout_ns[static_cast<std::size_t>(Phase::PRE_GRASP)] = 200'000'000;  // too short
+  ExecutionManager manager(limits);
+  world.run(manager, mug_job());
+  EXPECT_EQ(manager.abort_reason(), AbortReason::TIMEOUT) << log_text(manager);
+  EXPECT_EQ(manager.phase(), Phase::ABORTED);
+  EXPECT_EQ(world.sent.back().kind, ArmRequest::Kind::STOP);
+}
+
+TEST(ExecutionManager, APersonsStopDuringTheApproachBacksAway) {
+  World world;
+  ExecutionManager manager;
+  bool asked = false;
+  world.event = [&](World& w, const ExecutionManager& m) {
+    if (m.phase() == Phase::APPROACH && !asked) {
+      const_cast<ExecutionManager&>(m).request_stop(w.rig.now());
+      asked = true;
+    }
+  };
+  const PickPlaceJob job = mug_job();
+  world.run(manager, job);
+  EXPECT_EQ(manager.abort_reason(), AbortReason::STOP_REQUESTED) << log_text(manager);
+  EXPECT_EQ(manager.phase(), Phase::ABORTED);
+  EXPECT_LT(joint_distance(world.rig.controller->snapshot().joints, job.pre_grasp), 1.0);
+}
+
+TEST(ExecutionManager, NoPerceptionAtAllMeansNoMotion) {
+  World world;
+  world.perceiving = false;
+  ExecutionManager manager;
+  world.run(manager, mug_job());
+  EXPECT_EQ(manager.abort_reason(), AbortReason::PERCEPTION_STALE);
+  ASSERT_EQ(world.sent.size(), 2U) << "the initial move was decided at start; then the stop";
+  EXPECT_EQ(world.sent.back().kind, ArmRequest::Kind::STOP);
+}
+
+TEST(PickPlaceJob, UnreachablePlacesAndNonFiniteInputsAreNamed) {
+  auto plan = plan_grasp(mug(), GraspOptions{});
+  ASSERT_TRUE(plan && plan->best());
+  auto far = make_pick_place_job(1, mug().base_from_object.translation(), *plan->best(),
+                                 Vector3d(2.0, 0.0, 0.05), JobOptions{});
+  ASSERT_FALSE(far);
+  EXPECT_EQ(far.error().rfind("carry: ", 0), 0U) << far.error();
+  auto nan = make_pick_place_job(1, Vector3d(std::nan(""), 0, 0), *plan->best(), PLACE, {});
+  EXPECT_FALSE(nan);
+  EXPECT_NEAR(finger_for_opening(0.14, {}), 0.0, 1e-9);
+  EXPECT_NEAR(finger_for_opening(0.0, {}), 6400.0, 1e-9);
+}
+
+}  // namespace
+}  // namespace orthoflow::manipulation
