@@ -278,6 +278,18 @@ kernels::PointCloud small_frame() {
   return cloud;
 }
 
+/// small_frame() whose point 5 is the tool point of the arm at HOME, in the camera frame.
+kernels::PointCloud frame_with_the_hand_at_home() {
+  const Eigen::Vector3d tool =
+      base_from_camera().inverse() *
+      drivers::jaco::forward_kinematics(drivers::jaco::HOME_JOINTS).translation();
+  kernels::PointCloud cloud = small_frame();
+  cloud.x()[5] = float(tool.x());
+  cloud.y()[5] = float(tool.y());
+  cloud.z()[5] = float(tool.z());
+  return cloud;
+}
+
 TEST(BodyFilter, FramesWithoutAFreshSaneStateAreDroppedAndCounted) {
   const kernels::PointCloud cloud = small_frame();  // stamped T0
   engine::ParamMap params;
@@ -314,13 +326,7 @@ TEST(BodyFilter, FramesWithoutAFreshSaneStateAreDroppedAndCounted) {
 TEST(BodyFilter, TheArmIsLookedUpAtTheFramesTime) {
   // The hand's point at HOME, then the arm swings its base joint 90 degrees away: the frame taken
   // at HOME's time loses the point even though newer states have arrived since.
-  const Eigen::Vector3d tool =
-      base_from_camera().inverse() *
-      drivers::jaco::forward_kinematics(drivers::jaco::HOME_JOINTS).translation();
-  kernels::PointCloud cloud = small_frame();
-  cloud.x()[5] = float(tool.x());
-  cloud.y()[5] = float(tool.y());
-  cloud.z()[5] = float(tool.z());
+  kernels::PointCloud cloud = frame_with_the_hand_at_home();
   drivers::jaco::JointAngles away = drivers::jaco::HOME_JOINTS;
   away[0] += 90.0;
   for (const bool swung : {false, true}) {
@@ -346,13 +352,7 @@ TEST(BodyFilter, AFrameInAnIpcChunkIsCopiedNotWritten) {
   Rig rig(channel);
   ASSERT_TRUE(rig.node);
   // The hand, at HOME, inside the frame: a point at the tool point in the camera frame.
-  const Eigen::Vector3d tool =
-      base_from_camera().inverse() *
-      drivers::jaco::forward_kinematics(drivers::jaco::HOME_JOINTS).translation();
-  kernels::PointCloud cloud = small_frame();
-  cloud.x()[5] = float(tool.x());
-  cloud.y()[5] = float(tool.y());
-  cloud.z()[5] = float(tool.z());
+  kernels::PointCloud cloud = frame_with_the_hand_at_home();
   std::vector<std::byte> chunk_storage(FrameBlock::bytes_for(cloud.size()) + 64);
   auto* aligned = reinterpret_cast<std::byte*>(
       (reinterpret_cast<std::uintptr_t>(chunk_storage.data()) + 63) & ~std::uintptr_t{63});

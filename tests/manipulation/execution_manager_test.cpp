@@ -13,6 +13,7 @@
 #include "manipulation/execution_manager.hpp"
 #include "manipulation/pick_place_job.hpp"
 #include "tests/drivers/jaco_test_rig.hpp"
+#include "tests/support/counting_new.hpp"  // the one TU of this binary that replaces operator new
 
 namespace orthoflow::manipulation {
 namespace {
@@ -54,6 +55,7 @@ struct World {
   PerceptionInput perception{};
   std::vector<ArmRequest> sent;
   int refusals = 0;
+  std::uint64_t step_allocations = 0;  ///< operator new calls inside ExecutionManager::step
   /// Called every cycle before the manager's step (a test's event).
   std::function<void(World&, const ExecutionManager&)> event;
 
@@ -98,7 +100,12 @@ struct World {
       update_world(job);
       update_perception();
       if (event) event(*this, manager);
-      const ArmRequest r = manager.step(rig.now(), arm_input(), perception);
+      const ArmInput input = arm_input();
+      test::g_allocations.store(0);
+      test::g_counting.store(true);  // the manager's step allocates nothing
+      const ArmRequest r = manager.step(rig.now(), input, perception);
+      test::g_counting.store(false);
+      step_allocations += test::g_allocations.load();
       if (r.kind != ArmRequest::Kind::NONE) {
         sent.push_back(r);
         jaco::ArmCommand c;
@@ -162,6 +169,7 @@ TEST(ExecutionManager, PicksAndPlacesTheMugOnTheSimulatedArm) {
       Phase::CARRY,      Phase::PLACE, Phase::RELEASE,   Phase::RETREAT,  Phase::DONE};
   EXPECT_EQ(phases_of(manager), expected) << log_text(manager);
   EXPECT_EQ(world.refusals, 0);
+  EXPECT_EQ(world.step_allocations, 0U) << "no allocation in any of the 1850 steps";
   EXPECT_FALSE(world.attached) << "released";
   EXPECT_LT((world.mug - PLACE).norm(), 0.02) << "the mug stands at the place";
   EXPECT_LT(joint_distance(world.rig.controller->snapshot().joints, job.retreat), 1.0);
