@@ -4,18 +4,23 @@
 // table plane, carried through the configured camera pose. Per object: the chosen grasp (kind,
 // pre-grasp and grasp positions, approach, finger opening, joint solutions) or why there is none,
 // and every rejected candidate with its reason. The frame is the last one with objects unless
-// --frame names one.
+// --frame names one. With --place X,Y, each grasped object's pick-and-place job too
+// (manipulation/pick_place_job.hpp): the joints of the lift, the carry, the place and the retreat,
+// or the step the arm does not reach.
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <iostream>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "apps/commands.hpp"
 #include "manipulation/grasp_planner.hpp"
+#include "manipulation/pick_place_job.hpp"
 #include "manipulation/robot_frames.hpp"
 
 namespace orthoflow::apps {
@@ -34,10 +39,30 @@ struct GraspArgs {
   std::string objects;
   std::optional<std::uint64_t> frame;
   std::string model = "jaco2";
+  std::vector<double> place;  // --place X,Y: where on the table (base frame) to put each object
   bool json = false;
 };
 
 nlohmann::json vec_json(const Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+
+// --place: the pick-and-place job's joint-space poses, solved before anything would move, or the
+// step the arm does not reach.
+nlohmann::json job_json(std::uint64_t track, const manipulation::ObjectBox& box,
+                        const manipulation::Grasp& grasp, const std::vector<double>& place,
+                        const manipulation::GraspOptions& options) {
+  manipulation::JobOptions job_options;
+  job_options.grasp = options;
+  const Vector3d centre = box.base_from_object.translation();
+  const Vector3d to(place[0], place[1], centre.z());
+  auto job = manipulation::make_pick_place_job(static_cast<std::uint32_t>(track), centre, grasp, to,
+                                               job_options);
+  if (!job.has_value()) return {{"refused", job.error()}};
+  const manipulation::PickPlaceJob& j = job.value();
+  return {{"place_m", vec_json(to)},         {"lift_joints_deg", j.lift},
+          {"carry_joints_deg", j.carry},     {"place_joints_deg", j.place},
+          {"retreat_joints_deg", j.retreat}, {"open_fingers", j.open_fingers},
+          {"close_fingers", j.close_fingers}};
+}
 
 // The chosen frame of the run's JSON lines: the one --frame names, else the last with objects.
 manipulation::PerceivedFrame pick_frame(const GraspArgs& a) {
@@ -111,6 +136,7 @@ void run_grasp(const GraspArgs& a) {
     entry["feasible"] = p.feasible_count;
     if (const manipulation::Grasp* g = p.best()) {
       ++planned;
+      if (!a.place.empty()) entry["job"] = job_json(o.track, box, *g, a.place, options);
       entry["grasp"] = {{"kind", manipulation::to_string(g->kind)},
                         {"pre_grasp_m", vec_json(g->pre_grasp.translation())},
                         {"grasp_m", vec_json(g->grasp.translation())},
@@ -159,6 +185,14 @@ void run_grasp(const GraspArgs& a) {
           g["pre_grasp_m"][0].get<double>(), g["pre_grasp_m"][1].get<double>(),
           g["pre_grasp_m"][2].get<double>(), g["width_m"].get<double>(),
           g["opening_m"].get<double>());
+      if (e.contains("job")) {
+        const auto& j = e["job"];
+        if (j.contains("refused"))
+          std::printf("    no job to the place: %s\n", j["refused"].get<std::string>().c_str());
+        else
+          std::printf("    job to [%.3f, %.3f]: lift, carry, place and retreat solved\n",
+                      j["place_m"][0].get<double>(), j["place_m"][1].get<double>());
+      }
     } else {
       std::printf("no feasible grasp\n");
     }
@@ -183,6 +217,21 @@ void add_grasp_command(CLI::App& app) {
   cmd->add_option("--frame", a->frame, "frame id (default: the last frame with objects)");
   cmd->add_option("--model", a->model, "arm model: jaco2 or v1")
       ->check(CLI::IsMember({"jaco2", "v1"}));
+  cmd->add_option("--place", a->place,
+                  "X,Y on the table in the arm's base frame (m): also solve each grasped object's "
+                  "pick-and-place job (lift, carry, place, retreat) in joint space")
+      ->type_name("X,Y")  // signed: not the commands' non-negative rule (apps/option_checks.hpp)
+      ->expected(2)
+      ->delimiter(',')
+      ->check(CLI::Validator(
+          [](const std::string& v) {
+            char* end = nullptr;
+            const double x = std::strtod(v.c_str(), &end);
+            return end != v.c_str() && *end == '\0' && std::isfinite(x) && std::fabs(x) <= 2.0
+                       ? std::string()
+                       : "'" + v + "' is not a coordinate in [-2, 2] m";
+          },
+          "X,Y"));
   cmd->add_flag("--json", a->json, "one JSON object on stdout");
   cmd->callback([a] { run_grasp(*a); });
 }

@@ -87,6 +87,20 @@ with tempfile.TemporaryDirectory() as tmp:
         else:
             reasons = [r["reason"] for r in o.get("rejected", [])] + [o.get("refused", "")]
             expect(any(reasons), f"an object without a grasp says why: {o}")
+    # --place: each grasped object's pick-and-place job in joint space, or the step out of reach.
+    jobs = json.loads(run(cli, "grasp", "--robot-frames", frames_yaml, "--objects", objects,
+                          "--place=-0.3,-0.3", "--json").stdout)
+    solved = [o["job"] for o in jobs["objects"] if "job" in o and "refused" not in o["job"]]
+    expect(solved and all(len(j["carry_joints_deg"]) == 6 and j["place_m"][:2] == [-0.3, -0.3]
+                          and 0 <= j["open_fingers"] < j["close_fingers"] for j in solved),
+           f"jobs to (-0.3, -0.3): {jobs['objects']}")
+    far = json.loads(run(cli, "grasp", "--robot-frames", frames_yaml, "--objects", objects,
+                         "--place=1.9,0", "--json").stdout)
+    expect(all(o["job"]["refused"].startswith("carry: ") for o in far["objects"] if "job" in o),
+           f"a place out of reach names the step: {far['objects']}")
+    p = run(cli, "grasp", "--robot-frames", frames_yaml, "--objects", objects, "--place", "nan,0",
+            code=None)
+    expect(p.returncode != 0 and "not a coordinate" in p.stderr, p.stderr)
     text = run(cli, "grasp", "--robot-frames", frames_yaml, "--objects", objects, "--frame", "3").stdout
     expect(text.startswith("frame 3: "), text)
     p = run(cli, "grasp", "--robot-frames", samples, "--objects", objects, code=EXIT_BAD_INPUT)
