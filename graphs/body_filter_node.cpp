@@ -43,6 +43,12 @@ struct BodyFilterSettings {
   std::int64_t max_state_age_ns = 50'000'000;
 };
 
+/// |a - b| for every pair of stamps (a state or a frame from another process may carry any value).
+std::uint64_t distance_ns(std::int64_t a, std::int64_t b) noexcept {
+  return a > b ? static_cast<std::uint64_t>(a) - static_cast<std::uint64_t>(b)
+               : static_cast<std::uint64_t>(b) - static_cast<std::uint64_t>(a);
+}
+
 /// Why a frame was not filtered.
 enum class Verdict { FILTERED, NO_STATE, STALE, FAULT, BAD_STATE, TOO_LARGE };
 
@@ -163,21 +169,22 @@ class BodyFilter final : public engine::Node {
     const engine::ArmStatePayload* before = nullptr;  // newest at or before the frame
     const engine::ArmStatePayload* after = nullptr;   // oldest after it
     const engine::ArmStatePayload* nearest = nullptr;
-    std::int64_t nearest_age = std::numeric_limits<std::int64_t>::max();
+    std::uint64_t nearest_age = std::numeric_limits<std::uint64_t>::max();
     for (std::size_t i = 0; i < history_count_; ++i) {
       const engine::ArmStatePayload& s = history_[i];
-      const std::int64_t age =
-          s.stamp_ns > frame_ns ? s.stamp_ns - frame_ns : frame_ns - s.stamp_ns;
+      const std::uint64_t age = distance_ns(s.stamp_ns, frame_ns);
       if (age < nearest_age) nearest_age = age, nearest = &s;
       if (s.stamp_ns <= frame_ns && (before == nullptr || s.stamp_ns > before->stamp_ns))
         before = &s;
       if (s.stamp_ns > frame_ns && (after == nullptr || s.stamp_ns < after->stamp_ns)) after = &s;
     }
-    last_age_us_.store(static_cast<std::uint64_t>(nearest_age / 1000), std::memory_order_relaxed);
-    if (nearest_age > settings_.max_state_age_ns) return Verdict::STALE;
+    last_age_us_.store(nearest_age / 1000, std::memory_order_relaxed);
+    const auto max_age = static_cast<std::uint64_t>(settings_.max_state_age_ns);
+    if (nearest_age > max_age) return Verdict::STALE;
+    // Both within the limit of the frame: their differences below cannot overflow.
     const bool bracket = before != nullptr && after != nullptr &&
-                         frame_ns - before->stamp_ns <= settings_.max_state_age_ns &&
-                         after->stamp_ns - frame_ns <= settings_.max_state_age_ns;
+                         distance_ns(frame_ns, before->stamp_ns) <= max_age &&
+                         distance_ns(after->stamp_ns, frame_ns) <= max_age;
     for (const engine::ArmStatePayload* s :
          {nearest, bracket ? before : nearest, bracket ? after : nearest}) {
       if ((s->flags & engine::ARM_FAULT) != 0) return Verdict::FAULT;

@@ -7,6 +7,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <random>
 #include <thread>
 #include <vector>
@@ -318,6 +319,10 @@ TEST(BodyFilter, FramesWithoutAFreshSaneStateAreDroppedAndCounted) {
   auto nan = home(T0 + 1'000'000);
   nan.joints_deg[3] = std::nan("");
   EXPECT_TRUE(verdict({nan}, "dropped_bad_state"));
+  // Stamps from another process can be anything: the extremes are stale, never an overflow.
+  EXPECT_TRUE(verdict({home(std::numeric_limits<std::int64_t>::min()),
+                       home(std::numeric_limits<std::int64_t>::max())},
+                      "dropped_stale_state"));
   auto estop = home(T0 - 39'000'000);
   estop.flags = engine::ARM_ESTOP;  // stopped, but its joints are known: the frame is filtered
   EXPECT_FALSE(verdict({estop}, "frames_filtered"));
