@@ -19,6 +19,7 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/commands.hpp"
+#include "apps/perceived_scene.hpp"
 #include "manipulation/grasp_planner.hpp"
 #include "manipulation/pick_place_job.hpp"
 #include "manipulation/robot_frames.hpp"
@@ -28,11 +29,6 @@ namespace {
 
 using Eigen::Isometry3d;
 using Eigen::Vector3d;
-
-[[noreturn]] void fail(const std::string& message, int code) {
-  std::cerr << "orthoflow grasp: " << message << '\n';
-  throw CLI::RuntimeError(code);
-}
 
 struct GraspArgs {
   std::string frames;
@@ -64,49 +60,14 @@ nlohmann::json job_json(std::uint64_t track, const manipulation::ObjectBox& box,
           {"close_fingers", j.close_fingers}};
 }
 
-// The chosen frame of the run's JSON lines: the one --frame names, else the last with objects.
-manipulation::PerceivedFrame pick_frame(const GraspArgs& a) {
-  std::ifstream in(a.objects);
-  if (!in) fail(a.objects + ": cannot open", EXIT_BAD_INPUT);
-  std::optional<manipulation::PerceivedFrame> chosen;
-  std::size_t number = 0;
-  for (std::string line; std::getline(in, line);) {
-    ++number;
-    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
-    auto parsed = manipulation::parse_run_line(line);
-    if (!parsed.has_value())
-      fail(a.objects + ":" + std::to_string(number) + ": " + parsed.error(), EXIT_BAD_INPUT);
-    if (a.frame ? parsed.value().frame == *a.frame : !parsed.value().objects.empty()) {
-      chosen = std::move(parsed.value());
-      if (a.frame) break;
-    }
-  }
-  if (!chosen) {
-    fail(a.objects +
-             (a.frame ? ": no frame " + std::to_string(*a.frame) : ": no frame with objects"),
-         EXIT_BAD_INPUT);
-  }
-  if (!chosen->has_plane) {
-    fail(a.objects + ": frame " + std::to_string(chosen->frame) + " has no table plane",
-         EXIT_BAD_INPUT);
-  }
-  return *chosen;
-}
-
 void run_grasp(const GraspArgs& a) {
-  const auto frames = manipulation::load_robot_frames(a.frames);
-  if (!frames.has_value()) fail(frames.error(), EXIT_BAD_INPUT);
-  const Isometry3d& x = frames.value().base_from_camera;
-  const manipulation::PerceivedFrame frame = pick_frame(a);
-  // The plane in the base frame, its normal toward the camera's side (up).
-  Vector3d normal = x.linear() * frame.plane_normal;
-  double offset = frame.plane_d - normal.dot(x.translation());
-  if (frame.plane_d < 0.0) {
-    normal = -normal;
-    offset = -offset;
-  }
+  const PerceivedScene scene = load_perceived_scene("grasp", a.frames, a.objects, a.frame);
+  const Isometry3d& x = scene.base_from_camera;
+  const manipulation::PerceivedFrame& frame = scene.frame;
+  const Vector3d& normal = scene.table.normal;
+  const double offset = scene.table.offset;
   manipulation::GraspOptions options;
-  options.table = {normal, offset};
+  options.table = scene.table;
   options.geometry =
       a.model == "v1" ? &drivers::jaco::jaco_v1_geometry() : &drivers::jaco::jaco2_geometry();
   nlohmann::json out = {{"frame", frame.frame},

@@ -54,6 +54,8 @@ void add_calibrate_command(CLI::App& app);
 /// @brief `grasp --robot-frames F --objects RUN.jsonl`: grasp plans of a run's objects
 /// (apps/cmd_grasp.cpp).
 void add_grasp_command(CLI::App& app);
+/// @brief `orthoflow task clear_table|serve_a_meal`: the table tasks planned on a run's objects.
+void add_task_command(CLI::App& app);
 
 /// @brief `run`: the tabletop graph on the embedded session or a given source; summary, JSON lines,
 /// snapshot.
