@@ -184,15 +184,7 @@ void add_grasp_command(CLI::App& app) {
       ->type_name("X,Y")  // signed: not the commands' non-negative rule (apps/option_checks.hpp)
       ->expected(2)
       ->delimiter(',')
-      ->check(CLI::Validator(
-          [](const std::string& v) {
-            char* end = nullptr;
-            const double x = std::strtod(v.c_str(), &end);
-            return end != v.c_str() && *end == '\0' && std::isfinite(x) && std::fabs(x) <= 2.0
-                       ? std::string()
-                       : "'" + v + "' is not a coordinate in [-2, 2] m";
-          },
-          "X,Y"));
+      ->check(table_coordinate());
   cmd->add_flag("--json", a->json, "one JSON object on stdout");
   cmd->callback([a] { run_grasp(*a); });
 }

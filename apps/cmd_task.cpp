@@ -36,18 +36,6 @@ struct TaskArgs {
   bool json = false;
 };
 
-CLI::Validator coordinate() {
-  return CLI::Validator(
-      [](const std::string& v) {
-        char* end = nullptr;
-        const double x = std::strtod(v.c_str(), &end);
-        return end != v.c_str() && *end == '\0' && std::isfinite(x) && std::fabs(x) <= 2.0
-                   ? std::string()
-                   : "'" + v + "' is not a coordinate in [-2, 2] m";
-      },
-      "M");
-}
-
 void run_task(const TaskArgs& a) {
   const PerceivedScene scene = load_perceived_scene("task", a.frames, a.objects, a.frame);
   manipulation::GraspOptions grasp_options;
@@ -155,7 +143,7 @@ void add_task_command(CLI::App& app) {
       ->type_name("X0,Y0,X1,Y1")
       ->expected(4)
       ->delimiter(',')
-      ->check(coordinate());
+      ->check(table_coordinate());
   cmd->add_option("--keep", a->keep, "clear_table: categories that are table items and stay")
       ->delimiter(',');
   cmd->add_option("--bring", a->bring, "serve_a_meal: the categories to bring, in order")
@@ -165,7 +153,7 @@ void add_task_command(CLI::App& app) {
       ->type_name("X,Y")
       ->expected(2)
       ->delimiter(',')
-      ->check(coordinate());
+      ->check(table_coordinate());
   cmd->add_flag("--json", a->json, "one JSON object on stdout");
   cmd->callback([a] {
     const char* missing = a->task == "clear_table" && a->area.empty() ? "clear_table needs --area"

@@ -1,5 +1,7 @@
 #include "apps/perceived_scene.hpp"
 
+#include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <iostream>
 
@@ -41,6 +43,18 @@ manipulation::PerceivedFrame pick_frame(const std::string& command, const std::s
 }
 
 }  // namespace
+
+CLI::Validator table_coordinate() {
+  return CLI::Validator(
+      [](const std::string& v) {
+        char* end = nullptr;
+        const double x = std::strtod(v.c_str(), &end);
+        return end != v.c_str() && *end == '\0' && std::isfinite(x) && std::fabs(x) <= 2.0
+                   ? std::string()
+                   : "'" + v + "' is not a coordinate in [-2, 2] m";
+      },
+      "M");
+}
 
 PerceivedScene load_perceived_scene(const std::string& command, const std::string& frames_file,
                                     const std::string& objects_file,

@@ -7,6 +7,7 @@
 #include <optional>
 #include <string>
 
+#include <CLI/CLI.hpp>
 #include <Eigen/Geometry>
 
 #include "manipulation/grasp_planner.hpp"
@@ -22,6 +23,10 @@ struct PerceivedScene {
 
 /// @brief Loads the robot frames and the chosen frame; throws CLI::RuntimeError(EXIT_BAD_INPUT)
 /// with "orthoflow @p command: ..." on stderr.
+/// @brief The check of a coordinate option on the table (base frame): a finite number in [-2, 2] m.
+/// Signed, so such options also carry a type name of their own (apps/option_checks.hpp).
+[[nodiscard]] CLI::Validator table_coordinate();
+
 [[nodiscard]] PerceivedScene load_perceived_scene(const std::string& command,
                                                   const std::string& frames_file,
                                                   const std::string& objects_file,
