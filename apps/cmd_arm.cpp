@@ -6,6 +6,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstring>
 #include <iostream>
 #include <sstream>
@@ -21,6 +22,11 @@ namespace orthoflow::apps {
 namespace arm_cli {
 
 namespace jaco = drivers::jaco;
+
+namespace {
+std::atomic<bool> follow_stop{false};
+extern "C" void on_follow_stop(int) { follow_stop.store(true); }
+}  // namespace
 
 [[noreturn]] void fail(const std::string& what, int code) {
   std::cerr << "orthoflow arm: " << what << '\n';
@@ -306,11 +312,16 @@ void run_state(const ArmArgs& a) {
     print_snapshot(arm->snapshot(), a.json);
     return;
   }
-  // 10 lines per second of the 100 Hz stream, until --seconds or Ctrl-C.
+  // 10 lines per second of the 100 Hz stream, until --seconds, Ctrl-C or SIGTERM: a signal ends the
+  // loop like the time limit does (the arm is closed and the count printed), exit 0.
+  follow_stop.store(false);
+  const auto previous_int = std::signal(SIGINT, on_follow_stop);
+  const auto previous_term = std::signal(SIGTERM, on_follow_stop);
   const auto start = std::chrono::steady_clock::now();
   std::uint64_t printed_cycle = 0;
-  while (a.seconds <= 0.0 ||
-         std::chrono::steady_clock::now() - start < std::chrono::duration<double>(a.seconds)) {
+  while (!follow_stop.load() &&
+         (a.seconds <= 0.0 ||
+          std::chrono::steady_clock::now() - start < std::chrono::duration<double>(a.seconds))) {
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
     if (ipc && !engine::probe_roudi()) {
       ipc->roudi_alive.store(false, std::memory_order_release);
@@ -323,6 +334,8 @@ void run_state(const ArmArgs& a) {
     print_snapshot(s, a.json);
     if (s.fault) fail("the arm faulted: " + jaco::to_string(s.fault_error));
   }
+  std::signal(SIGINT, previous_int);
+  std::signal(SIGTERM, previous_term);
   arm.reset();
   if (ipc) {
     std::cerr << "published " << ipc->published.load() << " states on " << ARM_STATE_TOPIC << '\n';
@@ -360,7 +373,7 @@ void add_arm_command(CLI::App& app) {
   info->callback([a] { run_info(*a); });
   auto* state = arm->add_subcommand("state", "joints, pose, fingers and state (--follow: 10 Hz)");
   add_common_options(state, a);
-  state->add_flag("--follow", a->follow, "keep printing until Ctrl-C or --seconds");
+  state->add_flag("--follow", a->follow, "keep printing until Ctrl-C, SIGTERM or --seconds");
   state->add_option("--seconds", a->seconds, "with --follow: stop after this many seconds");
   state->add_flag("--publish", a->publish,
                   "with --follow: publish every 100 Hz snapshot on the iceoryx topic "
