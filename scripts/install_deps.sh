@@ -5,6 +5,7 @@ set -euo pipefail
 
 PACKAGES=(
   cmake ninja-build g++ pkg-config git
+  ccache  # scripts/test.sh: the four presets' builds reuse what an earlier build compiled
   libeigen3-dev libxsimd-dev libtbb-dev libyaml-cpp-dev nlohmann-json3-dev libcli11-dev
   liblzf-dev libcairo2-dev libpng-dev libleveldb-dev libusb-1.0-0-dev
   libcivetweb-dev  # the web view's HTTP + WebSocket server (ui/, `orthoflow run --ui`)
