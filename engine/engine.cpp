@@ -80,6 +80,8 @@ struct Engine::Impl {
   std::atomic<bool> stop_requested{false};
   const std::atomic<bool>* external_stop = nullptr;
   std::uint64_t max_frames = 0;
+  std::span<std::int64_t> latency_trace;  // RunOptions::latency_trace
+  std::atomic<std::uint64_t> traced{0};   // frames finished, as an index into it
   std::uint64_t next_frame = 0;
   bool source_ended = false;  // touched only by the serial admission node
   std::atomic<std::int64_t> next_tick_ns{0};
@@ -296,6 +298,10 @@ struct Engine::Impl {
     if (slot.pending.fetch_sub(1, std::memory_order_acq_rel) != 1) return;
     const std::int64_t latency = now_ns() - slot.stamp_ns;
     stats.frame_latency.record(latency);
+    if (!latency_trace.empty()) {
+      const std::uint64_t k = traced.fetch_add(1, std::memory_order_relaxed);
+      if (k < latency_trace.size()) latency_trace[k] = latency;
+    }
     if (graph.spec.period_ns > 0 && latency > graph.spec.period_ns)
       stats.deadline_misses.fetch_add(1);
     stats.frames_done.fetch_add(1, std::memory_order_relaxed);
@@ -318,6 +324,7 @@ StopReason Engine::run(const RunOptions& options) {
   impl_->ran = true;
   impl_->external_stop = options.stop;
   impl_->max_frames = options.max_frames;
+  impl_->latency_trace = options.latency_trace;
   const std::int64_t start = now_ns();
   impl_->next_tick_ns.store(start);
   impl_->parked.reserve(impl_->slot_count);

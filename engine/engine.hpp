@@ -7,6 +7,7 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <string_view>
 
 #include "engine/graph.hpp"
@@ -23,6 +24,11 @@ struct EngineConfig {
 struct RunOptions {
   std::uint64_t max_frames = 0;  ///< stop the source after this many frames (0 = no limit)
   const std::atomic<bool>* stop = nullptr;  ///< external stop flag (e.g. set by a signal handler)
+  /// Optional: every frame's exact latency (source stamp -> frame fully processed, ns), the k-th
+  /// frame to finish at index k, while k < size; the histogram's buckets are 12.5 % wide, this is
+  /// for comparisons finer than that. Caller-owned; the frame path writes one slot and never
+  /// allocates. After run(), min(stats().frames_done, size) slots are written.
+  std::span<std::int64_t> latency_trace{};
 };
 
 /// @brief Why run() returned. In every case all in-flight frames were drained first.

@@ -1,5 +1,6 @@
 #include "engine/histogram.hpp"
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 
@@ -46,6 +47,14 @@ std::int64_t LatencyHistogram::percentile(double q) const noexcept {
     }
   }
   return max();
+}
+
+std::int64_t exact_percentile(std::span<const std::int64_t> sorted, double q) noexcept {
+  if (sorted.empty()) return 0;
+  const double clamped = q < 0.0 ? 0.0 : (q > 1.0 ? 1.0 : q);
+  auto rank = static_cast<std::size_t>(std::ceil(clamped * static_cast<double>(sorted.size())));
+  if (rank == 0) rank = 1;
+  return sorted[std::min(rank, sorted.size()) - 1];
 }
 
 }  // namespace orthoflow::engine

@@ -5,6 +5,7 @@
 #include <array>
 #include <atomic>
 #include <cstdint>
+#include <span>
 
 namespace orthoflow::engine {
 
@@ -33,5 +34,11 @@ class LatencyHistogram {
   std::atomic<std::uint64_t> count_{0};
   std::atomic<std::int64_t> max_{0};
 };
+
+/// @brief The exact nearest-rank quantile q in [0, 1] of @p sorted (ascending): the sample of rank
+/// ceil(q n), at least 1; 0 if empty. For exact samples (RunOptions::latency_trace) where the
+/// histogram's 12.5 % buckets are too coarse.
+[[nodiscard]] std::int64_t exact_percentile(std::span<const std::int64_t> sorted,
+                                            double q) noexcept;
 
 }  // namespace orthoflow::engine

@@ -7,6 +7,7 @@
 #include <csignal>
 #include <ctime>
 #include <thread>
+#include <vector>
 
 #include "engine/engine.hpp"
 #include "engine/generic_nodes.hpp"
@@ -191,12 +192,17 @@ TEST(Engine, QueuePolicyNeverDrops) {
   EXPECT_EQ(sink_of(engine).value_sum.load(), 99 * 100 / 2);
 }
 
+// Ten frames through a node that spins 3 ms on each; @p header: the graph's settings.
+std::string ten_slow_frames(const std::string& header) {
+  return graph_text(header,
+                    "  - {name: src, kind: ticker, params: {frames: 10}}\n"
+                    "  - {name: slow, kind: busy, params: {spin_us: 3000}}\n"
+                    "  - {name: sink, kind: count}\n",
+                    "  - src.out -> slow.in\n  - slow.out -> sink.in\n");
+}
+
 TEST(Engine, PeriodPacesTheSourceAndCountsDeadlineMisses) {
-  auto graph = must_build(graph_text("  period_ms: 2\n  pool: {blocks: 2}\n",
-                                     "  - {name: src, kind: ticker, params: {frames: 10}}\n"
-                                     "  - {name: slow, kind: busy, params: {spin_us: 3000}}\n"
-                                     "  - {name: sink, kind: count}\n",
-                                     "  - src.out -> slow.in\n  - slow.out -> sink.in\n"));
+  auto graph = must_build(ten_slow_frames("  period_ms: 2\n  pool: {blocks: 2}\n"));
   ASSERT_TRUE(graph);
   Engine engine(*graph, {2});
   engine.run({});
@@ -204,6 +210,33 @@ TEST(Engine, PeriodPacesTheSourceAndCountsDeadlineMisses) {
   EXPECT_EQ(engine.stats().nodes[1].deadline_misses.load(), 10u);
   EXPECT_EQ(engine.stats().deadline_misses.load(), 10u);
   EXPECT_GE(engine.stats().frame_latency.percentile(0.5), 3'000'000);
+}
+
+TEST(Engine, LatencyTraceHoldsEveryFramesExactLatencyUpToItsSize) {
+  // 10 frames of at least 3 ms each into a trace of 7 (a trace shorter than the run) and one of 16
+  // (longer): the first 7 (10) slots hold the frames' latencies, the rest stay untouched, and they
+  // agree with the histogram (the same samples: the exact maximum, every value >= 3 ms).
+  for (const std::size_t size : {std::size_t{7}, std::size_t{16}}) {
+    auto graph = must_build(ten_slow_frames("  pool: {blocks: 2}\n"));
+    ASSERT_TRUE(graph);
+    Engine engine(*graph, {2});
+    std::vector<std::int64_t> trace(size, -1);
+    RunOptions options;
+    options.latency_trace = trace;
+    engine.run(options);
+    const std::size_t written = std::min<std::size_t>(size, 10);
+    ASSERT_EQ(engine.stats().frames_done.load(), 10u);
+    for (std::size_t k = 0; k < size; ++k) {
+      if (k < written) {
+        EXPECT_GE(trace[k], 3'000'000) << k;
+      } else {
+        EXPECT_EQ(trace[k], -1) << k;
+      }
+    }
+    const auto longest = *std::max_element(trace.begin(), trace.begin() + written);
+    EXPECT_LE(longest, engine.stats().frame_latency.max());
+    if (written == 10) { EXPECT_EQ(longest, engine.stats().frame_latency.max()); }
+  }
 }
 
 TEST(Engine, PoolExhaustionAtTheSourceIsADrop) {

@@ -41,6 +41,7 @@ TEST(LatencyHistogram, PercentilesWithinStatedError) {
   for (double q : {0.5, 0.9, 0.99, 0.999}) {
     const auto exact =
         values[static_cast<std::size_t>(std::ceil(q * static_cast<double>(values.size()))) - 1];
+    EXPECT_EQ(exact_percentile(values, q), exact) << q;
     EXPECT_GE(h.percentile(q), exact) << q;
     EXPECT_LE(static_cast<double>(h.percentile(q)), 1.125 * static_cast<double>(exact) + 1) << q;
   }
@@ -48,6 +49,23 @@ TEST(LatencyHistogram, PercentilesWithinStatedError) {
   EXPECT_EQ(h.percentile(1.0), values.back());
   h.record(-5);  // clock skew never underflows
   EXPECT_EQ(h.count(), 20001u);
+}
+
+TEST(LatencyHistogram, ExactPercentileIsTheNearestRank) {
+  const std::vector<std::int64_t> none;
+  EXPECT_EQ(exact_percentile(none, 0.99), 0);
+  const std::vector<std::int64_t> one{7};
+  EXPECT_EQ(exact_percentile(one, 0.0), 7);
+  EXPECT_EQ(exact_percentile(one, 1.0), 7);
+  std::vector<std::int64_t> hundred(100);
+  for (std::size_t i = 0; i < hundred.size(); ++i) hundred[i] = static_cast<std::int64_t>(i + 1);
+  EXPECT_EQ(exact_percentile(hundred, 0.0), 1);  // rank at least 1
+  EXPECT_EQ(exact_percentile(hundred, 0.5), 50);
+  EXPECT_EQ(exact_percentile(hundred, 0.99), 99);
+  EXPECT_EQ(exact_percentile(hundred, 0.991), 100);
+  EXPECT_EQ(exact_percentile(hundred, 1.0), 100);
+  EXPECT_EQ(exact_percentile(hundred, -1.0), 1);  // clamped
+  EXPECT_EQ(exact_percentile(hundred, 2.0), 100);
 }
 
 TEST(LatencyHistogram, ConcurrentRecordingLosesNothing) {
