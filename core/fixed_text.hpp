@@ -32,6 +32,22 @@ struct FixedText {
     if (n > 0) std::memcpy(chars.data(), s.data(), n);  // an empty view may hold a null pointer
     std::fill(chars.begin() + static_cast<std::ptrdiff_t>(n), chars.end(), '\0');
   }
+  /// @brief Stores @p s; one longer than CAPACITY keeps its start and its end with "..." between
+  /// them, so that a message's subject (a path's file name) and its reason both survive. For
+  /// messages, never labels. Never allocates.
+  void assign_elided(std::string_view s) noexcept {
+    static_assert(CAPACITY >= 9, "room for a start, \"...\" and an end");
+    if (s.size() <= CAPACITY) {
+      assign(s);
+      return;
+    }
+    const std::size_t tail = (CAPACITY - 3) / 2;
+    const std::size_t head = CAPACITY - 3 - tail;
+    std::memcpy(chars.data(), s.data(), head);
+    std::memcpy(chars.data() + head, "...", 3);
+    std::memcpy(chars.data() + head + 3, s.data() + (s.size() - tail), tail);
+    chars[CAPACITY] = '\0';
+  }
   /// @brief Stores @p s only if it fits whole (at most CAPACITY bytes, no embedded zero); otherwise
   /// leaves the text empty. @return whether it was stored: what a caller checks before it sends a
   /// label that must not be cut short.

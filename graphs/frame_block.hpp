@@ -75,6 +75,7 @@ struct ObjectRecord {
 /// without allocating. One rule: the first error a frame meets is the one it reports (set() keeps
 /// it; later stages see a frame that already failed and do not overwrite it).
 struct FrameError {
+  static constexpr std::size_t DETAIL_MAX_BYTES = 511;
   enum class Code : std::uint8_t {
     NONE,
     FRAME_TOO_LARGE,  ///< source: more points than the pool block holds (value: the point count)
@@ -87,8 +88,10 @@ struct FrameError {
   std::uint8_t cause = 0;
   double value = 0.0;
   kernels::SegmentationError segmentation{};
-  Text stage;   ///< the node that reported it
-  Text detail;  ///< FILE_UNREADABLE: the reader's message (truncated)
+  Text stage;  ///< the node that reported it
+  /// FILE_UNREADABLE: the reader's message, its middle elided past DETAIL_MAX_BYTES (the file's
+  /// path and the reason stay whatever the folder's depth).
+  core::FixedText<DETAIL_MAX_BYTES> detail;
   [[nodiscard]] bool empty() const noexcept { return code == Code::NONE; }
   /// @brief The code's name, e.g. "SEGMENTATION". Never allocates.
   [[nodiscard]] static std::string_view name(Code code) noexcept;

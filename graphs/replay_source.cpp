@@ -60,9 +60,9 @@ class ReplaySource final : public FrameSource {
       FrameError& e = block.state().error;
       e.set(FrameError::Code::FILE_UNREADABLE, name_,
             slot == nullptr ? 0 : static_cast<std::uint8_t>(slot->error.code));
-      e.detail.assign(slot == nullptr
-                          ? std::string_view("replay_source: no record decoded within 5 s")
-                          : std::string_view(slot->error.message));
+      e.detail.assign_elided(slot == nullptr
+                                 ? std::string_view("replay_source: no record decoded within 5 s")
+                                 : std::string_view(slot->error.message));
       return engine::SourceStatus::FRAME;
     }
     kernels::PointCloud& cloud = slot->cloud;

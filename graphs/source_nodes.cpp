@@ -87,11 +87,11 @@ class PcdSource final : public FrameSource {
       FrameError& e = block.state().error;
       if (slot == nullptr) {
         e.set(FrameError::Code::FILE_UNREADABLE, name_, 0);
-        e.detail.assign("pcd_source: the decoder did not deliver the next file within 5 s");
+        e.detail.assign_elided("pcd_source: the decoder did not deliver the next file within 5 s");
       } else {
         e.set(FrameError::Code::FILE_UNREADABLE, name_,
               static_cast<std::uint8_t>(slot->error.code));
-        e.detail.assign(slot->error.message);
+        e.detail.assign_elided(slot->error.message);
       }
       return engine::SourceStatus::FRAME;
     }

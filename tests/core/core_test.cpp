@@ -94,6 +94,27 @@ TEST(FixedText, TruncatesTerminatesAndCompares) {
   EXPECT_FALSE(checked.try_assign(with_zero));
 }
 
+TEST(FixedText, ElidedKeepsTheStartAndTheEnd) {
+  Text t;
+  t.assign_elided("short");  // fits: as assign()
+  EXPECT_EQ(t.view(), "short");
+  const std::string fits(TEXT_MAX_BYTES, 'f');
+  t.assign_elided(fits);
+  EXPECT_EQ(t.view(), fits);
+  // One byte too long: the middle gives way to "...", the start and the end stay.
+  const std::string path = "/a/long/checkout/" + std::string(60, 'd') + "/b.pcd: line 1: bad";
+  t.assign_elided(path);
+  ASSERT_EQ(t.view().size(), TEXT_MAX_BYTES);
+  EXPECT_EQ(t.view().substr(0, 17), "/a/long/checkout/");
+  EXPECT_NE(t.view().find("..."), std::string_view::npos);
+  EXPECT_TRUE(t.view().ends_with("/b.pcd: line 1: bad"));
+  t.assign_elided("x");  // shorter after longer: no leftover bytes
+  EXPECT_EQ(t.view(), "x");
+  FixedText<9> small;
+  small.assign_elided("0123456789");
+  EXPECT_EQ(small.view(), "012...789");
+}
+
 TEST(LabelText, OneRuleForEveryLabel) {
   EXPECT_EQ(check_label("mug"), LabelProblem::NONE);
   EXPECT_EQ(check_label("\xF0\x9F\x8D\xB5 cup"), LabelProblem::NONE);  // a 4-byte code point
