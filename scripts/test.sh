@@ -92,6 +92,8 @@ collect_fuzzer() {
 }
 
 run_fuzzers() {
+  local t0
+  t0=$(date +%s)
   echo "=== preset fuzz: configure and build"
   if ! { cmake --preset fuzz >"$logdir/fuzz.configure.log" && cmake --build --preset fuzz; }; then
     cat "$logdir/fuzz.configure.log"
@@ -99,9 +101,10 @@ run_fuzzers() {
     failed=$((failed + 1))
     return
   fi
+  note_time "fuzz build" "$t0"
   # Two fuzzers at a time: each libFuzzer process is single-threaded and CI has two cores. Each
   # one's output goes to its own log, printed whole when it ends (never interleaved).
-  local f t0 pids=() names=() i
+  local f pids=() names=() i
   t0=$(date +%s)
   for f in build/fuzz/tests/fuzz/fuzz_*; do
     [ -x "$f" ] || continue
