@@ -80,8 +80,7 @@ struct Engine::Impl {
   std::atomic<bool> stop_requested{false};
   const std::atomic<bool>* external_stop = nullptr;
   std::uint64_t max_frames = 0;
-  std::span<std::int64_t> latency_trace;  // RunOptions::latency_trace
-  std::atomic<std::uint64_t> traced{0};   // frames finished, as an index into it
+  std::span<std::int64_t> latency_trace;  // RunOptions::latency_trace, indexed by frames_done
   std::uint64_t next_frame = 0;
   bool source_ended = false;  // touched only by the serial admission node
   std::atomic<std::int64_t> next_tick_ns{0};
@@ -298,13 +297,10 @@ struct Engine::Impl {
     if (slot.pending.fetch_sub(1, std::memory_order_acq_rel) != 1) return;
     const std::int64_t latency = now_ns() - slot.stamp_ns;
     stats.frame_latency.record(latency);
-    if (!latency_trace.empty()) {
-      const std::uint64_t k = traced.fetch_add(1, std::memory_order_relaxed);
-      if (k < latency_trace.size()) latency_trace[k] = latency;
-    }
     if (graph.spec.period_ns > 0 && latency > graph.spec.period_ns)
       stats.deadline_misses.fetch_add(1);
-    stats.frames_done.fetch_add(1, std::memory_order_relaxed);
+    const std::uint64_t k = stats.frames_done.fetch_add(1, std::memory_order_relaxed);
+    if (k < latency_trace.size()) latency_trace[k] = latency;
     Message token;
     token.slot = slot_index;
     dispatch->try_put(token);  // hand the token back: the next frame may start

@@ -32,12 +32,19 @@ void LatencyHistogram::record(std::int64_t ns) noexcept {
   while (sample > seen && !max_.compare_exchange_weak(seen, sample, std::memory_order_relaxed)) {}
 }
 
+namespace {
+// The nearest rank of quantile q (clamped to [0, 1]) among n > 0 samples: ceil(q n), at least 1.
+std::uint64_t nearest_rank(double q, std::uint64_t n) noexcept {
+  const double clamped = q < 0.0 ? 0.0 : (q > 1.0 ? 1.0 : q);
+  const auto rank = static_cast<std::uint64_t>(std::ceil(clamped * static_cast<double>(n)));
+  return std::clamp<std::uint64_t>(rank, 1, n);
+}
+}  // namespace
+
 std::int64_t LatencyHistogram::percentile(double q) const noexcept {
   const std::uint64_t total = count();
   if (total == 0) return 0;
-  const double clamped = q < 0.0 ? 0.0 : (q > 1.0 ? 1.0 : q);
-  auto rank = static_cast<std::uint64_t>(std::ceil(clamped * static_cast<double>(total)));
-  if (rank == 0) rank = 1;
+  const std::uint64_t rank = nearest_rank(q, total);
   std::uint64_t seen = 0;
   for (std::size_t b = 0; b < BUCKETS; ++b) {
     seen += buckets_[b].load(std::memory_order_relaxed);
@@ -51,10 +58,7 @@ std::int64_t LatencyHistogram::percentile(double q) const noexcept {
 
 std::int64_t exact_percentile(std::span<const std::int64_t> sorted, double q) noexcept {
   if (sorted.empty()) return 0;
-  const double clamped = q < 0.0 ? 0.0 : (q > 1.0 ? 1.0 : q);
-  auto rank = static_cast<std::size_t>(std::ceil(clamped * static_cast<double>(sorted.size())));
-  if (rank == 0) rank = 1;
-  return sorted[std::min(rank, sorted.size()) - 1];
+  return sorted[nearest_rank(q, sorted.size()) - 1];
 }
 
 }  // namespace orthoflow::engine
