@@ -54,6 +54,7 @@ void add_calibrate_command(CLI::App& app);
 /// @brief `grasp --robot-frames F --objects RUN.jsonl`: grasp plans of a run's objects
 /// (apps/cmd_grasp.cpp).
 void add_grasp_command(CLI::App& app);
+void add_demo_command(CLI::App& app);
 /// @brief `orthoflow task clear_table|serve_a_meal`: the table tasks planned on a run's objects.
 void add_task_command(CLI::App& app);
 

@@ -8,6 +8,7 @@
 #include <cstring>
 #include <limits>
 #include <new>
+#include <string>
 #include <vector>
 
 #include <unistd.h>
@@ -274,9 +275,23 @@ Result<void, std::string> parse_zones(const std::string& text, BodyFilterSetting
   return {};
 }
 
+/// "tx,ty,tz,qw,qx,qy,qz" as a robot frames file's base_from_camera (the same checks).
+Result<manipulation::RobotFrames, std::string> parse_inline_frames(const std::string& text) {
+  std::vector<std::string> v;
+  std::size_t start = 0;
+  for (std::size_t comma; (comma = text.find(',', start)) != std::string::npos; start = comma + 1)
+    v.push_back(text.substr(start, comma - start));
+  v.push_back(text.substr(start));
+  if (v.size() != 7)
+    return err("base_from_camera: '" + text + "' is not 7 numbers tx,ty,tz,qw,qx,qy,qz");
+  return manipulation::parse_robot_frames("base_from_camera:\n  translation_m: [" + v[0] + ", " +
+                                          v[1] + ", " + v[2] + "]\n  rotation_wxyz: [" + v[3] +
+                                          ", " + v[4] + ", " + v[5] + ", " + v[6] + "]\n");
+}
+
 Result<BodyFilterSettings, std::string> parse_settings(const ParamMap& params) {
-  if (auto ok = params.only(
-          {"robot_frames", "state", "state_topic", "max_state_age_ms", "margin", "arm", "exclude"});
+  if (auto ok = params.only({"robot_frames", "base_from_camera", "state", "state_topic",
+                             "max_state_age_ms", "margin", "arm", "exclude"});
       !ok)
     return err(ok.error());
   BodyFilterSettings s;
@@ -289,18 +304,24 @@ Result<BodyFilterSettings, std::string> parse_settings(const ParamMap& params) {
   s.geometry =
       *arm == "jaco_v1" ? &drivers::jaco::jaco_v1_geometry() : &drivers::jaco::jaco2_geometry();
   if (!s.arm) {
-    if (params.has("robot_frames") || params.has("state") || params.has("state_topic"))
-      return err(std::string("body_filter: arm none takes no robot_frames, state or state_topic"));
+    if (params.has("robot_frames") || params.has("base_from_camera") || params.has("state") ||
+        params.has("state_topic"))
+      return err(std::string(
+          "body_filter: arm none takes no robot_frames, base_from_camera, state or state_topic"));
     if (s.zone_count == 0)
       return err(std::string("body_filter: arm none needs exclude zones (else it does nothing)"));
     return s;
   }
   auto path = params.text("robot_frames", "");
   if (!path) return err(path.error());
-  if (path->empty())
-    return err(std::string(
-        "body_filter: robot_frames (the robot frames file, base_from_camera) is required"));
-  auto frames = manipulation::load_robot_frames(*path);
+  auto inline_frames = params.text("base_from_camera", "");
+  if (!inline_frames) return err(inline_frames.error());
+  if (path->empty() == inline_frames->empty())
+    return err(
+        std::string("body_filter: give exactly one of robot_frames (the robot frames file) and "
+                    "base_from_camera (tx,ty,tz,qw,qx,qy,qz)"));
+  auto frames =
+      path->empty() ? parse_inline_frames(*inline_frames) : manipulation::load_robot_frames(*path);
   if (!frames) return err("body_filter: " + frames.error());
   s.base_from_camera = frames->base_from_camera;
   auto age = params.number("max_state_age_ms", 50.0, 1.0, 1000.0);
@@ -346,15 +367,15 @@ NodeResult make_body_filter(const ParamMap& params, const engine::NodeContext& c
 }  // namespace
 
 void add_body_filter_node(engine::NodeRegistry& registry, ArmStateFeed* channel) {
-  registry.add(
-      "body_filter",
-      "robot-body filter (C_robot): points inside the arm's link model become NaN; "
-      "robot_frames (file), state (ipc | channel), state_topic, max_state_age_ms, margin (m), "
-      "arm (jaco2 | jaco_v1 | none), exclude (instructor zones: ax,ay,az,bx,by,bz,r;...); "
-      "frames without a fresh arm state are dropped and counted",
-      [channel](const ParamMap& params, const engine::NodeContext& context) {
-        return make_body_filter(params, context, channel);
-      });
+  registry.add("body_filter",
+               "robot-body filter (C_robot): points inside the arm's link model become NaN; "
+               "robot_frames (file) or base_from_camera (tx,ty,tz,qw,qx,qy,qz), state (ipc | "
+               "channel), state_topic, max_state_age_ms, margin (m), "
+               "arm (jaco2 | jaco_v1 | none), exclude (instructor zones: ax,ay,az,bx,by,bz,r;...); "
+               "frames without a fresh arm state are dropped and counted",
+               [channel](const ParamMap& params, const engine::NodeContext& context) {
+                 return make_body_filter(params, context, channel);
+               });
 }
 
 Result<void, std::string> insert_body_filter(engine::GraphSpec& spec,

@@ -240,9 +240,13 @@ bool ExecutionManager::path_blocked(const ArmInput& arm,
   if (goal == nullptr || others.empty()) return false;
   const Eigen::Vector3d from = drivers::jaco::forward_kinematics(arm.joints).translation();
   const Eigen::Vector3d to = drivers::jaco::forward_kinematics(*goal).translation();
+  return segment_blocked(from, to, others, limits_.obstacle_clearance_m);
+}
+
+bool segment_blocked(const Eigen::Vector3d& from, const Eigen::Vector3d& to,
+                     std::span<const Obstacle> others, double clearance_m) noexcept {
   for (const Obstacle& o : others) {
-    if (distance_to_segment(from, to, o.centre) < o.radius + limits_.obstacle_clearance_m)
-      return true;
+    if (distance_to_segment(from, to, o.centre) < o.radius + clearance_m) return true;
   }
   return false;
 }

@@ -128,6 +128,11 @@ struct PerceptionInput {
   std::span<const Obstacle> others{};
 };
 
+/// @brief True if a sphere of @p others comes nearer than @p clearance_m to the segment [@p from,
+/// @p to] (the manager's path check; a planner uses it to pick a grasp whose approach is free).
+[[nodiscard]] bool segment_blocked(const Eigen::Vector3d& from, const Eigen::Vector3d& to,
+                                   std::span<const Obstacle> others, double clearance_m) noexcept;
+
 /// @brief What to send the arm after a step.
 struct ArmRequest {
   enum class Kind : std::uint8_t { NONE, MOVE_JOINTS, MOVE_FINGERS, STOP };

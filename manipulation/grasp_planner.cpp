@@ -173,6 +173,29 @@ ObjectBox object_box_in_base(const Eigen::Isometry3d& base_from_camera,
   return box;
 }
 
+ObjectBox upright_box(const ObjectBox& box, const SupportPlane& table) noexcept {
+  const Vector3d up = table.normal.normalized();
+  const Eigen::Matrix3d r = box.base_from_object.linear();
+  int vertical = 0;  // the box axis nearest the table's normal: the object's height
+  for (int k = 1; k < 3; ++k) {
+    if (std::fabs(r.col(k).dot(up)) > std::fabs(r.col(vertical).dot(up))) vertical = k;
+  }
+  const int a = (vertical + 1) % 3, b = (vertical + 2) % 3;
+  Vector3d x = r.col(a) - r.col(a).dot(up) * up;
+  x = x.norm() > 1e-9 ? x.normalized() : up.unitOrthogonal();
+  ObjectBox out;
+  out.base_from_object.linear().col(0) = x;
+  out.base_from_object.linear().col(1) = up.cross(x);
+  out.base_from_object.linear().col(2) = up;
+  out.extents = Vector3d(box.extents[a], box.extents[b], box.extents[vertical]);
+  // The same centre, raised if the box's bottom would be below the table (it stands on it).
+  Vector3d centre = box.base_from_object.translation();
+  const double bottom = table.height_of(centre) - 0.5 * out.extents.z();
+  if (bottom < 0.0) centre -= bottom * up;
+  out.base_from_object.translation() = centre;
+  return out;
+}
+
 Result<GraspPlan, ObjectRejection> plan_grasp(const ObjectBox& box,
                                               const GraspOptions& options) noexcept {
   if (!box.base_from_object.matrix().allFinite() || !box.extents.allFinite() ||

@@ -69,6 +69,14 @@ struct ObjectBox {
     const std::array<float, 16>& object_from_camera_row_major,
     const std::array<float, 3>& extents) noexcept;
 
+/// @brief The upright box of an object standing on @p table: the box axis nearest the table's
+/// normal becomes the height (z along the normal), the next axis projected onto the table becomes
+/// x; the extents keep their lengths (a GOOD box is tight along its own axes, a box around a
+/// tilted box is not), and a box whose bottom would be below the table is raised onto it. A GOOD
+/// frame of a partial view is often tilted; the planner and the orientation constraint want the
+/// object upright. @pre finite input.
+[[nodiscard]] ObjectBox upright_box(const ObjectBox& box, const SupportPlane& table) noexcept;
+
 enum class GraspKind : std::uint8_t { TOP, SIDE };
 [[nodiscard]] const char* to_string(GraspKind kind) noexcept;
 

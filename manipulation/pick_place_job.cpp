@@ -11,6 +11,34 @@ double finger_for_opening(double opening_m, const JobOptions& options) noexcept 
   return (1.0 - share) * options.finger_closed;
 }
 
+std::size_t cover_box(const ObjectBox& box, std::span<Obstacle> out) noexcept {
+  const Eigen::Vector3d e = box.extents.cwiseMax(0.0);
+  const double cell = std::max(0.03, e.maxCoeff() / 4.0);
+  Eigen::Array3i n;
+  Eigen::Vector3d size;
+  for (int k = 0; k < 3; ++k) {
+    n[k] = static_cast<int>(std::clamp(std::ceil(e[k] / cell), 1.0, 4.0));
+    size[k] = e[k] / n[k];
+  }
+  const double radius = 0.5 * size.norm();
+  std::size_t count = 0;
+  for (int i = 0; i < n[0]; ++i) {
+    for (int j = 0; j < n[1]; ++j) {
+      for (int k = 0; k < n[2] && count < out.size(); ++k) {
+        const Eigen::Vector3d local =
+            (Eigen::Array3d(i, j, k) + 0.5).matrix().cwiseProduct(size) - 0.5 * e;
+        out[count++] = {box.base_from_object * local, radius};
+      }
+    }
+  }
+  return count;
+}
+
+double opening_for_finger(double finger, const JobOptions& options) noexcept {
+  const double share = std::clamp(finger / options.finger_closed, 0.0, 1.0);
+  return (1.0 - share) * options.grasp.hand.max_opening_m;
+}
+
 Result<PickPlaceJob, std::string> make_pick_place_job(std::uint32_t track_id,
                                                       const Eigen::Vector3d& target_centre,
                                                       const Grasp& grasp,

@@ -6,7 +6,9 @@
 /// retreat back along the approach; the hand's orientation never changes from the grasp on (the
 /// object stays upright). Finger commands from the opening and the width (a linear map of the
 /// finger range onto the hand's opening, a planning approximation, not a vendor figure).
+#include <cstddef>
 #include <cstdint>
+#include <span>
 #include <string>
 
 #include <Eigen/Geometry>
@@ -33,7 +35,18 @@ struct JobOptions {
     std::uint32_t track_id, const Eigen::Vector3d& target_centre, const Grasp& grasp,
     const Eigen::Vector3d& place_centre, const JobOptions& options) noexcept;
 
+/// @brief Most spheres cover_box gives one box.
+inline constexpr std::size_t MAX_BOX_SPHERES = 64;
+/// @brief @p box as obstacles for the execution manager: cut into at most 4 x 4 x 4 cells about a
+/// quarter of its largest extent (at least 3 cm) wide, each covered by its circumscribed sphere, so
+/// a plate or a tall box is a set of small spheres rather than one sphere as wide as it is.
+/// @return the spheres written to @p out (at most MAX_BOX_SPHERES, fewer if @p out is shorter).
+/// @pre finite box. No allocation.
+std::size_t cover_box(const ObjectBox& box, std::span<Obstacle> out) noexcept;
+
 /// @brief Finger value for an opening of @p opening_m (0 open at max_opening_m, closed at 0).
 [[nodiscard]] double finger_for_opening(double opening_m, const JobOptions& options) noexcept;
+/// @brief The opening (m) of finger value @p finger: the inverse of finger_for_opening.
+[[nodiscard]] double opening_for_finger(double finger, const JobOptions& options) noexcept;
 
 }  // namespace orthoflow::manipulation

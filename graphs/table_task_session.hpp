@@ -1,0 +1,136 @@
+#pragma once
+/// @file
+/// @brief The closed loop of issue 21 (items 5-7): the thesis's clear_table and serve_a_meal
+/// (chapter 8) run end to end on the simulators. One call builds
+///   - a seeded tabletop (simulation::TableWorld, which reacts to the gripper),
+///   - the simulated JACO behind its real driver (drivers::jaco::JacoController on
+///     simulation::SimJacoTransport, on simulated time),
+///   - the tabletop graph with its source swapped for a `world_source` and the robot-body filter
+///     fed in-process by the arm's state (state: channel),
+///   - an in-memory learner taught through the learning channel, as a person would (by position,
+///     each object once, with its category),
+///   - the task planned from the labels the learner gives (manipulation/table_tasks.hpp), each move
+///     a grasp (manipulation/grasp_planner.hpp) and a pick-and-place job run by the execution
+///     manager (manipulation/execution_manager.hpp) on perception's newest objects,
+/// and runs it in lock step: one frame in flight; between frames the world, the arm (100 Hz) and
+/// the manager advance by one frame period of simulated time. Same seed, same report.
+///
+/// The task refuses a category nobody taught; an arm fault, the emergency stop or an abort while
+/// holding stops the whole task; any other abort fails that move and the task goes on.
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "core/result.hpp"
+#include "manipulation/execution_manager.hpp"
+#include "manipulation/table_tasks.hpp"
+#include "simulation/object_catalog.hpp"
+#include "simulation/synthetic_scene.hpp"
+
+namespace orthoflow::graphs {
+
+enum class TableTask : std::uint8_t { CLEAR_TABLE, SERVE_A_MEAL };
+[[nodiscard]] const char* to_string(TableTask task) noexcept;
+
+/// @brief Trouble a script makes during one move (the issue's aborts).
+enum class TaskEvent : std::uint8_t {
+  NONE,
+  MOVE_TARGET,      ///< a person moves the target 10 cm along the table
+  STOP_PERCEPTION,  ///< the objects stop arriving (perception died)
+  UNPLUG_ARM,       ///< the arm's USB cable is pulled
+};
+[[nodiscard]] const char* to_string(TaskEvent event) noexcept;
+
+/// @brief What on_frame sees.
+struct TaskFrameView {
+  std::uint64_t frame = 0;
+  double seconds = 0.0;                      ///< simulated time since the start
+  const simulation::Scene* scene = nullptr;  ///< objects where they are, the arm's capsules
+  const Eigen::Isometry3d* base_from_camera = nullptr;
+  int held_object_id = -1;  ///< world object id in the hand, or -1
+  const char* phase = "";   ///< the execution manager's phase
+};
+
+struct TableTaskConfig {
+  TableTask task = TableTask::CLEAR_TABLE;
+  std::uint64_t seed = 1;
+  std::uint32_t objects = 5;  ///< objects on the table (fewer if they do not fit)
+  /// The scene's categories (empty: bottle, bowl, mug, can, box, flask, plate).
+  std::vector<simulation::Category> categories;
+  std::vector<std::string> keep{"plate"};  ///< clear_table: table items, they stay
+  std::vector<std::string> bring;          ///< serve_a_meal: categories to bring, in order
+  manipulation::TableArea area{{0.20, -0.50}, {0.56, -0.15}};  ///< clear_table: base frame (m)
+  Eigen::Vector2d user_place{-0.35, -0.50};    ///< serve_a_meal: the first object's spot
+  std::int64_t frame_period_ns = 100'000'000;  ///< the camera's period in simulated time
+  std::uint32_t settle_frames = 10;            ///< frames before the person teaches (tracks form)
+  std::uint32_t recognise_frames = 10;         ///< frames between the teaching and the plan
+  double max_seconds = 900.0;                  ///< simulated time limit of the whole task
+  TaskEvent event = TaskEvent::NONE;
+  manipulation::Phase event_phase = manipulation::Phase::APPROACH;  ///< of the first move
+  manipulation::ExecutionLimits limits = default_limits();
+  /// Called after every frame's objects arrived (the picture sequence); may be empty.
+  std::function<void(const TaskFrameView&)> on_frame;
+
+  /// @brief The manager's limits for a closed loop with the body filter: the hand's own filter
+  /// hides the target in the last centimetres of the approach, so a target is lost only after 5 s
+  /// unseen.
+  [[nodiscard]] static manipulation::ExecutionLimits default_limits() noexcept;
+};
+
+/// @brief One primitive operator of a move: the phase and how long it took.
+struct OperatorTime {
+  std::string phase;
+  double seconds = 0.0;
+};
+
+struct MoveReport {
+  std::uint32_t track = 0;
+  std::string label;  ///< the learner's
+  std::string truth;  ///< the world's category of the object perceived there ("" if none)
+  Eigen::Vector2d to = Eigen::Vector2d::Zero();
+  std::string grasp;  ///< "top" / "side", or "" when none was planned
+  std::vector<OperatorTime> operators;
+  bool done = false;     ///< the execution manager finished the move
+  bool arrived = false;  ///< the world's object now rests within 5 cm of the spot
+  bool held = false;     ///< the world's object was in the hand at some point (ground truth)
+  std::string failure;   ///< why not (an abort's reason, a planning refusal, ...)
+  double seconds = 0.0;
+  std::vector<std::string> decisions;  ///< the manager's log: "t phase -> phase: why"
+};
+
+struct StayReport {
+  std::uint32_t track = 0;
+  std::string label;
+  std::string truth;
+  std::string reason;
+};
+
+struct TableTaskReport {
+  std::string task;
+  std::uint64_t seed = 0;
+  std::vector<std::string> scene;  ///< the world's objects' categories at the start
+  std::size_t taught = 0;          ///< teaches the learner acknowledged
+  std::size_t recognised = 0;      ///< objects whose label at planning time equals their truth
+  std::size_t perceived = 0;       ///< described objects at planning time
+  std::string refused;             ///< why the task was refused before it started
+  std::string stopped;             ///< why the task stopped before its last move
+  std::vector<MoveReport> moves;
+  std::vector<StayReport> stays;
+  std::uint64_t frames = 0;
+  double seconds = 0.0;            ///< simulated
+  std::uint64_t body_dropped = 0;  ///< frames the body filter dropped (no fresh arm state)
+  std::size_t fallen = 0;          ///< objects that fell off the table
+  [[nodiscard]] std::size_t arrived() const noexcept;
+};
+
+/// @brief Runs one task. @return the report, or why the loop could not be built (a graph error).
+[[nodiscard]] Result<TableTaskReport, std::string> run_table_task(const TableTaskConfig& config);
+
+/// @brief The camera pose the synthetic table implies (the arm's base on the table, 0.283 m
+/// beyond its centre, its z up, its y away from the camera): config/robot_frames_synthetic.yaml.
+[[nodiscard]] Eigen::Isometry3d synthetic_base_from_camera(const simulation::TableSpec& table);
+
+}  // namespace orthoflow::graphs

@@ -1,0 +1,59 @@
+#include "graphs/world_source.hpp"
+
+#include <algorithm>
+#include <memory>
+
+#include "graphs/frame_source.hpp"
+#include "graphs/node_support.hpp"
+#include "simulation/object_catalog.hpp"
+
+namespace orthoflow::graphs {
+
+namespace {
+
+class WorldSource final : public FrameSource {
+ public:
+  WorldSource(std::size_t capacity, const engine::NodeContext& context, WorldFeed& feed)
+      : FrameSource(capacity, context), feed_(feed) {
+    cloud_.reserve(640 * 480);
+  }
+  engine::SourceStatus produce(engine::Message& out) noexcept override {
+    const simulation::Scene* scene = feed_.next_frame(cloud_);
+    if (scene == nullptr) return engine::SourceStatus::END;
+    if (!take_block(out)) return engine::SourceStatus::FRAME;
+    emit_cloud(out, cloud_);
+    FrameState& s = block_of(out, capacity_).state();
+    const auto& objects = scene->objects;
+    s.truth_count = static_cast<std::uint32_t>(std::min(objects.size(), MAX_TRUTH));
+    for (std::uint32_t k = 0; k < s.truth_count; ++k) {
+      s.truth[k].label = simulation::OBJECT_LABEL_BASE + objects[k].id;
+      s.truth[k].category.assign(simulation::category_name(objects[k].model.category));
+    }
+    return engine::SourceStatus::FRAME;
+  }
+
+ private:
+  WorldFeed& feed_;
+  kernels::PointCloud cloud_;
+};
+
+}  // namespace
+
+void add_world_source_node(engine::NodeRegistry& registry, WorldFeed* feed) {
+  registry.add(
+      "world_source",
+      "frames of the closed-loop simulated world of this process (orthoflow demo); no "
+      "parameters",
+      [feed](const engine::ParamMap& params, const engine::NodeContext& context) -> NodeResult {
+        if (feed == nullptr)
+          return err(
+              std::string("world_source: no closed-loop world in this process (orthoflow demo has "
+                          "one)"));
+        if (auto ok = params.only({}); !ok) return err(ok.error());
+        auto capacity = frame_capacity(context);
+        if (!capacity) return err(capacity.error());
+        return std::unique_ptr<engine::Node>(new WorldSource(*capacity, context, *feed));
+      });
+}
+
+}  // namespace orthoflow::graphs
