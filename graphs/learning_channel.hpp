@@ -20,6 +20,10 @@
 namespace orthoflow::graphs {
 
 /// @brief What a sender asks of the learning channel.
+/// @brief A TEACH by position names the object whose centroid is nearest, if it is this near: a
+/// person pointing at something the robot does not see must not teach its neighbour.
+inline constexpr float TEACH_POSITION_MAX_M = 0.15F;
+
 struct LearningCommand {
   enum class Kind : std::uint8_t {
     TEACH,    ///< store the object's key views (and current view) under label; by track or by
@@ -30,8 +34,9 @@ struct LearningCommand {
     UNDO,     ///< take back the most recent teach or correct not undone yet (from any sender)
   };
   Kind kind = Kind::TEACH;
-  std::uint32_t track_id = 0;       ///< TEACH (when not by_position), CORRECT, ASK
-  bool by_position = false;         ///< TEACH: the object whose centroid is nearest to position
+  std::uint32_t track_id = 0;  ///< TEACH (when not by_position), CORRECT, ASK
+  bool by_position = false;    ///< TEACH: the object whose centroid is nearest to position (within
+                               ///< TEACH_POSITION_MAX_M; none nearer: NO_SUCH_TRACK)
   std::array<float, 3> position{};  ///< sensor frame, metres
   core::Text
       label;  ///< TEACH, CORRECT, FORGET: fill with label.try_assign() (refuses what would be cut)

@@ -15,7 +15,8 @@ LessonDesk::LessonDesk(LearningService& service, TrackMemories& memories)
       lesson_(MAX_TEACH_VIEWS * service.descriptor_length()) {}
 
 // The object a command names: by track id (its main piece, not a fragment, when both are in the
-// frame), or the one whose centroid is nearest to the position. -1 when there is none.
+// frame), or the one whose centroid is nearest to the position, within TEACH_POSITION_MAX_M. -1
+// when there is none.
 std::int64_t LessonDesk::find_object(const FrameState& s, const LearningCommand& c) const noexcept {
   std::int64_t best = -1;
   float best_d = 1e30F;
@@ -28,7 +29,7 @@ std::int64_t LessonDesk::find_object(const FrameState& s, const LearningCommand&
     const float dx = o.stats.centroid[0] - c.position[0], dy = o.stats.centroid[1] - c.position[1],
                 dz = o.stats.centroid[2] - c.position[2];
     const float d = std::sqrt(dx * dx + dy * dy + dz * dz);
-    if (d < best_d) {
+    if (d < best_d && d <= TEACH_POSITION_MAX_M) {
       best_d = d;
       best = k;
     }

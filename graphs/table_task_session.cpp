@@ -51,7 +51,9 @@ const char* to_string(TaskEvent event) noexcept {
 
 manipulation::ExecutionLimits TableTaskConfig::default_limits() noexcept {
   manipulation::ExecutionLimits limits;
-  limits.target_lost_ns = 10'000'000'000;
+  limits.target_lost_ns = 5'000'000'000;
+  for (const Phase p : {Phase::APPROACH, Phase::LIFT, Phase::PLACE, Phase::RETREAT})
+    limits.timeout_ns[static_cast<std::size_t>(p)] = 20'000'000'000;
   limits.obstacle_clearance_m = 0.02;
   limits.target_moved_m = 0.06;
   return limits;
@@ -348,7 +350,9 @@ void Session::plan_task() {
 void Session::start_move() {
   MoveReport& r = report_.moves[move_];
   const Seen* s = find_seen(r.track, planned_[move_]);
-  if (s != nullptr && s->label != r.label) s = nullptr;
+  // A track's label flickers to Unknown in some frames (the tracker's fragments); another label is
+  // another object.
+  if (s != nullptr && !s->label.empty() && s->label != r.label) s = nullptr;
   if (s == nullptr) {
     // The arm may hide it, or the tracker may be re-forming its track: look again for 3 s.
     if (++unseen_frames_ < 30) {
@@ -521,6 +525,7 @@ void Session::arm_cycle() noexcept {
         in.target_centre = o.centre;
       }
     }
+    in.target_hidden = !in.target_seen && (target_centre_ - tool_base).norm() < HAND_HIDES_M;
     in.others = std::span(others_).first(fill_obstacles(tool_base, holding));
     manipulation::ArmInput a;
     a.joints = s.joints;
@@ -670,6 +675,7 @@ Result<TableTaskReport, std::string> Session::run() {
       node.kind = "world_source";
       node.params = {};
     }
+    if (node.kind == "recognise") node.params.assign("instructor", "0");  // the person teaches
   }
   spec->period_ns = 0;      // simulated time: as fast as the graph goes
   spec->max_in_flight = 1;  // lock step: each frame's objects arrive before the next frame

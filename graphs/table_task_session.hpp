@@ -74,9 +74,11 @@ struct TableTaskConfig {
   /// Called after every frame's objects arrived (the picture sequence); may be empty.
   std::function<void(const TaskFrameView&)> on_frame;
 
-  /// @brief The manager's limits for a closed loop with the body filter: the hand's own filter
-  /// hides the target in the last centimetres of the approach, so a target is lost only after 5 s
-  /// unseen.
+  /// @brief The manager's limits for this loop: a target unseen for 5 s (not counting while the
+  /// hand hides it) is lost, one 6 cm from its plan has moved (a partial view's box shifts by a few
+  /// centimetres), obstacles need 2 cm of clearance (they are covered by small spheres,
+  /// manipulation::cover_box), and the slow phases near the table (approach, lift, place, retreat
+  /// at 0.3 of the speed cap) get 20 s.
   [[nodiscard]] static manipulation::ExecutionLimits default_limits() noexcept;
 };
 

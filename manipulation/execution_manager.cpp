@@ -271,7 +271,7 @@ ArmRequest ExecutionManager::step(std::int64_t now_ns, const ArmInput& arm,
     return abort(now_ns, AbortReason::PERCEPTION_STALE, "perception is older than its limit");
   const bool before_hold =
       phase_ == Phase::PRE_GRASP || phase_ == Phase::APPROACH || phase_ == Phase::CLOSE;
-  if (perception.target_seen)
+  if (perception.target_seen || perception.target_hidden)
     target_last_seen_ns_ = std::max(target_last_seen_ns_, perception.stamp_ns);
   if (before_hold) {
     if (now_ns - target_last_seen_ns_ > limits_.target_lost_ns)

@@ -124,6 +124,9 @@ struct Obstacle {
 struct PerceptionInput {
   std::int64_t stamp_ns = 0;  ///< time of the frame the objects come from (0: none yet)
   bool target_seen = false;   ///< the target's track is in that frame
+  /// The target is not seen because the hand is where it is (the camera sees the hand, the body
+  /// filter removes what is near it): not evidence that it is gone, so the lost timer waits.
+  bool target_hidden = false;
   Eigen::Vector3d target_centre = Eigen::Vector3d::Zero();  ///< base frame
   std::span<const Obstacle> others{};
 };

@@ -184,6 +184,23 @@ void teach_correct_forget(LearningService& learning, Outcome stored) {
   auto missing = teacher.call(command(LearningCommand::Kind::TEACH, 99999, "gamma"));
   ASSERT_TRUE(missing);
   EXPECT_EQ(missing->outcome, Outcome::NO_SUCH_TRACK);
+  // by position: a point near the object's centroid teaches it; one farther than
+  // TEACH_POSITION_MAX_M from every object teaches nothing (never the nearest neighbour)
+  const engine::ObjectEntry* here = entry_of(teacher.last(), track);
+  ASSERT_NE(here, nullptr);
+  LearningCommand near = command(LearningCommand::Kind::TEACH, 0, "gamma");
+  near.by_position = true;
+  near.position = {here->centroid[0] + 0.02F, here->centroid[1], here->centroid[2]};
+  auto pointed = teacher.call(near);
+  ASSERT_TRUE(pointed);
+  EXPECT_EQ(pointed->outcome, stored) << to_string(pointed->outcome);
+  EXPECT_EQ(pointed->track_id, track);
+  LearningCommand far = near;
+  far.position = {here->centroid[0], here->centroid[1] - 5.0F, here->centroid[2]};
+  auto nowhere = teacher.call(far);
+  ASSERT_TRUE(nowhere);
+  EXPECT_EQ(nowhere->outcome, Outcome::NO_SUCH_TRACK);
+  ASSERT_TRUE(teacher.call(command(LearningCommand::Kind::FORGET, 0, "gamma")));
   engine.request_stop();
   runner.join();
   EXPECT_EQ(learning.commands_dropped(), 0U);

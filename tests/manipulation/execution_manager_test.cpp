@@ -227,6 +227,21 @@ TEST(ExecutionManager, ALostTrackStopsTheArm) {
   EXPECT_EQ(manager.phase(), Phase::ABORTED);
 }
 
+TEST(ExecutionManager, ATargetHiddenByTheHandIsNotLost) {
+  World world;
+  ExecutionManager manager;
+  world.event = [](World& w, const ExecutionManager& m) {
+    // From the pre-grasp on, the camera sees only the hand where the mug is.
+    if (m.phase() == Phase::PRE_GRASP) {
+      w.mug_visible = false;
+      w.perception.target_hidden = true;
+    }
+  };
+  world.run(manager, mug_job());
+  EXPECT_EQ(manager.phase(), Phase::DONE) << log_text(manager);
+  EXPECT_EQ(manager.abort_reason(), AbortReason::NONE);
+}
+
 TEST(ExecutionManager, AnObstacleWhileCarryingStopsAndHolds) {
   World world;
   ExecutionManager manager;
