@@ -50,6 +50,7 @@ nlohmann::json to_json(const graphs::TableTaskReport& r) {
                      {"done", m.done},
                      {"arrived", m.arrived},
                      {"held", m.held},
+                     {"error_m", m.error_m},
                      {"failure", m.failure},
                      {"seconds", m.seconds},
                      {"decisions", m.decisions}});

@@ -162,7 +162,8 @@ class Session final : public WorldFeed {
   int target_object_ = -1;  // world object id of the current move's target
   std::uint32_t target_track_ = 0;
   Vector3d target_centre_ = Vector3d::Zero();
-  std::vector<Vector3d> planned_;  // each move's object centre at planning time
+  Vector3d target_start_ = Vector3d::Zero();  // the world's object centre at the move's start
+  std::vector<Vector3d> planned_;             // each move's object centre at planning time
   Isometry3d camera_from_base_ = Isometry3d::Identity();
   bool event_fired_ = false, perception_dead_ = false;
   bool was_holding_ = false;  // the manager held the object at its last step
@@ -383,12 +384,22 @@ void Session::start_move() {
   // The best grasp whose way in (tool now -> pre-grasp -> grasp) keeps clear of the other objects.
   target_track_ = s->track;
   target_centre_ = s->centre;
-  const Vector3d tool = jaco::forward_kinematics(g.seed).translation();
+  // Each job starts from the initial pose: its way to the pre-grasp starts there.
+  const Vector3d tool = jaco::forward_kinematics(job_options_.initial).translation();
   const auto obstacles =
       std::span<const manipulation::Obstacle>(others_).first(fill_obstacles(tool, false));
   // The best grasp whose way in (tool now -> pre-grasp -> grasp) keeps clear of the other objects
   // and whose whole job the arm reaches.
   const Vector3d place(r.to.x(), r.to.y(), s->centre.z());
+  // Carry high enough that the hand passes 10 cm above the tallest other object (0.15-0.30 m).
+  double tallest = 0.0;
+  for (const Seen& o : seen_) {
+    if (!is_target(o))
+      tallest =
+          std::max(tallest, job_options_.grasp.table.height_of(o.centre) + 0.5 * o.box.extents.z());
+  }
+  job_options_.lift_m =
+      std::clamp(tallest + 0.10 - job_options_.grasp.table.height_of(s->centre), 0.15, 0.30);
   const double clear = config_.limits.obstacle_clearance_m;
   std::optional<manipulation::PickPlaceJob> job;
   std::string why = "every feasible grasp's way in passes another object";
@@ -412,12 +423,13 @@ void Session::start_move() {
     return;
   }
   target_object_ = -1;  // the world's object there (to check where it ends up)
-  double best = 0.06;
+  double best = 0.10;
   for (std::size_t i = 0; i < world_->scene().objects.size(); ++i) {
     const double d = (to_base(world_->centre(i)) - s->centre).head<2>().norm();
     if (d < best) {
       best = d;
       target_object_ = static_cast<int>(world_->scene().objects[i].id);
+      target_start_ = to_base(world_->centre(i));
     }
   }
   move_start_ns_ = now();
@@ -449,7 +461,12 @@ void Session::finish_move() {
   if (index >= 0 && world_->held() != index) {
     const auto i = static_cast<std::size_t>(index);
     const Vector3d c = to_base(world_->centre(i));
-    r.arrived = world_->scene().objects[i].base_m == 0.0 && (c.head<2>() - r.to).norm() < ARRIVED_M;
+    // Moved as planned: the object's own displacement is the plan's (spot minus the perceived
+    // centre) within ARRIVED_M. (Its model origin is not its perceived centre: a mug's box holds
+    // its handle.)
+    const Vector2d planned = r.to - target_centre_.head<2>();
+    r.error_m = ((c - target_start_).head<2>() - planned).norm();
+    r.arrived = world_->scene().objects[i].base_m == 0.0 && r.error_m < ARRIVED_M;
   }
   const manipulation::AbortReason why = manager_.abort_reason();
   ++move_;

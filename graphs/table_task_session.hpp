@@ -95,10 +95,13 @@ struct MoveReport {
   Eigen::Vector2d to = Eigen::Vector2d::Zero();
   std::string grasp;  ///< "top" / "side", or "" when none was planned
   std::vector<OperatorTime> operators;
-  bool done = false;     ///< the execution manager finished the move
-  bool arrived = false;  ///< the world's object now rests within 5 cm of the spot
-  bool held = false;     ///< the world's object was in the hand at some point (ground truth)
-  std::string failure;   ///< why not (an abort's reason, a planning refusal, ...)
+  bool done = false;  ///< the execution manager finished the move
+  /// The world's object rests on the table, moved as planned within 5 cm: its displacement is the
+  /// spot minus its perceived centre (ground truth, what a person watching would judge).
+  bool arrived = false;
+  double error_m = -1.0;  ///< that displacement's error (m); -1 when it was not moved
+  bool held = false;      ///< the world's object was in the hand at some point (ground truth)
+  std::string failure;    ///< why not (an abort's reason, a planning refusal, ...)
   double seconds = 0.0;
   std::vector<std::string> decisions;  ///< the manager's log: "t phase -> phase: why"
 };

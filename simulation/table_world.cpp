@@ -50,6 +50,7 @@ void TableWorld::update(const Vec3& tool, double opening_m) noexcept {
       release();
       return;
     }
+    grip_opening_ = std::min(grip_opening_, opening_m);  // the fingers squeeze it
     PlacedObject& o = scene_.objects[static_cast<std::size_t>(held_)];
     o.table_x = local[0] + grip_offset_[0];
     o.table_y = local[1] + grip_offset_[1];

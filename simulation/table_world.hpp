@@ -11,10 +11,10 @@
 /// - **Holding:** a held object keeps its offset from the tool point (in table coordinates) and
 ///   stays upright (its yaw does not change: the planner keeps a grasped object parallel to the
 ///   table); it never goes below the table.
-/// - **Release:** when the fingers open RELEASE_MARGIN_M wider than where they closed on it, it
-/// drops
-///   straight down and rests on the table (stacking on another object is not modelled); one
-///   released beyond the table's edge falls to the floor and leaves the scene (counted).
+/// - **Release:** when the fingers open RELEASE_MARGIN_M wider than the narrowest they closed to
+///   while holding it, it drops straight down and rests on the table (stacking on another object is
+///   not modelled); one released beyond the table's edge falls to the floor and leaves the scene
+///   (counted).
 /// - Not modelled: the hand or the arm pushing an object, objects pushing each other.
 /// Deterministic; no allocation in update().
 #include <cstddef>
@@ -67,7 +67,7 @@ class TableWorld {
   TableFrame frame_{};
   int held_ = -1;
   Vec3 grip_offset_{};  ///< held object's (x, y, base) minus the tool's (x, y, up), table frame
-  double grip_opening_ = 0.0;  ///< the opening at which the held object was taken
+  double grip_opening_ = 0.0;  ///< the narrowest opening since the held object was taken
   double last_opening_ = std::numeric_limits<double>::quiet_NaN();  ///< the previous update's
   std::size_t fallen_ = 0;
 };
