@@ -2,7 +2,9 @@
 /// @file
 /// @brief (internal) FrameSource: the base of the graph's frame sources (source_nodes.cpp,
 /// kinect_source.cpp): one output port, a pool block per frame, the cloud written in place.
+#include <algorithm>
 #include <new>
+#include <span>
 #include <string_view>
 
 #include "engine/frame_payload.hpp"
@@ -10,6 +12,8 @@
 #include "graphs/frame_block.hpp"
 #include "graphs/node_support.hpp"
 #include "kernels/point_cloud.hpp"
+#include "simulation/object_catalog.hpp"
+#include "simulation/synthetic_scene.hpp"
 
 namespace orthoflow::graphs {
 
@@ -37,6 +41,16 @@ class FrameSource : public engine::Node {
     }
     out.payload = std::move(*block);
     return true;
+  }
+  /// The ground truth of a synthetic frame: each object's label and category.
+  void write_truth(engine::Message& out,
+                   std::span<const simulation::PlacedObject> objects) const noexcept {
+    FrameState& s = block_of(out, capacity_).state();
+    s.truth_count = static_cast<std::uint32_t>(std::min(objects.size(), MAX_TRUTH));
+    for (std::uint32_t k = 0; k < s.truth_count; ++k) {
+      s.truth[k].label = simulation::OBJECT_LABEL_BASE + objects[k].id;
+      s.truth[k].category.assign(simulation::category_name(objects[k].model.category));
+    }
   }
   /// Writes @p cloud into the message's block and clears the per-frame state.
   bool emit_cloud(engine::Message& out, const kernels::PointCloud& cloud) noexcept {

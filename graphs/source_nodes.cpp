@@ -36,13 +36,7 @@ class SyntheticSource final : public FrameSource {
     if (!take_block(out)) return engine::SourceStatus::FRAME;
     cloud_.info.host_stamp_ns = Clock::now().time_since_epoch().count();
     emit_cloud(out, cloud_);
-    FrameState& s = block_of(out, capacity_).state();
-    const auto& objects = sequence_.scene().objects;
-    s.truth_count = static_cast<std::uint32_t>(std::min(objects.size(), MAX_TRUTH));
-    for (std::uint32_t k = 0; k < s.truth_count; ++k) {
-      s.truth[k].label = simulation::OBJECT_LABEL_BASE + objects[k].id;
-      s.truth[k].category.assign(simulation::category_name(objects[k].model.category));
-    }
+    write_truth(out, sequence_.scene().objects);
     return engine::SourceStatus::FRAME;
   }
 

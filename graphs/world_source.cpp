@@ -1,11 +1,9 @@
 #include "graphs/world_source.hpp"
 
-#include <algorithm>
 #include <memory>
 
 #include "graphs/frame_source.hpp"
 #include "graphs/node_support.hpp"
-#include "simulation/object_catalog.hpp"
 
 namespace orthoflow::graphs {
 
@@ -22,13 +20,7 @@ class WorldSource final : public FrameSource {
     if (scene == nullptr) return engine::SourceStatus::END;
     if (!take_block(out)) return engine::SourceStatus::FRAME;
     emit_cloud(out, cloud_);
-    FrameState& s = block_of(out, capacity_).state();
-    const auto& objects = scene->objects;
-    s.truth_count = static_cast<std::uint32_t>(std::min(objects.size(), MAX_TRUTH));
-    for (std::uint32_t k = 0; k < s.truth_count; ++k) {
-      s.truth[k].label = simulation::OBJECT_LABEL_BASE + objects[k].id;
-      s.truth[k].category.assign(simulation::category_name(objects[k].model.category));
-    }
+    write_truth(out, scene->objects);
     return engine::SourceStatus::FRAME;
   }
 

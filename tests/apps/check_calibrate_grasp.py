@@ -1,6 +1,7 @@
 """`orthoflow calibrate hand-eye|simulate-samples` and `orthoflow grasp` (issue 21): the camera's pose
 recovered from a simulated rig's samples file within 2 mm and 0.5 degrees, refusals of bad sample
-files with the line, and grasp plans of the embedded session's objects in the arm's base frame."""
+files with the line, grasp plans of the embedded session's objects in the arm's base frame, and
+`orthoflow demo`'s refusals and pictures."""
 import json
 import math
 import os
@@ -127,4 +128,19 @@ with tempfile.TemporaryDirectory() as tmp:
     open(broken, "w").write('{"objects": 1}\n')
     p = run(cli, "grasp", "--robot-frames", frames_yaml, "--objects", broken, code=EXIT_BAD_INPUT)
     expect("broken.jsonl:1: objects: not a list" in p.stderr, p.stderr)
+    # `orthoflow demo`: a category nobody taught is refused (exit 1, the reason on stdout and in JSON);
+    # serve-a-meal needs its categories; the pictures go where asked.
+    p = run(cli, "demo", "serve-a-meal", "--categories", "pizza", "--seed", "3", "--json", code=EXIT_FAILURE)
+    report = json.loads(p.stdout)
+    expect(report["runs"][0]["refused"] == "nobody taught the category 'pizza'" and not report["runs"][0]["moves"],
+           p.stdout)
+    expect(1 <= report["runs"][0]["taught"] <= len(report["runs"][0]["scene"]), p.stdout)
+    p = run(cli, "demo", "serve-a-meal", code=None)
+    expect(p.returncode != 0 and "needs --categories" in p.stderr, p.stderr)
+    pictures = os.path.join(tmp, "pictures")
+    run(cli, "demo", "serve-a-meal", "--categories", "pizza", "--pictures", pictures, "--picture-every", "10",
+        code=EXIT_FAILURE)
+    pngs = sorted(os.listdir(pictures))
+    expect(pngs and pngs[0] == "frame00000.png" and open(os.path.join(pictures, pngs[0]), "rb").read(4) == b"\x89PNG",
+           f"pictures: {pngs}")
 print("ok")
