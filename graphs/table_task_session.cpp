@@ -108,6 +108,9 @@ class Session final : public WorldFeed {
   enum class Stage { SETTLE, TEACH, RECOGNISE, MOVE, RUNNING, FINISH, END };
 
   Result<void, std::string> build_world();
+  /// The seeded table: make_scene's objects on the robot frames' table, clear of the arm's base
+  /// column and of the placing area / the user's place, up to config_.objects.
+  [[nodiscard]] simulation::Scene draw_scene(std::uint64_t seed);
   Result<void, std::string> open_arm();
   void take_objects() noexcept;
   void advance_stage();
@@ -120,9 +123,10 @@ class Session final : public WorldFeed {
   /// Writes every object's spheres into others_ but the target's (and, @p holding, those near
   /// @p hand: pieces of the object in it). @return how many.
   std::size_t fill_obstacles(const Vector3d& hand, bool holding);
-  [[nodiscard]] bool is_target(const Seen& o) const {
-    return o.track == target_track_ || (o.centre - target_centre_).norm() < 0.03;
-  }
+  /// The target in the newest objects: its track; else (renumbered, or moved by someone) the
+  /// nearest object of its label within 15 cm of where it was planned, or anything within 3 cm.
+  [[nodiscard]] const Seen* current_target() const;
+  [[nodiscard]] bool is_target(const Seen& o) const { return &o == current_target(); }
   [[nodiscard]] const Seen* find_seen(std::uint32_t track, const Vector3d& near) const;
   [[nodiscard]] std::string truth_near(const Vector3d& base_point) const;
   [[nodiscard]] std::int64_t now() const noexcept { return sim_.clock().now_ns(); }
@@ -162,8 +166,9 @@ class Session final : public WorldFeed {
   int target_object_ = -1;  // world object id of the current move's target
   std::uint32_t target_track_ = 0;
   Vector3d target_centre_ = Vector3d::Zero();
-  Vector3d target_start_ = Vector3d::Zero();  // the world's object centre at the move's start
-  std::vector<Vector3d> planned_;             // each move's object centre at planning time
+  Vector3d target_start_ = Vector3d::Zero();
+  std::string target_label_;       // the world's object centre at the move's start
+  std::vector<Vector3d> planned_;  // each move's object centre at planning time
   Isometry3d camera_from_base_ = Isometry3d::Identity();
   bool event_fired_ = false, perception_dead_ = false;
   bool was_holding_ = false;  // the manager held the object at its last step
@@ -172,12 +177,12 @@ class Session final : public WorldFeed {
   std::array<kernels::Capsule, manipulation::ARM_BODY_CAPSULES> capsules_{};
 };
 
-Result<void, std::string> Session::build_world() {
+simulation::Scene Session::draw_scene(std::uint64_t seed) {
   simulation::SceneConfig scene_config;
   scene_config.objects =
       std::min<std::uint32_t>(config_.objects + 6, simulation::MAX_SCENE_OBJECTS);
   scene_config.categories = config_.categories.empty() ? default_categories() : config_.categories;
-  simulation::Scene scene = simulation::make_scene(scene_config, config_.seed);
+  simulation::Scene scene = simulation::make_scene(scene_config, seed);
   scene.table = simulation::TableSpec{};  // the table the robot frames assume
   base_from_camera_ = synthetic_base_from_camera(scene.table);
   const simulation::TableFrame frame = simulation::table_frame(scene.table);
@@ -202,6 +207,27 @@ Result<void, std::string> Session::build_world() {
     if (on_table && free && at.norm() > 0.30 && kept.size() < config_.objects) kept.push_back(o);
   }
   scene.objects = std::move(kept);
+  return scene;
+}
+
+Result<void, std::string> Session::build_world() {
+  // serve_a_meal: the scene is drawn again (seed + 1000 k, at most 50 times) until it holds every
+  // category asked for, so that the task has something to serve (none does: the first draw).
+  simulation::Scene scene = draw_scene(config_.seed);
+  for (std::uint64_t draw = 0; draw < 50 && config_.task == TableTask::SERVE_A_MEAL; ++draw) {
+    simulation::Scene candidate = draw == 0 ? scene : draw_scene(config_.seed + 1000 * draw);
+    bool all = true;
+    for (const std::string& want : config_.bring) {
+      all = all && std::any_of(candidate.objects.begin(), candidate.objects.end(),
+                               [&](const simulation::PlacedObject& o) {
+                                 return want == simulation::category_name(o.model.category);
+                               });
+    }
+    if (all) {
+      scene = std::move(candidate);
+      break;
+    }
+  }
   for (std::size_t i = 0; i < scene.objects.size(); ++i) {
     scene.objects[i].id = static_cast<std::uint32_t>(i);
     report_.scene.emplace_back(simulation::category_name(scene.objects[i].model.category));
@@ -256,6 +282,20 @@ std::size_t Session::fill_obstacles(const Vector3d& hand, bool holding) {
           o.box, std::span(others_).subspan(used, manipulation::MAX_BOX_SPHERES));
   }
   return used;
+}
+
+const Seen* Session::current_target() const {
+  const Seen* best = nullptr;
+  double best_d = 0.0;
+  for (const Seen& o : seen_) {
+    if (o.track == target_track_) return &o;
+    const double d = (o.centre - target_centre_).norm();
+    if ((d < 0.03 || (d < 0.15 && o.label == target_label_)) && (best == nullptr || d < best_d)) {
+      best = &o;
+      best_d = d;
+    }
+  }
+  return best;
 }
 
 const Seen* Session::find_seen(std::uint32_t track, const Vector3d& near) const {
@@ -384,6 +424,7 @@ void Session::start_move() {
   // The best grasp whose way in (tool now -> pre-grasp -> grasp) keeps clear of the other objects.
   target_track_ = s->track;
   target_centre_ = s->centre;
+  target_label_ = r.label;
   // Each job starts from the initial pose: its way to the pre-grasp starts there.
   const Vector3d tool = jaco::forward_kinematics(job_options_.initial).translation();
   const auto obstacles =
