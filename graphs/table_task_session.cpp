@@ -126,7 +126,12 @@ class Session final : public WorldFeed {
   /// The target in the newest objects: its track; else (renumbered, or moved by someone) the
   /// nearest object of its label within 15 cm of where it was planned, or anything within 3 cm.
   [[nodiscard]] const Seen* current_target() const;
-  [[nodiscard]] bool is_target(const Seen& o) const { return &o == current_target(); }
+  /// The target or a piece of it (the tracker's fragments near it): never an obstacle.
+  [[nodiscard]] bool is_target(const Seen& o) const {
+    const Seen* t = current_target();
+    return &o == t || o.track == target_track_ || (o.centre - target_centre_).norm() < 0.03 ||
+           (t != nullptr && (o.centre - t->centre).norm() < 0.03);
+  }
   [[nodiscard]] const Seen* find_seen(std::uint32_t track, const Vector3d& near) const;
   [[nodiscard]] std::string truth_near(const Vector3d& base_point) const;
   [[nodiscard]] std::int64_t now() const noexcept { return sim_.clock().now_ns(); }
@@ -576,12 +581,11 @@ void Session::arm_cycle() noexcept {
     manipulation::PerceptionInput in;
     in.stamp_ns = seen_stamp_ns_;
     const bool holding = world_->held() >= 0;
-    for (const Seen& o : seen_) {
-      // The hand's own filter cuts a target it is about to take: that view is not evidence.
-      if (is_target(o) && (o.centre - tool_base).norm() > HAND_HIDES_M && !in.target_seen) {
-        in.target_seen = true;
-        in.target_centre = o.centre;
-      }
+    // The hand's own filter cuts a target it is about to take: that view is not evidence.
+    if (const Seen* t = current_target();
+        t != nullptr && (t->centre - tool_base).norm() > HAND_HIDES_M) {
+      in.target_seen = true;
+      in.target_centre = t->centre;
     }
     in.target_hidden = !in.target_seen && (target_centre_ - tool_base).norm() < HAND_HIDES_M;
     in.others = std::span(others_).first(fill_obstacles(tool_base, holding));
