@@ -51,6 +51,7 @@ Result<void, std::string> write_demo_picture(const graphs::TaskFrameView& view,
   }
   if (marks.user_place != nullptr) {
     cairo_set_source_rgb(c, 0.2, 0.55, 0.2);
+    cairo_new_path(c);
     cairo_arc(c, px(marks.user_place->x()), py(marks.user_place->y()), 0.06 * SCALE, 0, 6.2832);
     cairo_stroke(c);
   }
@@ -62,6 +63,7 @@ Result<void, std::string> write_demo_picture(const graphs::TaskFrameView& view,
     const std::uint32_t rgb = o.model.rgb;
     cairo_set_source_rgb(c, ((rgb >> 16) & 0xFF) / 255.0, ((rgb >> 8) & 0xFF) / 255.0,
                          (rgb & 0xFF) / 255.0);
+    cairo_new_path(c);  // no line from the previous label
     cairo_arc(c, px(p.x()), py(p.y()), o.model.footprint_radius * SCALE, 0, 6.2832);
     static_cast<int>(o.id) == view.held_object_id ? cairo_fill(c) : cairo_stroke(c);
     cairo_set_source_rgb(c, 0.05, 0.05, 0.05);
@@ -72,6 +74,7 @@ Result<void, std::string> write_demo_picture(const graphs::TaskFrameView& view,
   cairo_set_line_cap(c, CAIRO_LINE_CAP_ROUND);
   for (const simulation::BodyCapsule& b : view.scene->robot) {
     const Eigen::Vector3d a = base(x, b.a), e = base(x, b.b);
+    cairo_new_path(c);
     cairo_set_line_width(c, 2.0 * b.radius * SCALE);
     cairo_move_to(c, px(a.x()), py(a.y()));
     cairo_line_to(c, px(e.x()), py(e.y()));
