@@ -126,9 +126,9 @@ class Session final : public WorldFeed {
   /// The target in the newest objects: its track; else (renumbered, or moved by someone) the
   /// nearest object of its label within 15 cm of where it was planned, or anything within 3 cm.
   [[nodiscard]] const Seen* current_target() const;
-  /// The target or a piece of it (the tracker's fragments near it): never an obstacle.
-  [[nodiscard]] bool is_target(const Seen& o) const {
-    const Seen* t = current_target();
+  /// The target @p t (current_target(), found once per use) or a piece of it (the tracker's
+  /// fragments near it): never an obstacle.
+  [[nodiscard]] bool is_target(const Seen& o, const Seen* t) const {
     return &o == t || o.track == target_track_ || (o.centre - target_centre_).norm() < 0.03 ||
            (t != nullptr && (o.centre - t->centre).norm() < 0.03);
   }
@@ -171,8 +171,8 @@ class Session final : public WorldFeed {
   int target_object_ = -1;  // world object id of the current move's target
   std::uint32_t target_track_ = 0;
   Vector3d target_centre_ = Vector3d::Zero();
-  Vector3d target_start_ = Vector3d::Zero();
-  std::string target_label_;       // the world's object centre at the move's start
+  Vector3d target_start_ = Vector3d::Zero();  // the world's object centre at the move's start
+  std::string target_label_;
   std::vector<Vector3d> planned_;  // each move's object centre at planning time
   Isometry3d camera_from_base_ = Isometry3d::Identity();
   bool event_fired_ = false, perception_dead_ = false;
@@ -279,9 +279,10 @@ void Session::take_objects() noexcept {
 }
 
 std::size_t Session::fill_obstacles(const Vector3d& hand, bool holding) {
+  const Seen* target = current_target();
   std::size_t used = 0;
   for (const Seen& o : seen_) {
-    if (is_target(o) || (holding && (o.centre - hand).norm() < HAND_HIDES_M)) continue;
+    if (is_target(o, target) || (holding && (o.centre - hand).norm() < HAND_HIDES_M)) continue;
     if (used + manipulation::MAX_BOX_SPHERES <= others_.size())
       used += manipulation::cover_box(
           o.box, std::span(others_).subspan(used, manipulation::MAX_BOX_SPHERES));
@@ -439,8 +440,9 @@ void Session::start_move() {
   const Vector3d place(r.to.x(), r.to.y(), s->centre.z());
   // Carry high enough that the hand passes 10 cm above the tallest other object (0.15-0.30 m).
   double tallest = 0.0;
+  const Seen* target = current_target();
   for (const Seen& o : seen_) {
-    if (!is_target(o))
+    if (!is_target(o, target))
       tallest =
           std::max(tallest, job_options_.grasp.table.height_of(o.centre) + 0.5 * o.box.extents.z());
   }
@@ -656,8 +658,7 @@ void Session::advance_stage() {
         stage_frame_ = frame_;
       }
       break;
-    case Stage::RUNNING:
-      if (!manager_.running()) finish_move();
+    case Stage::RUNNING:  // next_frame finishes the move as soon as the manager ends
       break;
     case Stage::FINISH:
       if (frame_ - stage_frame_ >= 5) stage_ = Stage::END;
