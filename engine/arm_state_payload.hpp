@@ -13,7 +13,7 @@
 namespace orthoflow::engine {
 
 inline constexpr std::uint32_t ARM_STATE_TYPE_ID = 0x5341464FU;  ///< "OFAS" in little-endian bytes
-inline constexpr std::uint16_t ARM_STATE_VERSION = 1;
+inline constexpr std::uint16_t ARM_STATE_VERSION = 2;            ///< 2: held_m
 
 /// @brief Flags of ArmStatePayload::flags.
 inline constexpr std::uint32_t ARM_ESTOP = 1U << 0;  ///< the emergency stop is latched
@@ -40,6 +40,11 @@ struct alignas(64) ArmStatePayload {
   float currents_a[6];
   float voltage_v;
   float reserved2;
+  /// What the hand holds, written by whoever runs the task (the driver alone does not know): a
+  /// capsule whose ends are offsets from position_m in the base frame (ax, ay, az, bx, by, bz) and
+  /// its radius (m); radius 0: nothing held. The body filter removes it with the arm, so the held
+  /// object is never seen, nor merged with what it passes over, as an object on the table.
+  double held_m[7];
 
   /// @brief Writes type id, version and payload_bytes; zeroes the rest. No allocation.
   void reset() noexcept {

@@ -2,6 +2,7 @@
 // state, kernels::capsule_mask over the frame, NaN where the arm is.
 #include "graphs/body_filter_node.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstdlib>
@@ -32,6 +33,8 @@ const engine::PortSpec PORTS[] = {FRAME_IN, FRAME_OUT};
 /// Instructor zones at most (thesis: C_instructor, a configured region where a person's hands come
 /// in: nothing there is segmented, so nothing there is taught).
 constexpr std::size_t MAX_ZONES = 8;
+/// A held object wider than this is a bad word, not an object a JACO hand holds.
+constexpr double MAX_HELD_RADIUS_M = 0.3;
 static_assert(manipulation::ARM_BODY_CAPSULES + MAX_ZONES <= kernels::MAX_CAPSULES);
 
 struct BodyFilterSettings {
@@ -122,11 +125,13 @@ class BodyFilter final : public engine::Node {
     std::size_t count = 0;
     if (settings_.arm) {
       drivers::jaco::JointAngles joints{};
-      if (const Verdict v = joints_at(frame_ns, joints); v != Verdict::FILTERED) return v;
+      manipulation::HeldObject held;
+      if (const Verdict v = joints_at(frame_ns, joints, held); v != Verdict::FILTERED) return v;
       count = manipulation::arm_body_capsules(
           joints, settings_.base_from_camera, settings_.model, *settings_.geometry,
           std::span<kernels::Capsule, manipulation::ARM_BODY_CAPSULES>(
-              capsules.data(), manipulation::ARM_BODY_CAPSULES));
+              capsules.data(), manipulation::ARM_BODY_CAPSULES),
+          held);
     }
     for (std::size_t z = 0; z < settings_.zone_count; ++z) capsules[count++] = settings_.zones[z];
     const kernels::CloudView& cloud = frame->cloud;
@@ -164,7 +169,8 @@ class BodyFilter final : public engine::Node {
 
   /// The arm's joints at @p frame_ns: between the two states around it (linearly, when both lie
   /// within the age limit), else the nearest state's, if it is no further than the limit.
-  Verdict joints_at(std::int64_t frame_ns, drivers::jaco::JointAngles& joints) noexcept {
+  Verdict joints_at(std::int64_t frame_ns, drivers::jaco::JointAngles& joints,
+                    manipulation::HeldObject& held) noexcept {
     take_states();
     if (history_count_ == 0) return Verdict::NO_STATE;
     const engine::ArmStatePayload* before = nullptr;  // newest at or before the frame
@@ -201,6 +207,14 @@ class BodyFilter final : public engine::Node {
       // 10 ms apart, a joint moves a few degrees at most: a larger step is a wrap of a continuous
       // joint's reading, or a jump; the nearer sample is the safer one then.
       joints[j] = std::fabs(b - a) <= 30.0 ? a + w * (b - a) : nearest->joints_deg[j];
+    }
+    // What the hand holds: the nearest state's word (a capsule that is not finite is no capsule).
+    const double* h = nearest->held_m;
+    if (std::isfinite(h[6]) && h[6] > 0.0 && h[6] < MAX_HELD_RADIUS_M &&
+        std::all_of(h, h + 6, [](double v) { return std::isfinite(v) && std::fabs(v) < 1.0; })) {
+      held.a = Eigen::Vector3d(h[0], h[1], h[2]);
+      held.b = Eigen::Vector3d(h[3], h[4], h[5]);
+      held.radius_m = h[6];
     }
     return Verdict::FILTERED;
   }

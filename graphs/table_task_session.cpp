@@ -83,6 +83,10 @@ constexpr std::int64_t START_NS = 1'000'000'000;  // frame stamps must not be 0
 constexpr double ARRIVED_M = 0.05;
 /// Perceived objects this near the tool are cut by the hand's own body filter.
 constexpr double HAND_HIDES_M = 0.17;
+/// Planned paths keep this much more than the manager's clearance when they can.
+constexpr double PLAN_MARGIN_M = 0.02;
+/// The lowest lift a job is planned with (the grasp check wants the object half of it up).
+constexpr double LOWEST_LIFT_M = 0.10;
 
 std::vector<simulation::Category> default_categories() {
   using simulation::Category;
@@ -176,8 +180,9 @@ class Session final : public WorldFeed {
   std::vector<Vector3d> planned_;  // each move's object centre at planning time
   Isometry3d camera_from_base_ = Isometry3d::Identity();
   bool event_fired_ = false, perception_dead_ = false;
-  bool was_holding_ = false;  // the manager held the object at its last step
-  bool waiting_ = false;      // the next move waits for its object to be seen again
+  manipulation::HeldObject held_;  // the target as the hand will hold it
+  bool was_holding_ = false;       // the manager held the object at its last step
+  bool waiting_ = false;           // the next move waits for its object to be seen again
   std::uint32_t unseen_frames_ = 0;
   std::array<kernels::Capsule, manipulation::ARM_BODY_CAPSULES> capsules_{};
 };
@@ -427,16 +432,12 @@ void Session::start_move() {
     ++move_;
     return;
   }
-  // The best grasp whose way in (tool now -> pre-grasp -> grasp) keeps clear of the other objects.
   target_track_ = s->track;
   target_centre_ = s->centre;
   target_label_ = r.label;
-  // Each job starts from the initial pose: its way to the pre-grasp starts there.
   const Vector3d tool = jaco::forward_kinematics(job_options_.initial).translation();
   const auto obstacles =
       std::span<const manipulation::Obstacle>(others_).first(fill_obstacles(tool, false));
-  // The best grasp whose way in (tool now -> pre-grasp -> grasp) keeps clear of the other objects
-  // and whose whole job the arm reaches.
   const Vector3d place(r.to.x(), r.to.y(), s->centre.z());
   // Carry high enough that the hand passes 10 cm above the tallest other object (0.15-0.30 m).
   double tallest = 0.0;
@@ -446,24 +447,41 @@ void Session::start_move() {
       tallest =
           std::max(tallest, job_options_.grasp.table.height_of(o.centre) + 0.5 * o.box.extents.z());
   }
-  job_options_.lift_m =
+  const double wanted =
       std::clamp(tallest + 0.10 - job_options_.grasp.table.height_of(s->centre), 0.15, 0.30);
+  // Other lifts when that one's job is blocked or out of reach: higher to pass over, lower to
+  // reach.
+  const std::array<double, 5> lifts{wanted, wanted + 0.05, wanted + 0.10, wanted - 0.05,
+                                    LOWEST_LIFT_M};
   const double clear = config_.limits.obstacle_clearance_m;
+  const jaco::JointAngles arm_now = arm_->snapshot().joints;
   std::optional<manipulation::PickPlaceJob> job;
-  std::string why = "every feasible grasp's way in passes another object";
-  for (std::size_t k = 0; k < plan->feasible_count && !job; ++k) {
-    const manipulation::Grasp& c = plan->feasible[k];
-    if (manipulation::segment_blocked(tool, c.pre_grasp.translation(), obstacles, clear) ||
-        manipulation::segment_blocked(c.pre_grasp.translation(), c.grasp.translation(), obstacles,
-                                      clear))
-      continue;
-    auto made = manipulation::make_pick_place_job(s->track, s->centre, c, place, job_options_);
-    if (!made) {
-      why = "no job: " + made.error();
-      continue;
+  std::string why;  // why the preferred grasp and lift (the first tried) have no job
+  // The first grasp (best first) and lift whose every move keeps clear of the other objects along
+  // its joint-space path and inside the safety limits; with a margin first (a perceived box shifts
+  // by a centimetre or two between frames, and the manager checks every frame), then without.
+  for (const double margin : {PLAN_MARGIN_M, 0.0}) {
+    for (std::size_t k = 0; k < plan->feasible_count && !job; ++k) {
+      const manipulation::Grasp& c = plan->feasible[k];
+      for (std::size_t l = 0; l < lifts.size() && !job; ++l) {
+        if (lifts[l] < LOWEST_LIFT_M || (l > 0 && lifts[l] == wanted)) continue;
+        job_options_.lift_m = lifts[l];
+        auto made = manipulation::make_pick_place_job(s->track, s->centre, c, place, job_options_);
+        if (!made) {
+          if (why.empty()) why = "no job: " + made.error();
+          continue;
+        }
+        if (auto ok = manipulation::check_job_paths(*made, arm_now, obstacles, clear + margin,
+                                                    jaco::SafetyLimits{});
+            !ok) {
+          if (why.empty()) why = "no clear job: " + ok.error();
+          continue;
+        }
+        job = *made;
+        r.grasp = manipulation::to_string(c.kind);
+      }
     }
-    job = *made;
-    r.grasp = manipulation::to_string(c.kind);
+    if (job) break;
   }
   if (!job) {
     r.failure = why;
@@ -480,6 +498,8 @@ void Session::start_move() {
       target_start_ = to_base(world_->centre(i));
     }
   }
+  held_ = manipulation::held_object(jaco::forward_kinematics(job->grasp).translation(), s->centre,
+                                    s->box.extents, job_options_.grasp.table.normal);
   move_start_ns_ = now();
   (void)manager_.start(*job, now());
   stage_ = Stage::RUNNING;
@@ -577,6 +597,13 @@ void Session::arm_cycle() noexcept {
   p.control = static_cast<std::uint32_t>(s.control);
   for (std::size_t j = 0; j < jaco::JOINTS; ++j) p.joints_deg[j] = s.joints[j];
   for (std::size_t f = 0; f < jaco::FINGERS; ++f) p.fingers[f] = s.fingers[f];
+  if (stage_ == Stage::RUNNING && manager_.holding()) {  // the body filter removes it with the arm
+    for (int k = 0; k < 3; ++k) {
+      p.held_m[k] = held_.a[k];
+      p.held_m[3 + k] = held_.b[k];
+    }
+    p.held_m[6] = held_.radius_m;
+  }
   arm_states_.write(p);
   if (stage_ == Stage::RUNNING && manager_.running()) {
     fire_event();

@@ -17,7 +17,8 @@ kernels::Capsule capsule(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
 std::size_t arm_body_capsules(const drivers::jaco::JointAngles& joints,
                               const Eigen::Isometry3d& base_from_camera, const ArmBodyModel& model,
                               const drivers::jaco::ArmGeometry& geometry,
-                              std::span<kernels::Capsule, ARM_BODY_CAPSULES> out) noexcept {
+                              std::span<kernels::Capsule, ARM_BODY_CAPSULES> out,
+                              const HeldObject& held) noexcept {
   const Eigen::Isometry3d camera_from_base = base_from_camera.inverse(Eigen::Isometry);
   const drivers::jaco::ChainFrames frames =
       drivers::jaco::forward_kinematics_frames(joints, geometry);
@@ -40,7 +41,22 @@ std::size_t arm_body_capsules(const drivers::jaco::JointAngles& joints,
   out[n++] = capsule(camera_from_base * (tool.translation() - model.hand_back_m * axis),
                      camera_from_base * (tool.translation() + model.hand_front_m * axis),
                      model.hand_radius_m + model.margin_m);
+  if (held.held()) {
+    out[n++] =
+        capsule(camera_from_base * (tool.translation() + held.a),
+                camera_from_base * (tool.translation() + held.b), held.radius_m + model.margin_m);
+  }
   return n;
+}
+
+HeldObject held_object(const Eigen::Vector3d& tool, const Eigen::Vector3d& centre,
+                       const Eigen::Vector3d& extents, const Eigen::Vector3d& up) noexcept {
+  const Eigen::Vector3d u = up.normalized();
+  HeldObject h;
+  h.a = centre - 0.5 * extents.z() * u - tool;
+  h.b = centre + 0.5 * extents.z() * u - tool;
+  h.radius_m = 0.5 * extents.head<2>().norm();
+  return h;
 }
 
 }  // namespace orthoflow::manipulation

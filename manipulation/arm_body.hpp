@@ -29,15 +29,34 @@ struct ArmBodyModel {
   double margin_m = 0.02;       ///< every radius inflated by this
 };
 
-/// @brief Two segments per DH row and the hand.
-inline constexpr std::size_t ARM_BODY_CAPSULES = 13;
+/// @brief What the hand holds: a capsule whose ends are offsets from the tool point in the base
+/// frame (the hand's orientation does not change while it holds: the object stays upright), and its
+/// radius. Radius 0: nothing held.
+struct HeldObject {
+  Eigen::Vector3d a = Eigen::Vector3d::Zero();
+  Eigen::Vector3d b = Eigen::Vector3d::Zero();
+  double radius_m = 0.0;
+  [[nodiscard]] bool held() const noexcept { return radius_m > 0.0; }
+};
+
+/// @brief The held object of a box @p extents (x, y across the table, z up) centred at
+/// @p centre, taken by the hand at @p tool (both base frame, at the grasp): its upright axis and
+/// the radius of its footprint's circumscribed circle.
+[[nodiscard]] HeldObject held_object(const Eigen::Vector3d& tool, const Eigen::Vector3d& centre,
+                                     const Eigen::Vector3d& extents,
+                                     const Eigen::Vector3d& up) noexcept;
+
+/// @brief Two segments per DH row, the hand, and a held object.
+inline constexpr std::size_t ARM_BODY_CAPSULES = 14;
 
 /// @brief The arm's capsules at @p joints in the camera frame (@p base_from_camera from the robot
-/// frames file), written to @p out. Zero-length segments are left out. @return the count written.
-/// @pre finite joints and transform.
-[[nodiscard]] std::size_t arm_body_capsules(
-    const drivers::jaco::JointAngles& joints, const Eigen::Isometry3d& base_from_camera,
-    const ArmBodyModel& model, const drivers::jaco::ArmGeometry& geometry,
-    std::span<kernels::Capsule, ARM_BODY_CAPSULES> out) noexcept;
+/// frames file), written to @p out, and @p held's (inflated by the margin) when it holds one.
+/// Zero-length segments are left out. @return the count written. @pre finite joints and transform.
+[[nodiscard]] std::size_t arm_body_capsules(const drivers::jaco::JointAngles& joints,
+                                            const Eigen::Isometry3d& base_from_camera,
+                                            const ArmBodyModel& model,
+                                            const drivers::jaco::ArmGeometry& geometry,
+                                            std::span<kernels::Capsule, ARM_BODY_CAPSULES> out,
+                                            const HeldObject& held = {}) noexcept;
 
 }  // namespace orthoflow::manipulation

@@ -234,13 +234,46 @@ bool ExecutionManager::at_fingers(const ArmInput& arm, double goal) const noexce
   return true;
 }
 
+bool ExecutionManager::moved(const Eigen::Vector3d& seen) const noexcept {
+  const Eigen::Vector3d d = seen - job_.target_centre;
+  const double rise = d.dot(job_.up);
+  return (d - rise * job_.up).norm() > limits_.target_moved_m || rise > limits_.target_moved_m;
+}
+
 bool ExecutionManager::path_blocked(const ArmInput& arm,
                                     std::span<const Obstacle> others) const noexcept {
   const JointAngles* goal = joint_goal(phase_);
   if (goal == nullptr || others.empty()) return false;
-  const Eigen::Vector3d from = drivers::jaco::forward_kinematics(arm.joints).translation();
-  const Eigen::Vector3d to = drivers::jaco::forward_kinematics(*goal).translation();
-  return segment_blocked(from, to, others, limits_.obstacle_clearance_m);
+  return joint_path_blocked(arm.joints, *goal, others, limits_.obstacle_clearance_m);
+}
+
+bool joint_path_blocked(const JointAngles& from, const JointAngles& to,
+                        std::span<const Obstacle> others, double clearance_m) noexcept {
+  if (others.empty()) return false;
+  Eigen::Vector3d previous = drivers::jaco::forward_kinematics(from).translation();
+  for (std::size_t s = 1; s <= JOINT_PATH_SAMPLES; ++s) {
+    const double t = static_cast<double>(s) / static_cast<double>(JOINT_PATH_SAMPLES);
+    JointAngles q{};
+    for (std::size_t j = 0; j < q.size(); ++j) q[j] = from[j] + t * (to[j] - from[j]);
+    const Eigen::Vector3d point = drivers::jaco::forward_kinematics(q).translation();
+    if (segment_blocked(previous, point, others, clearance_m)) return true;
+    previous = point;
+  }
+  return false;
+}
+
+double joint_path_deviation(const JointAngles& from, const JointAngles& to) noexcept {
+  const Eigen::Vector3d a = drivers::jaco::forward_kinematics(from).translation();
+  const Eigen::Vector3d b = drivers::jaco::forward_kinematics(to).translation();
+  double worst = 0.0;
+  for (std::size_t s = 1; s < JOINT_PATH_SAMPLES; ++s) {
+    const double t = static_cast<double>(s) / static_cast<double>(JOINT_PATH_SAMPLES);
+    JointAngles q{};
+    for (std::size_t j = 0; j < q.size(); ++j) q[j] = from[j] + t * (to[j] - from[j]);
+    worst = std::max(worst,
+                     distance_to_segment(a, b, drivers::jaco::forward_kinematics(q).translation()));
+  }
+  return worst;
 }
 
 bool segment_blocked(const Eigen::Vector3d& from, const Eigen::Vector3d& to,
@@ -276,8 +309,7 @@ ArmRequest ExecutionManager::step(std::int64_t now_ns, const ArmInput& arm,
   if (before_hold) {
     if (now_ns - target_last_seen_ns_ > limits_.target_lost_ns)
       return abort(now_ns, AbortReason::TARGET_LOST, "the target's track is gone");
-    if (perception.target_seen &&
-        (perception.target_centre - job_.target_centre).norm() > limits_.target_moved_m)
+    if (perception.target_seen && moved(perception.target_centre))
       return abort(now_ns, AbortReason::TARGET_MOVED, "the target moved from the planned place");
   }
   if (path_blocked(arm, perception.others))

@@ -72,6 +72,7 @@ enum class AbortReason : std::uint8_t {
 struct PickPlaceJob {
   std::uint32_t track_id = 0;
   Eigen::Vector3d target_centre = Eigen::Vector3d::Zero();  ///< base frame, when planned
+  Eigen::Vector3d up = Eigen::Vector3d::UnitZ();  ///< the table's normal (base frame, unit)
   drivers::jaco::JointAngles initial{}, pre_grasp{}, grasp{}, lift{}, carry{}, place{}, retreat{};
   double open_fingers = 0.0;   ///< the model's units (0 open)
   double close_fingers = 0.0;  ///< the model's units
@@ -96,7 +97,10 @@ struct ExecutionLimits {
                                                    0};              // ABORTED
   std::int64_t perception_max_age_ns = 300'000'000;  ///< the stale-perception interlock
   std::int64_t target_lost_ns = 500'000'000;         ///< the target unseen this long is lost
-  double target_moved_m = 0.03;        ///< the target farther than this from the plan has moved
+  /// The target has moved when its centre is farther than this from the plan along the table, or
+  /// has risen more than this. A centre that sinks is the hand hiding a partial view's top as it
+  /// comes down on it (it sank 6 cm under a top grasp on a bottle), not a move.
+  double target_moved_m = 0.03;
   double obstacle_clearance_m = 0.05;  ///< another object's sphere this near the path blocks it
   double joint_tolerance_deg = 1.0;    ///< a joint goal is reached within this
   /// A finger goal is reached within this (model units): 2 % of the JACO2's range (its controller
@@ -135,6 +139,29 @@ struct PerceptionInput {
 /// @p to] (the manager's path check; a planner uses it to pick a grasp whose approach is free).
 [[nodiscard]] bool segment_blocked(const Eigen::Vector3d& from, const Eigen::Vector3d& to,
                                    std::span<const Obstacle> others, double clearance_m) noexcept;
+
+/// @brief Tool points sampled along a joint-space move to check its path: the controller moves
+/// every joint on one synchronised profile (drivers/jaco_motion.hpp), so the tool follows the
+/// forward kinematics of the straight joint-space segment, a curve that can sag far from the
+/// straight Cartesian line between its ends. The polyline through these points is within a few mm
+/// of it.
+inline constexpr std::size_t JOINT_PATH_SAMPLES = 16;
+
+/// @brief True if the tool's path of the joint-space move @p from -> @p to (the polyline through
+/// JOINT_PATH_SAMPLES + 1 forward-kinematics points of the JACO2) comes nearer than @p clearance_m
+/// to a sphere of @p others. What the manager checks every cycle from where the arm is to the
+/// phase's goal, and what a planner checks for each move of a job. No allocation.
+[[nodiscard]] bool joint_path_blocked(const drivers::jaco::JointAngles& from,
+                                      const drivers::jaco::JointAngles& to,
+                                      std::span<const Obstacle> others,
+                                      double clearance_m) noexcept;
+
+/// @brief How far the tool's path of the joint-space move @p from -> @p to strays from the straight
+/// line between its ends (m), over the same samples as joint_path_blocked. A short straight move
+/// (approach, lift, place) that strays far is an IK solution on another branch: the wrist would
+/// swing round through the scene. No allocation.
+[[nodiscard]] double joint_path_deviation(const drivers::jaco::JointAngles& from,
+                                          const drivers::jaco::JointAngles& to) noexcept;
 
 /// @brief What to send the arm after a step.
 struct ArmRequest {
@@ -188,6 +215,8 @@ class ExecutionManager {
                                const drivers::jaco::JointAngles& goal) const noexcept;
   [[nodiscard]] bool at_fingers(const ArmInput& arm, double goal) const noexcept;
   [[nodiscard]] const drivers::jaco::JointAngles* joint_goal(Phase phase) const noexcept;
+  /// True if the target seen at @p seen has moved from the plan (ExecutionLimits::target_moved_m).
+  [[nodiscard]] bool moved(const Eigen::Vector3d& seen) const noexcept;
   [[nodiscard]] bool path_blocked(const ArmInput& arm,
                                   std::span<const Obstacle> others) const noexcept;
 

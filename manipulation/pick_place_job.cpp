@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 namespace orthoflow::manipulation {
 
@@ -54,6 +55,7 @@ Result<PickPlaceJob, std::string> make_pick_place_job(std::uint32_t track_id,
   PickPlaceJob job;
   job.track_id = track_id;
   job.target_centre = target_centre;
+  job.up = up;
   job.initial = options.initial;
   job.pre_grasp = grasp.pre_grasp_joints;
   job.grasp = grasp.grasp_joints;
@@ -87,6 +89,38 @@ Result<PickPlaceJob, std::string> make_pick_place_job(std::uint32_t track_id,
     seed = *q;
   }
   return job;
+}
+
+Result<void, std::string> check_job_paths(const PickPlaceJob& job,
+                                          const drivers::jaco::JointAngles& now,
+                                          std::span<const Obstacle> others, double clearance_m,
+                                          const drivers::jaco::SafetyLimits& limits) {
+  const struct {
+    const char* name;
+    const drivers::jaco::JointAngles* from;
+    const drivers::jaco::JointAngles* to;
+    bool straight;
+  } moves[] = {{"initial", &now, &job.initial, false},
+               {"pre_grasp", &job.initial, &job.pre_grasp, false},
+               {"approach", &job.pre_grasp, &job.grasp, true},
+               {"lift", &job.grasp, &job.lift, true},
+               {"carry", &job.lift, &job.carry, false},
+               {"place", &job.carry, &job.place, true},
+               {"retreat", &job.place, &job.retreat, true}};
+  for (const auto& m : moves) {
+    if (auto safe = drivers::jaco::check_joint_move(limits, *m.from, *m.to); !safe)
+      return err(std::string(m.name) + ": " + drivers::jaco::describe(safe.error()));
+    if (joint_path_blocked(*m.from, *m.to, others, clearance_m))
+      return err(std::string(m.name) + ": passes another object");
+    if (const double swing = joint_path_deviation(*m.from, *m.to);
+        m.straight && swing > MAX_SWING_M) {
+      char text[96];
+      std::snprintf(text, sizeof text, ": the hand would swing %.2f m off its straight line",
+                    swing);
+      return err(std::string(m.name) + text);
+    }
+  }
+  return {};
 }
 
 }  // namespace orthoflow::manipulation

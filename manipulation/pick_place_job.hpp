@@ -14,6 +14,7 @@
 #include <Eigen/Geometry>
 
 #include "core/result.hpp"
+#include "drivers/jaco_safety.hpp"
 #include "manipulation/execution_manager.hpp"
 #include "manipulation/grasp_planner.hpp"
 
@@ -34,6 +35,24 @@ struct JobOptions {
 [[nodiscard]] Result<PickPlaceJob, std::string> make_pick_place_job(
     std::uint32_t track_id, const Eigen::Vector3d& target_centre, const Grasp& grasp,
     const Eigen::Vector3d& place_centre, const JobOptions& options) noexcept;
+
+/// @brief How far a straight move of a job may stray from its line (check_job_paths).
+inline constexpr double MAX_SWING_M = 0.03;
+
+/// @brief Checks every move the manager will send for @p job, from the arm's joints @p now (to the
+/// initial pose, the pre-grasp, the grasp, then lift, carry, place and retreat), each along its
+/// joint-space path: the tool keeps @p clearance_m from every sphere of @p others
+/// (joint_path_blocked) and stays inside the driver's safety limits (drivers::jaco::
+/// check_joint_move, the check that would otherwise refuse the command mid-job); the straight moves
+/// near the objects (approach, lift, place, retreat) stray at most MAX_SWING_M from their straight
+/// line (joint_path_deviation: else the IK chose another branch). @p others: the objects other
+/// than the target. @return the first move that fails and why, e.g. "carry: passes another
+/// object". @note Allocates only for the error text (planning, not the frame path).
+[[nodiscard]] Result<void, std::string> check_job_paths(const PickPlaceJob& job,
+                                                        const drivers::jaco::JointAngles& now,
+                                                        std::span<const Obstacle> others,
+                                                        double clearance_m,
+                                                        const drivers::jaco::SafetyLimits& limits);
 
 /// @brief Most spheres cover_box gives one box.
 inline constexpr std::size_t MAX_BOX_SPHERES = 64;

@@ -10,6 +10,7 @@
 #include <limits>
 #include <random>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "core/rng.hpp"
@@ -350,6 +351,46 @@ TEST(BodyFilter, TheArmIsLookedUpAtTheFramesTime) {
     EXPECT_EQ(std::isnan(frame->cloud.points.z[5]), swung)
         << (swung ? "at HOME when the frame was taken" : "arrived at HOME only after the frame");
   }
+}
+
+TEST(BodyFilter, WhatTheHandHoldsGoesWithTheArm) {
+  // Point 6 hangs 25 cm below the hand at HOME, where a held bottle is; point 7 is 10 cm beside it.
+  const Eigen::Vector3d tool =
+      drivers::jaco::forward_kinematics(drivers::jaco::HOME_JOINTS).translation();
+  const Isometry3d camera_from_base = base_from_camera().inverse();
+  kernels::PointCloud cloud = small_frame();
+  const auto put = [&](std::size_t i, const Eigen::Vector3d& base_point) {
+    const Eigen::Vector3d c = camera_from_base * base_point;
+    cloud.x()[i] = float(c.x());
+    cloud.y()[i] = float(c.y());
+    cloud.z()[i] = float(c.z());
+  };
+  put(6, tool + Vector3d(0.0, 0.0, -0.25));
+  put(7, tool + Vector3d(0.10, 0.0, -0.25));
+  // What survives with @p held_m in the state: points 6 and 7.
+  const auto survivors = [&](const std::array<double, 7>& held_m) {
+    ArmStateChannel channel;
+    Rig rig(channel);
+    engine::ArmStatePayload st = state_at(drivers::jaco::HOME_JOINTS, T0);
+    std::copy(held_m.begin(), held_m.end(), st.held_m);
+    channel.write(st);
+    const engine::Message out = rig.run(cloud);
+    EXPECT_FALSE(out.skipped);
+    if (out.skipped) return std::pair<bool, bool>{};
+    const FrameBlock fb(out.payload.bytes(), FrameBlock::capacity_for(out.payload.bytes().size()));
+    auto frame = fb.frame();
+    EXPECT_TRUE(frame);
+    return std::pair<bool, bool>{!std::isnan(frame->cloud.points.z[6]),
+                                 !std::isnan(frame->cloud.points.z[7])};
+  };
+  const double nan = std::nan("");
+  EXPECT_EQ(survivors({}), std::make_pair(true, true)) << "nothing held";
+  // A bottle 30 cm tall, 4 cm in radius, hanging from the tool point (plus the 2 cm margin).
+  EXPECT_EQ(survivors({0, 0, -0.30, 0, 0, 0, 0.04}), std::make_pair(false, true));
+  EXPECT_EQ(survivors({0, 0, -0.30, 0, 0, 0, nan}), std::make_pair(true, true)) << "a bad word";
+  EXPECT_EQ(survivors({0, 0, nan, 0, 0, 0, 0.04}), std::make_pair(true, true)) << "a bad word";
+  EXPECT_EQ(survivors({0, 0, -0.30, 0, 0, 0, 5.0}), std::make_pair(true, true))
+      << "no hand holds it";
 }
 
 TEST(BodyFilter, AFrameInAnIpcChunkIsCopiedNotWritten) {

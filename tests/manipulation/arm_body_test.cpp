@@ -142,5 +142,27 @@ TEST(ArmBody, TheMarginAndTheHandAreHonoured) {
   EXPECT_FLOAT_EQ(caps[n - 1].radius, 0.09F);
 }
 
+TEST(ArmBody, AHeldObjectIsOneMoreCapsuleBelowTheHand) {
+  const drivers::jaco::JointAngles home = drivers::jaco::HOME_JOINTS;
+  const Isometry3d tool = drivers::jaco::forward_kinematics(home);
+  ArmBodyModel model;
+  std::array<kernels::Capsule, ARM_BODY_CAPSULES> caps{};
+  const std::size_t bare =
+      arm_body_capsules(home, Isometry3d::Identity(), model, drivers::jaco::jaco2_geometry(), caps);
+  // A 0.08 x 0.06 x 0.20 box centred 5 cm below the tool point, upright.
+  const HeldObject held = held_object(tool.translation(), tool.translation() - Vector3d(0, 0, 0.05),
+                                      Vector3d(0.08, 0.06, 0.20), Vector3d::UnitZ());
+  EXPECT_NEAR(held.radius_m, 0.05, 1e-12);
+  EXPECT_TRUE(held.a.isApprox(Vector3d(0, 0, -0.15)));
+  EXPECT_TRUE(held.b.isApprox(Vector3d(0, 0, 0.05)));
+  const std::size_t with = arm_body_capsules(home, Isometry3d::Identity(), model,
+                                             drivers::jaco::jaco2_geometry(), caps, held);
+  ASSERT_EQ(with, bare + 1);
+  const kernels::Capsule& c = caps[bare];
+  EXPECT_NEAR(c.a[2], tool.translation().z() - 0.15, 1e-6);
+  EXPECT_NEAR(c.b[2], tool.translation().z() + 0.05, 1e-6);
+  EXPECT_NEAR(c.radius, 0.05 + model.margin_m, 1e-6);
+}
+
 }  // namespace
 }  // namespace orthoflow::manipulation

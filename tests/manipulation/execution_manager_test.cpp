@@ -48,6 +48,7 @@ struct World {
   bool attached = false;
   bool slippery = false;  ///< the fingers never hold it
   Vector3d grip_offset = Vector3d::Zero();
+  Vector3d seen_offset = Vector3d::Zero();  ///< perception's error on the mug's centre
   std::vector<Obstacle> obstacles;
   bool perceiving = true;   ///< false: perception stops (a dead camera)
   bool mug_visible = true;  ///< false: the mug's track is gone
@@ -89,7 +90,7 @@ struct World {
     last_frame_ns = now;
     perception.stamp_ns = now - 30'000'000;
     perception.target_seen = mug_visible;
-    perception.target_centre = mug;
+    perception.target_centre = mug + seen_offset;
     perception.others = obstacles;
   }
   /// Runs @p job until the manager ends (or @p max_s of simulated time).
@@ -190,6 +191,30 @@ TEST(ExecutionManager, TheTargetMovingDuringTheApproachBacksTheArmAway) {
             phases_of(manager).end());
   EXPECT_LT(joint_distance(world.rig.controller->snapshot().joints, job.pre_grasp), 1.0)
       << "backed away to the pre-grasp pose";
+}
+
+TEST(ExecutionManager, ACentreThatSinksUnderTheHandIsNotAMoveButALiftIs) {
+  // The hand coming down hides the top of a partial view: its centre sinks 6 cm, the object stays.
+  {
+    World world;
+    ExecutionManager manager;
+    world.event = [](World& w, const ExecutionManager& m) {
+      w.seen_offset.z() = m.phase() == Phase::APPROACH ? -0.06 : 0.0;
+    };
+    world.run(manager, mug_job());
+    EXPECT_EQ(manager.phase(), Phase::DONE) << log_text(manager);
+  }
+  // A person lifts it 6 cm off the table.
+  {
+    World world;
+    ExecutionManager manager;
+    world.event = [](World& w, const ExecutionManager& m) {
+      if (m.phase() == Phase::APPROACH && !w.attached)
+        w.mug.z() = ::orthoflow::manipulation::mug().base_from_object.translation().z() + 0.06;
+    };
+    world.run(manager, mug_job());
+    EXPECT_EQ(manager.abort_reason(), AbortReason::TARGET_MOVED) << log_text(manager);
+  }
 }
 
 TEST(ExecutionManager, StalePerceptionStopsTheArmWhereItIs) {

@@ -1,0 +1,135 @@
+// The path checks of issue 21's closed loop: the tool's path of a joint-space move is the forward
+// kinematics of the straight joint-space segment (the controller's synchronised profile), not the
+// straight line between its ends; and every move of a pick-and-place job is checked along it, for
+// other objects and for the driver's safety limits, before the job starts.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <string>
+
+#include "manipulation/execution_manager.hpp"
+#include "manipulation/pick_place_job.hpp"
+
+namespace orthoflow::manipulation {
+namespace {
+
+using Eigen::Vector3d;
+namespace jaco = drivers::jaco;
+
+jaco::JointAngles turned(jaco::JointAngles q, double base_deg) {
+  q[0] += base_deg;
+  return q;
+}
+
+Vector3d tool_at(const jaco::JointAngles& from, const jaco::JointAngles& to, double t) {
+  jaco::JointAngles q{};
+  for (std::size_t j = 0; j < q.size(); ++j) q[j] = from[j] + t * (to[j] - from[j]);
+  return jaco::forward_kinematics(q).translation();
+}
+
+TEST(JointPath, FollowsTheArcNotTheChord) {
+  // The base turns 120 degrees: the tool sweeps an arc about the base; the chord between the ends
+  // cuts across, far inside the arc.
+  const jaco::JointAngles from = jaco::HOME_JOINTS;
+  const jaco::JointAngles to = turned(from, 120.0);
+  const Vector3d a = tool_at(from, to, 0.0), b = tool_at(from, to, 1.0);
+  const Vector3d on_arc = tool_at(from, to, 0.5);
+  const Vector3d on_chord = 0.5 * (a + b);
+  ASSERT_GT((on_arc - on_chord).norm(), 0.15) << "the arc sags well away from the chord";
+  const std::array<Obstacle, 1> at_arc{{{on_arc, 0.03}}};
+  const std::array<Obstacle, 1> at_chord{{{on_chord, 0.03}}};
+  EXPECT_TRUE(joint_path_blocked(from, to, at_arc, 0.02));
+  EXPECT_FALSE(segment_blocked(a, b, at_arc, 0.02)) << "the straight check misses it";
+  EXPECT_FALSE(joint_path_blocked(from, to, at_chord, 0.02)) << "the arm never goes there";
+  EXPECT_TRUE(segment_blocked(a, b, at_chord, 0.02));
+}
+
+TEST(JointPath, EmptyObstaclesAndAStillMove) {
+  const jaco::JointAngles q = jaco::HOME_JOINTS;
+  EXPECT_FALSE(joint_path_blocked(q, turned(q, 90.0), {}, 0.02));
+  const Vector3d tool = jaco::forward_kinematics(q).translation();
+  const std::array<Obstacle, 1> near{{{tool + Vector3d(0.0, 0.0, 0.04), 0.01}}};
+  EXPECT_TRUE(joint_path_blocked(q, q, near, 0.035)) << "standing still next to it";
+  EXPECT_FALSE(joint_path_blocked(q, q, near, 0.025));
+}
+
+ObjectBox mug() {
+  ObjectBox box;
+  box.base_from_object.translation() = Vector3d(0.30, -0.30, 0.05);
+  box.extents = Vector3d(0.08, 0.08, 0.10);
+  return box;
+}
+
+PickPlaceJob mug_job() {
+  const JobOptions options;
+  auto plan = plan_grasp(mug(), options.grasp);
+  EXPECT_TRUE(plan && plan->best() != nullptr);
+  auto job = make_pick_place_job(7, mug().base_from_object.translation(), *plan->best(),
+                                 Vector3d(0.05, -0.45, 0.05), options);
+  EXPECT_TRUE(job) << (job ? "" : job.error());
+  return *job;
+}
+
+TEST(JobPaths, AClearJobPassesAndAnObjectOnTheCarryIsNamed) {
+  const PickPlaceJob job = mug_job();
+  const jaco::SafetyLimits limits;
+  EXPECT_TRUE(check_job_paths(job, jaco::HOME_JOINTS, {}, 0.02, limits));
+  // A bottle where the carry's arc passes, not on the straight line from lift to carry.
+  const std::array<Obstacle, 1> on_carry{{{tool_at(job.lift, job.carry, 0.5), 0.01}}};
+  const auto blocked = check_job_paths(job, jaco::HOME_JOINTS, on_carry, 0.01, limits);
+  ASSERT_FALSE(blocked);
+  EXPECT_EQ(blocked.error().rfind("carry: ", 0), 0U) << blocked.error();
+}
+
+TEST(JobPaths, TheFirstBlockedMoveIsNamedInOrder) {
+  const PickPlaceJob job = mug_job();
+  // An object right at the pre-grasp pose blocks the way in before anything later.
+  const Vector3d pre = jaco::forward_kinematics(job.pre_grasp).translation();
+  const std::array<Obstacle, 1> at_pre{{{pre, 0.02}}};
+  const auto blocked = check_job_paths(job, jaco::HOME_JOINTS, at_pre, 0.02, jaco::SafetyLimits{});
+  ASSERT_FALSE(blocked);
+  EXPECT_EQ(blocked.error().rfind("pre_grasp: ", 0), 0U) << blocked.error();
+}
+
+TEST(JobPaths, AMoveTheSafetyLayerWouldRefuseIsNamed) {
+  const PickPlaceJob job = mug_job();
+  jaco::SafetyLimits limits;
+  // A keep-out box around the grasp pose only: the driver would refuse the approach mid-job.
+  const Vector3d grasp = jaco::forward_kinematics(job.grasp).translation();
+  ASSERT_TRUE(
+      limits.add_keep_out({grasp - Vector3d::Constant(0.01), grasp + Vector3d::Constant(0.01),
+                           core::FixedText<24>::from("fixture")}));
+  const auto refused = check_job_paths(job, jaco::HOME_JOINTS, {}, 0.02, limits);
+  ASSERT_FALSE(refused);
+  EXPECT_EQ(refused.error().rfind("approach: ", 0), 0U) << refused.error();
+  EXPECT_NE(refused.error().find("fixture"), std::string::npos) << refused.error();
+}
+
+TEST(JobPaths, AStraightMoveOnAnotherIkBranchIsRefused) {
+  PickPlaceJob job = mug_job();
+  EXPECT_LT(joint_path_deviation(job.carry, job.place), MAX_SWING_M)
+      << "the planned place is straight";
+  // The same place pose's tool point reached with the wrist turned round: the ends are near, the
+  // way between them swings through the scene.
+  job.place = job.carry;
+  job.place[3] += 150.0;
+  job.place[4] -= 100.0;
+  ASSERT_GT(joint_path_deviation(job.carry, job.place), MAX_SWING_M);
+  jaco::SafetyLimits limits;
+  limits.workspace.min.z() = -1.0;  // the swing alone, not the table's floor
+  const auto refused = check_job_paths(job, jaco::HOME_JOINTS, {}, 0.02, limits);
+  ASSERT_FALSE(refused);
+  EXPECT_EQ(refused.error().rfind("place: the hand would swing", 0), 0U) << refused.error();
+}
+
+TEST(JobPaths, ANonFiniteJobIsRefused) {
+  PickPlaceJob job = mug_job();
+  job.carry[2] = std::nan("");
+  const auto refused = check_job_paths(job, jaco::HOME_JOINTS, {}, 0.02, jaco::SafetyLimits{});
+  ASSERT_FALSE(refused);
+  EXPECT_EQ(refused.error().rfind("carry: ", 0), 0U) << refused.error();
+}
+
+}  // namespace
+}  // namespace orthoflow::manipulation
