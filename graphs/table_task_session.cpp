@@ -122,6 +122,9 @@ class Session final : public WorldFeed {
   void plan_task();
   void start_move();
   void finish_move();
+  /// Sends the arm to the initial pose if it is elsewhere and idle (it may hide the next object).
+  /// @return true while it is on its way.
+  bool park();
   void arm_cycle() noexcept;
   void fire_event();
   /// Writes every object's spheres into others_ but the target's (and, @p holding, those near
@@ -135,6 +138,12 @@ class Session final : public WorldFeed {
   [[nodiscard]] bool is_target(const Seen& o, const Seen* t) const {
     return &o == t || o.track == target_track_ || (o.centre - target_centre_).norm() < 0.03 ||
            (t != nullptr && (o.centre - t->centre).norm() < 0.03);
+  }
+  /// True if the arm, at the newest frame, stands between the camera and a @p radius_m object at
+  /// @p base_point.
+  [[nodiscard]] bool arm_hides(const Vector3d& base_point, double radius_m) const noexcept {
+    return manipulation::occludes(std::span(sight_).first(sight_count_), Vector3d::Zero(),
+                                  camera_from_base_ * base_point, radius_m);
   }
   [[nodiscard]] const Seen* find_seen(std::uint32_t track, const Vector3d& near) const;
   [[nodiscard]] std::string truth_near(const Vector3d& base_point) const;
@@ -182,9 +191,13 @@ class Session final : public WorldFeed {
   bool event_fired_ = false, perception_dead_ = false;
   manipulation::HeldObject held_;  // the target as the hand will hold it
   bool was_holding_ = false;       // the manager held the object at its last step
+  bool parking_ = false;           // the arm is on its way to the initial pose between jobs
   bool waiting_ = false;           // the next move waits for its object to be seen again
   std::uint32_t unseen_frames_ = 0;
   std::array<kernels::Capsule, manipulation::ARM_BODY_CAPSULES> capsules_{};
+  // The arm at the newest frame, as the body filter cuts it (with its margin), for occlusion.
+  std::array<kernels::Capsule, manipulation::ARM_BODY_CAPSULES> sight_{};
+  std::size_t sight_count_ = 0;
 };
 
 simulation::Scene Session::draw_scene(std::uint64_t seed) {
@@ -399,18 +412,50 @@ void Session::plan_task() {
   }
 }
 
+bool Session::park() {
+  const jaco::ArmSnapshot a = arm_->snapshot();
+  if (a.control != jaco::ControlState::IDLE) return parking_;
+  parking_ = false;
+  if (jaco::max_joint_error(job_options_.initial, a.joints) <= config_.limits.joint_tolerance_deg)
+    return false;
+  std::size_t used = 0;  // every object is an obstacle here: no target yet
+  for (const Seen& o : seen_) {
+    if (used + manipulation::MAX_BOX_SPHERES <= others_.size())
+      used += manipulation::cover_box(
+          o.box, std::span(others_).subspan(used, manipulation::MAX_BOX_SPHERES));
+  }
+  if (manipulation::joint_path_blocked(a.joints, job_options_.initial,
+                                       std::span(others_).first(used),
+                                       config_.limits.obstacle_clearance_m))
+    return false;
+  jaco::ArmCommand c;
+  c.kind = jaco::ArmCommand::Kind::MOVE_JOINTS;
+  c.joints = job_options_.initial;
+  parking_ = arm_->submit(c).has_value();  // refused (a fault): nothing moves
+  return parking_;
+}
+
 void Session::start_move() {
   MoveReport& r = report_.moves[move_];
   const Seen* s = find_seen(r.track, planned_[move_]);
   // A track's label flickers to Unknown in some frames (the tracker's fragments); another label is
   // another object.
   if (s != nullptr && !s->label.empty() && s->label != r.label) s = nullptr;
-  if (s == nullptr) {
-    // The arm may hide it, or the tracker may be re-forming its track: look again for 3 s.
+  // Seen behind the arm, its centre is not where it is (a cut view).
+  const bool cut = s != nullptr && arm_hides(s->centre, 0.5 * s->box.extents.head<2>().norm());
+  if (s == nullptr || cut) {
+    // The arm, where the last job left it, may hide it from the camera: it goes to the initial pose
+    // first. Then the tracker may be re-forming its track: look again for 3 s.
+    if (park()) {
+      waiting_ = true;
+      return;
+    }
     if (++unseen_frames_ < 30) {
       waiting_ = true;
       return;
     }
+  }
+  if (s == nullptr) {
     r.failure = "the object is no longer seen";
     unseen_frames_ = 0;
     ++move_;
@@ -438,7 +483,6 @@ void Session::start_move() {
   const Vector3d tool = jaco::forward_kinematics(job_options_.initial).translation();
   const auto obstacles =
       std::span<const manipulation::Obstacle>(others_).first(fill_obstacles(tool, false));
-  const Vector3d place(r.to.x(), r.to.y(), s->centre.z());
   // Carry high enough that the hand passes 10 cm above the tallest other object (0.15-0.30 m).
   double tallest = 0.0;
   const Seen* target = current_target();
@@ -459,30 +503,39 @@ void Session::start_move() {
   std::string why;  // why the preferred grasp and lift (the first tried) have no job
   // The first grasp (best first) and lift whose every move keeps clear of the other objects along
   // its joint-space path and inside the safety limits; with a margin first (a perceived box shifts
-  // by a centimetre or two between frames, and the manager checks every frame), then without.
-  for (const double margin : {PLAN_MARGIN_M, 0.0}) {
-    for (std::size_t k = 0; k < plan->feasible_count && !job; ++k) {
-      const manipulation::Grasp& c = plan->feasible[k];
-      for (std::size_t l = 0; l < lifts.size() && !job; ++l) {
-        if (lifts[l] < LOWEST_LIFT_M || (l > 0 && lifts[l] == wanted)) continue;
-        job_options_.lift_m = lifts[l];
-        auto made = manipulation::make_pick_place_job(s->track, s->centre, c, place, job_options_);
-        if (!made) {
-          if (why.empty()) why = "no job: " + made.error();
-          continue;
+  // by a centimetre or two between frames, and the manager checks every frame), then without. The
+  // move's own spot first; then the spots of the moves still to come (a spot the arm cannot reach
+  // with this object may suit another one: they swap).
+  std::size_t spot = move_;
+  for (; spot < report_.moves.size() && !job; ++spot) {
+    const Vector2d& to = report_.moves[spot].to;
+    const Vector3d place(to.x(), to.y(), s->centre.z());
+    for (const double margin : {PLAN_MARGIN_M, 0.0}) {
+      for (std::size_t k = 0; k < plan->feasible_count && !job; ++k) {
+        const manipulation::Grasp& c = plan->feasible[k];
+        for (std::size_t l = 0; l < lifts.size() && !job; ++l) {
+          if (lifts[l] < LOWEST_LIFT_M || (l > 0 && lifts[l] == wanted)) continue;
+          job_options_.lift_m = lifts[l];
+          auto made =
+              manipulation::make_pick_place_job(s->track, s->centre, c, place, job_options_);
+          if (!made) {
+            if (why.empty()) why = "no job: " + made.error();
+            continue;
+          }
+          if (auto ok = manipulation::check_job_paths(*made, arm_now, obstacles, clear + margin,
+                                                      jaco::SafetyLimits{});
+              !ok) {
+            if (why.empty()) why = "no clear job: " + ok.error();
+            continue;
+          }
+          job = *made;
+          r.grasp = manipulation::to_string(c.kind);
         }
-        if (auto ok = manipulation::check_job_paths(*made, arm_now, obstacles, clear + margin,
-                                                    jaco::SafetyLimits{});
-            !ok) {
-          if (why.empty()) why = "no clear job: " + ok.error();
-          continue;
-        }
-        job = *made;
-        r.grasp = manipulation::to_string(c.kind);
       }
+      if (job) break;
     }
-    if (job) break;
   }
+  if (job && spot - 1 != move_) std::swap(r.to, report_.moves[spot - 1].to);
   if (!job) {
     r.failure = why;
     ++move_;
@@ -610,13 +663,18 @@ void Session::arm_cycle() noexcept {
     manipulation::PerceptionInput in;
     in.stamp_ns = seen_stamp_ns_;
     const bool holding = world_->held() >= 0;
-    // The hand's own filter cuts a target it is about to take: that view is not evidence.
-    if (const Seen* t = current_target();
-        t != nullptr && (t->centre - tool_base).norm() > HAND_HIDES_M) {
+    // The hand's own filter cuts a target it is about to take, and the arm between the camera and
+    // the target cuts its view: such a view is not evidence of where it is.
+    const double radius = held_.radius_m;  // the target's footprint
+    const Seen* t = current_target();
+    if (t != nullptr && (t->centre - tool_base).norm() > HAND_HIDES_M &&
+        !arm_hides(t->centre, radius)) {
       in.target_seen = true;
       in.target_centre = t->centre;
     }
-    in.target_hidden = !in.target_seen && (target_centre_ - tool_base).norm() < HAND_HIDES_M;
+    in.target_hidden = !in.target_seen && ((target_centre_ - tool_base).norm() < HAND_HIDES_M ||
+                                           arm_hides(target_centre_, radius) ||
+                                           (t != nullptr && arm_hides(t->centre, radius)));
     in.others = std::span(others_).first(fill_obstacles(tool_base, holding));
     manipulation::ArmInput a;
     a.joints = s.joints;
@@ -640,8 +698,8 @@ void Session::arm_cycle() noexcept {
       }
       if (!arm_->submit(c)) manager_.refused(now());
     }
-    if (manager_.running()) arm_->keep_alive();
   }
+  if (manager_.running() || parking_) arm_->keep_alive();
   arm_->cycle();
   next_cycle_ns_ += jaco::ARM_PERIOD_NS;
   if (now() < next_cycle_ns_) sim_.run_for(std::chrono::nanoseconds(next_cycle_ns_ - now()));
@@ -726,6 +784,8 @@ const simulation::Scene* Session::next_frame(kernels::PointCloud& cloud) noexcep
   body.margin_m = 0.0;
   const std::size_t n = manipulation::arm_body_capsules(arm_->snapshot().joints, base_from_camera_,
                                                         body, jaco::jaco2_geometry(), capsules_);
+  sight_count_ = manipulation::arm_body_capsules(arm_->snapshot().joints, base_from_camera_, {},
+                                                 jaco::jaco2_geometry(), sight_);
   std::vector<simulation::BodyCapsule>& robot = world_->robot();
   robot.resize(n);
   for (std::size_t i = 0; i < n; ++i) {

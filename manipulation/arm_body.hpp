@@ -59,4 +59,15 @@ inline constexpr std::size_t ARM_BODY_CAPSULES = 14;
                                             std::span<kernels::Capsule, ARM_BODY_CAPSULES> out,
                                             const HeldObject& held = {}) noexcept;
 
+/// @brief Sight-line samples of occludes(): every 3 cm or closer over a 1.5 m line.
+inline constexpr std::size_t SIGHT_SAMPLES = 50;
+
+/// @brief True if a capsule of @p capsules comes within its radius plus @p target_radius_m of the
+/// line of sight from @p eye to @p target (all in one frame; the camera's origin is the eye in the
+/// camera frame): the arm stands between the camera and the object, so the object's view is cut and
+/// its centre is not evidence of where it is. The line is sampled (SIGHT_SAMPLES points). No
+/// allocation. @pre finite inputs.
+[[nodiscard]] bool occludes(std::span<const kernels::Capsule> capsules, const Eigen::Vector3d& eye,
+                            const Eigen::Vector3d& target, double target_radius_m) noexcept;
+
 }  // namespace orthoflow::manipulation

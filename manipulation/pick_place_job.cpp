@@ -84,6 +84,14 @@ Result<PickPlaceJob, std::string> make_pick_place_job(std::uint32_t track_id,
   for (const auto& s : steps) {
     auto q = drivers::jaco::inverse_kinematics(*s.pose, seed, options.grasp.limits,
                                                options.grasp.tolerance, geometry);
+    if (!q && s.out == &job.retreat) {
+      // Back along the approach is out of reach: the open hand rises off the object instead (its
+      // fingers are open wider than the object).
+      Eigen::Isometry3d up_and_away = place;
+      up_and_away.translation() += options.grasp.pre_grasp_distance_m * up;
+      q = drivers::jaco::inverse_kinematics(up_and_away, seed, options.grasp.limits,
+                                            options.grasp.tolerance, geometry);
+    }
     if (!q) return err(std::string(s.name) + ": " + drivers::jaco::to_string(q.error()));
     *s.out = *q;
     seed = *q;

@@ -164,5 +164,26 @@ TEST(ArmBody, AHeldObjectIsOneMoreCapsuleBelowTheHand) {
   EXPECT_NEAR(c.radius, 0.05 + model.margin_m, 1e-6);
 }
 
+TEST(ArmBody, AnArmBetweenTheCameraAndAnObjectOccludesIt) {
+  const Vector3d eye = Vector3d::Zero();
+  const Vector3d mug(0.0, 0.0, 1.2);  // 1.2 m in front of the camera
+  // A forearm crossing the line of sight 40 cm in front of the camera.
+  const std::array<kernels::Capsule, 1> across{{{{-0.2F, 0.0F, 0.4F}, {0.2F, 0.0F, 0.4F}, 0.05F}}};
+  EXPECT_TRUE(occludes(across, eye, mug, 0.04));
+  // The same forearm 15 cm to the side: clear of the line plus both radii (9 cm).
+  const std::array<kernels::Capsule, 1> aside{{{{-0.2F, 0.15F, 0.4F}, {0.2F, 0.15F, 0.4F}, 0.05F}}};
+  EXPECT_FALSE(occludes(aside, eye, mug, 0.04));
+  // 8 cm to the side: within 5 + 4 cm of the line, it cuts the object's edge.
+  const std::array<kernels::Capsule, 1> edge{{{{-0.2F, 0.08F, 0.4F}, {0.2F, 0.08F, 0.4F}, 0.05F}}};
+  EXPECT_TRUE(occludes(edge, eye, mug, 0.04));
+  // Behind the object (farther from the camera): no occlusion.
+  const std::array<kernels::Capsule, 1> behind{{{{-0.2F, 0.0F, 1.4F}, {0.2F, 0.0F, 1.4F}, 0.05F}}};
+  EXPECT_FALSE(occludes(behind, eye, mug, 0.04));
+  EXPECT_FALSE(occludes({}, eye, mug, 0.04)) << "no arm";
+  // A point-like capsule (both ends equal) on the line.
+  const std::array<kernels::Capsule, 1> ball{{{{0.0F, 0.0F, 0.7F}, {0.0F, 0.0F, 0.7F}, 0.01F}}};
+  EXPECT_TRUE(occludes(ball, eye, mug, 0.0));
+}
+
 }  // namespace
 }  // namespace orthoflow::manipulation

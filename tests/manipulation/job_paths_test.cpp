@@ -131,5 +131,35 @@ TEST(JobPaths, ANonFiniteJobIsRefused) {
   EXPECT_EQ(refused.error().rfind("carry: ", 0), 0U) << refused.error();
 }
 
+TEST(PickPlaceJob, ARetreatOutOfReachBackwardsRisesInstead) {
+  // Places along a line from near to far: a side grasp retreats back along its approach, unless
+  // the arm cannot reach that; then the open hand rises off the object by the same distance.
+  const JobOptions options;
+  auto plan = plan_grasp(mug(), options.grasp);
+  ASSERT_TRUE(plan);
+  std::size_t backwards = 0, upwards = 0;
+  for (std::size_t k = 0; k < plan->feasible_count; ++k) {
+    const Grasp& g = plan->feasible[k];
+    if (g.kind == GraspKind::TOP) continue;
+    for (double x = -0.8; x <= 0.8; x += 0.1) {
+      for (double y = -0.8; y <= 0.8; y += 0.1) {
+        const Vector3d place(x, y, mug().base_from_object.translation().z());
+        auto job = make_pick_place_job(7, mug().base_from_object.translation(), g, place, options);
+        if (!job) continue;
+        const Vector3d at_place = jaco::forward_kinematics(job->place).translation();
+        const Vector3d back = jaco::forward_kinematics(job->retreat).translation() - at_place;
+        if ((back + options.grasp.pre_grasp_distance_m * g.approach.normalized()).norm() < 0.005)
+          ++backwards;
+        else if ((back - Vector3d(0, 0, options.grasp.pre_grasp_distance_m)).norm() < 0.005)
+          ++upwards;
+        else
+          ADD_FAILURE() << "a retreat neither back nor up at " << x << ", " << y;
+      }
+    }
+  }
+  EXPECT_GT(backwards, 0U);
+  EXPECT_GT(upwards, 0U) << "no place needed the rising retreat: the test shows nothing";
+}
+
 }  // namespace
 }  // namespace orthoflow::manipulation
