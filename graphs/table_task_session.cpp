@@ -87,6 +87,8 @@ constexpr double HAND_HIDES_M = 0.17;
 constexpr double PLAN_MARGIN_M = 0.02;
 /// The lowest lift a job is planned with (the grasp check wants the object half of it up).
 constexpr double LOWEST_LIFT_M = 0.10;
+/// From the place on, an object this near the move's spot is the target, put down.
+constexpr double PLACED_NEAR_M = 0.06;
 
 std::vector<simulation::Category> default_categories() {
   using simulation::Category;
@@ -137,7 +139,14 @@ class Session final : public WorldFeed {
   /// fragments near it): never an obstacle.
   [[nodiscard]] bool is_target(const Seen& o, const Seen* t) const {
     return &o == t || o.track == target_track_ || (o.centre - target_centre_).norm() < 0.03 ||
-           (t != nullptr && (o.centre - t->centre).norm() < 0.03);
+           (t != nullptr && (o.centre - t->centre).norm() < 0.03) ||
+           (placing() && (o.centre.head<2>() - target_place_).norm() < PLACED_NEAR_M);
+  }
+  /// True from the place on: the target stands at its spot (under a new track: the hand hid it).
+  [[nodiscard]] bool placing() const noexcept {
+    const Phase p = manager_.phase();
+    return stage_ == Stage::RUNNING &&
+           (p == Phase::PLACE || p == Phase::RELEASE || p == Phase::RETREAT);
   }
   /// True if the arm, at the newest frame, stands between the camera and a @p radius_m object at
   /// @p base_point.
@@ -185,6 +194,7 @@ class Session final : public WorldFeed {
   std::uint32_t target_track_ = 0;
   Vector3d target_centre_ = Vector3d::Zero();
   Vector3d target_start_ = Vector3d::Zero();  // the world's object centre at the move's start
+  Vector2d target_place_ = Vector2d::Zero();  // where the current move puts it (base x, y)
   std::string target_label_;
   std::vector<Vector3d> planned_;  // each move's object centre at planning time
   Isometry3d camera_from_base_ = Isometry3d::Identity();
@@ -536,6 +546,7 @@ void Session::start_move() {
     }
   }
   if (job && spot - 1 != move_) std::swap(r.to, report_.moves[spot - 1].to);
+  target_place_ = r.to;
   if (!job) {
     r.failure = why;
     ++move_;
