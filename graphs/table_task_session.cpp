@@ -129,12 +129,15 @@ class Session final : public WorldFeed {
   bool park();
   void arm_cycle() noexcept;
   void fire_event();
-  /// Writes every object's spheres into others_ but the target's (and, @p holding, those near
+  /// Writes every object's spheres into others_ but the target's (@p target: current_target())
+  /// (and, @p holding, those near
   /// @p hand: pieces of the object in it). @return how many.
-  std::size_t fill_obstacles(const Vector3d& hand, bool holding);
+  std::size_t fill_obstacles(const Seen* target, const Vector3d& hand, bool holding);
   /// The target in the newest objects: its track; else (renumbered, or moved by someone) the
   /// nearest object of its label within 15 cm of where it was planned, or anything within 3 cm.
-  [[nodiscard]] const Seen* current_target() const;
+  [[nodiscard]] const Seen* current_target() const {
+    return find_seen(target_track_, target_centre_, target_label_, 0.15, 0.03);
+  }
   /// The target @p t (current_target(), found once per use) or a piece of it (the tracker's
   /// fragments near it): never an obstacle.
   [[nodiscard]] bool is_target(const Seen& o, const Seen* t) const {
@@ -154,7 +157,14 @@ class Session final : public WorldFeed {
     return manipulation::occludes(std::span(sight_).first(sight_count_), Vector3d::Zero(),
                                   camera_from_base_ * base_point, radius_m);
   }
-  [[nodiscard]] const Seen* find_seen(std::uint32_t track, const Vector3d& near) const;
+  /// The object of @p track in the newest objects; else (the tracker renumbered it, or someone
+  /// moved it) the nearest one to @p near: of @p label within @p same_label_m, or any within
+  /// @p any_m.
+  [[nodiscard]] const Seen* find_seen(std::uint32_t track, const Vector3d& near,
+                                      const std::string& label, double same_label_m,
+                                      double any_m) const;
+  /// Adds @p o's spheres to others_ after the first @p used. @return the new count.
+  std::size_t add_spheres(const Seen& o, std::size_t used);
   [[nodiscard]] std::string truth_near(const Vector3d& base_point) const;
   [[nodiscard]] std::int64_t now() const noexcept { return sim_.clock().now_ns(); }
   [[nodiscard]] Vector3d to_base(const simulation::Vec3& p) const {
@@ -306,25 +316,23 @@ void Session::take_objects() noexcept {
   }
 }
 
-std::size_t Session::fill_obstacles(const Vector3d& hand, bool holding) {
-  const Seen* target = current_target();
+std::size_t Session::fill_obstacles(const Seen* target, const Vector3d& hand, bool holding) {
   std::size_t used = 0;
   for (const Seen& o : seen_) {
-    if (is_target(o, target) || (holding && (o.centre - hand).norm() < HAND_HIDES_M)) continue;
-    if (used + manipulation::MAX_BOX_SPHERES <= others_.size())
-      used += manipulation::cover_box(
-          o.box, std::span(others_).subspan(used, manipulation::MAX_BOX_SPHERES));
+    if (!is_target(o, target) && !(holding && (o.centre - hand).norm() < HAND_HIDES_M))
+      used = add_spheres(o, used);
   }
   return used;
 }
 
-const Seen* Session::current_target() const {
+const Seen* Session::find_seen(std::uint32_t track, const Vector3d& near, const std::string& label,
+                               double same_label_m, double any_m) const {
   const Seen* best = nullptr;
   double best_d = 0.0;
   for (const Seen& o : seen_) {
-    if (o.track == target_track_) return &o;
-    const double d = (o.centre - target_centre_).norm();
-    if ((d < 0.03 || (d < 0.15 && o.label == target_label_)) && (best == nullptr || d < best_d)) {
+    if (o.track == track) return &o;
+    const double d = (o.centre - near).norm();
+    if ((d < any_m || (d < same_label_m && o.label == label)) && (best == nullptr || d < best_d)) {
       best = &o;
       best_d = d;
     }
@@ -332,17 +340,10 @@ const Seen* Session::current_target() const {
   return best;
 }
 
-const Seen* Session::find_seen(std::uint32_t track, const Vector3d& near) const {
-  for (const Seen& s : seen_) {
-    if (s.track == track) return &s;
-  }
-  const Seen* best = nullptr;  // the tracker may have given the object a new id
-  for (const Seen& s : seen_) {
-    if ((s.centre - near).norm() < 0.06 &&
-        (best == nullptr || (s.centre - near).norm() < (best->centre - near).norm()))
-      best = &s;
-  }
-  return best;
+std::size_t Session::add_spheres(const Seen& o, std::size_t used) {
+  if (used + manipulation::MAX_BOX_SPHERES > others_.size()) return used;
+  return used + manipulation::cover_box(
+                    o.box, std::span(others_).subspan(used, manipulation::MAX_BOX_SPHERES));
 }
 
 std::string Session::truth_near(const Vector3d& base_point) const {
@@ -429,11 +430,7 @@ bool Session::park() {
   if (jaco::max_joint_error(job_options_.initial, a.joints) <= config_.limits.joint_tolerance_deg)
     return false;
   std::size_t used = 0;  // every object is an obstacle here: no target yet
-  for (const Seen& o : seen_) {
-    if (used + manipulation::MAX_BOX_SPHERES <= others_.size())
-      used += manipulation::cover_box(
-          o.box, std::span(others_).subspan(used, manipulation::MAX_BOX_SPHERES));
-  }
+  for (const Seen& o : seen_) used = add_spheres(o, used);
   if (manipulation::joint_path_blocked(a.joints, job_options_.initial,
                                        std::span(others_).first(used),
                                        config_.limits.obstacle_clearance_m))
@@ -447,7 +444,7 @@ bool Session::park() {
 
 void Session::start_move() {
   MoveReport& r = report_.moves[move_];
-  const Seen* s = find_seen(r.track, planned_[move_]);
+  const Seen* s = find_seen(r.track, planned_[move_], {}, 0.0, 0.06);
   // A track's label flickers to Unknown in some frames (the tracker's fragments); another label is
   // another object.
   if (s != nullptr && !s->label.empty() && s->label != r.label) s = nullptr;
@@ -490,12 +487,12 @@ void Session::start_move() {
   target_track_ = s->track;
   target_centre_ = s->centre;
   target_label_ = r.label;
+  const Seen* target = current_target();
   const Vector3d tool = jaco::forward_kinematics(job_options_.initial).translation();
   const auto obstacles =
-      std::span<const manipulation::Obstacle>(others_).first(fill_obstacles(tool, false));
+      std::span<const manipulation::Obstacle>(others_).first(fill_obstacles(target, tool, false));
   // Carry high enough that the hand passes 10 cm above the tallest other object (0.15-0.30 m).
   double tallest = 0.0;
-  const Seen* target = current_target();
   for (const Seen& o : seen_) {
     if (!is_target(o, target))
       tallest =
@@ -505,42 +502,46 @@ void Session::start_move() {
       std::clamp(tallest + 0.10 - job_options_.grasp.table.height_of(s->centre), 0.15, 0.30);
   // Other lifts when that one's job is blocked or out of reach: higher to pass over, lower to
   // reach.
-  const std::array<double, 5> lifts{wanted, wanted + 0.05, wanted + 0.10, wanted - 0.05,
-                                    LOWEST_LIFT_M};
+  std::array<double, 5> lifts{wanted, wanted + 0.05, wanted + 0.10, wanted - 0.05, LOWEST_LIFT_M};
+  const auto lifts_end = std::unique(
+      lifts.begin(),
+      std::remove_if(lifts.begin(), lifts.end(), [](double l) { return l < LOWEST_LIFT_M; }));
   const double clear = config_.limits.obstacle_clearance_m;
   const jaco::JointAngles arm_now = arm_->snapshot().joints;
   std::optional<manipulation::PickPlaceJob> job;
-  std::string why;  // why the preferred grasp and lift (the first tried) have no job
-  // The first grasp (best first) and lift whose every move keeps clear of the other objects along
-  // its joint-space path and inside the safety limits; with a margin first (a perceived box shifts
-  // by a centimetre or two between frames, and the manager checks every frame), then without. The
-  // move's own spot first; then the spots of the moves still to come (a spot the arm cannot reach
-  // with this object may suit another one: they swap).
+  std::string why;  // why the preferred job (own spot, best grasp, first lift) is not the one
+  // The move's own spot first; then the spots of the moves still to come (a spot the arm cannot
+  // reach with this object may suit another one: they swap). At each, the jobs of every grasp (best
+  // first) and lift, solved once; the first whose every move keeps clear of the other objects
+  // along its joint-space path and inside the safety limits, with a margin first (a perceived box
+  // shifts by a centimetre or two between frames, and the manager checks every frame), then
+  // without.
+  std::vector<std::pair<manipulation::PickPlaceJob, const manipulation::Grasp*>> made;
   std::size_t spot = move_;
   for (; spot < report_.moves.size() && !job; ++spot) {
-    const Vector2d& to = report_.moves[spot].to;
-    const Vector3d place(to.x(), to.y(), s->centre.z());
+    const Vector3d place(report_.moves[spot].to.x(), report_.moves[spot].to.y(), s->centre.z());
+    made.clear();
+    for (std::size_t k = 0; k < plan->feasible_count; ++k) {
+      for (auto l = lifts.begin(); l != lifts_end; ++l) {
+        job_options_.lift_m = *l;
+        auto m = manipulation::make_pick_place_job(s->track, s->centre, plan->feasible[k], place,
+                                                   job_options_);
+        if (m)
+          made.emplace_back(*m, &plan->feasible[k]);
+        else if (spot == move_ && k == 0 && l == lifts.begin())
+          why = "no job: " + m.error();
+      }
+    }
     for (const double margin : {PLAN_MARGIN_M, 0.0}) {
-      for (std::size_t k = 0; k < plan->feasible_count && !job; ++k) {
-        const manipulation::Grasp& c = plan->feasible[k];
-        for (std::size_t l = 0; l < lifts.size() && !job; ++l) {
-          if (lifts[l] < LOWEST_LIFT_M || (l > 0 && lifts[l] == wanted)) continue;
-          job_options_.lift_m = lifts[l];
-          auto made =
-              manipulation::make_pick_place_job(s->track, s->centre, c, place, job_options_);
-          if (!made) {
-            if (why.empty()) why = "no job: " + made.error();
-            continue;
-          }
-          if (auto ok = manipulation::check_job_paths(*made, arm_now, obstacles, clear + margin,
-                                                      jaco::SafetyLimits{});
-              !ok) {
-            if (why.empty()) why = "no clear job: " + ok.error();
-            continue;
-          }
-          job = *made;
-          r.grasp = manipulation::to_string(c.kind);
+      for (const auto& [candidate, grasp] : made) {
+        auto ok = manipulation::check_job_paths(candidate, arm_now, obstacles, clear + margin,
+                                                jaco::SafetyLimits{});
+        if (ok) {
+          job = candidate;
+          r.grasp = manipulation::to_string(grasp->kind);
+          break;
         }
+        if (why.empty() && margin == 0.0) why = "no clear job: " + ok.error();
       }
       if (job) break;
     }
@@ -678,15 +679,15 @@ void Session::arm_cycle() noexcept {
     // the target cuts its view: such a view is not evidence of where it is.
     const double radius = held_.radius_m;  // the target's footprint
     const Seen* t = current_target();
-    if (t != nullptr && (t->centre - tool_base).norm() > HAND_HIDES_M &&
-        !arm_hides(t->centre, radius)) {
+    const bool cut = t != nullptr && arm_hides(t->centre, radius);
+    if (t != nullptr && (t->centre - tool_base).norm() > HAND_HIDES_M && !cut) {
       in.target_seen = true;
       in.target_centre = t->centre;
     }
-    in.target_hidden = !in.target_seen && ((target_centre_ - tool_base).norm() < HAND_HIDES_M ||
-                                           arm_hides(target_centre_, radius) ||
-                                           (t != nullptr && arm_hides(t->centre, radius)));
-    in.others = std::span(others_).first(fill_obstacles(tool_base, holding));
+    in.target_hidden =
+        !in.target_seen && (cut || (target_centre_ - tool_base).norm() < HAND_HIDES_M ||
+                            arm_hides(target_centre_, radius));
+    in.others = std::span(others_).first(fill_obstacles(t, tool_base, holding));
     manipulation::ArmInput a;
     a.joints = s.joints;
     a.fingers = {s.fingers[0], s.fingers[1], s.fingers[2]};
@@ -795,8 +796,11 @@ const simulation::Scene* Session::next_frame(kernels::PointCloud& cloud) noexcep
   body.margin_m = 0.0;
   const std::size_t n = manipulation::arm_body_capsules(arm_->snapshot().joints, base_from_camera_,
                                                         body, jaco::jaco2_geometry(), capsules_);
-  sight_count_ = manipulation::arm_body_capsules(arm_->snapshot().joints, base_from_camera_, {},
-                                                 jaco::jaco2_geometry(), sight_);
+  sight_count_ = n;  // the same arm as the body filter cuts it: with its margin
+  for (std::size_t i = 0; i < n; ++i) {
+    sight_[i] = capsules_[i];
+    sight_[i].radius += static_cast<float>(manipulation::ArmBodyModel{}.margin_m);
+  }
   std::vector<simulation::BodyCapsule>& robot = world_->robot();
   robot.resize(n);
   for (std::size_t i = 0; i < n; ++i) {

@@ -1,6 +1,7 @@
 #include "manipulation/arm_body.hpp"
 
-#include <algorithm>
+#include "manipulation/segment_distance.hpp"
+
 #include <cmath>
 
 namespace orthoflow::manipulation {
@@ -54,14 +55,11 @@ bool occludes(std::span<const kernels::Capsule> capsules, const Eigen::Vector3d&
               const Eigen::Vector3d& target, double target_radius_m) noexcept {
   for (const kernels::Capsule& c : capsules) {
     const Eigen::Vector3d a(c.a[0], c.a[1], c.a[2]);
-    const Eigen::Vector3d ab = Eigen::Vector3d(c.b[0], c.b[1], c.b[2]) - a;
-    const double reach = c.radius + target_radius_m;
-    const double length2 = ab.squaredNorm();
+    const Eigen::Vector3d b(c.b[0], c.b[1], c.b[2]);
     for (std::size_t s = 0; s <= SIGHT_SAMPLES; ++s) {
       const Eigen::Vector3d p =
           eye + (static_cast<double>(s) / static_cast<double>(SIGHT_SAMPLES)) * (target - eye);
-      const double t = length2 > 0.0 ? std::clamp((p - a).dot(ab) / length2, 0.0, 1.0) : 0.0;
-      if ((a + t * ab - p).squaredNorm() < reach * reach) return true;
+      if (distance_to_segment(a, b, p) < c.radius + target_radius_m) return true;
     }
   }
   return false;

@@ -1,5 +1,7 @@
 #include "manipulation/execution_manager.hpp"
 
+#include "manipulation/segment_distance.hpp"
+
 #include <algorithm>
 #include <cmath>
 
@@ -9,12 +11,12 @@ namespace {
 
 using drivers::jaco::JointAngles;
 
-double distance_to_segment(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                           const Eigen::Vector3d& p) noexcept {
-  const Eigen::Vector3d d = b - a;
-  const double len2 = d.squaredNorm();
-  const double t = len2 > 0.0 ? std::clamp((p - a).dot(d) / len2, 0.0, 1.0) : 0.0;
-  return (p - a - t * d).norm();
+/// The tool point at sample @p s of JOINT_PATH_SAMPLES along the joint-space segment.
+Eigen::Vector3d tool_along(const JointAngles& from, const JointAngles& to, std::size_t s) noexcept {
+  const double t = static_cast<double>(s) / static_cast<double>(JOINT_PATH_SAMPLES);
+  JointAngles q{};
+  for (std::size_t j = 0; j < q.size(); ++j) q[j] = from[j] + t * (to[j] - from[j]);
+  return drivers::jaco::forward_kinematics(q).translation();
 }
 
 ArmRequest move_to(const JointAngles& joints, double speed) noexcept {
@@ -250,12 +252,9 @@ bool ExecutionManager::path_blocked(const ArmInput& arm,
 bool joint_path_blocked(const JointAngles& from, const JointAngles& to,
                         std::span<const Obstacle> others, double clearance_m) noexcept {
   if (others.empty()) return false;
-  Eigen::Vector3d previous = drivers::jaco::forward_kinematics(from).translation();
+  Eigen::Vector3d previous = tool_along(from, to, 0);
   for (std::size_t s = 1; s <= JOINT_PATH_SAMPLES; ++s) {
-    const double t = static_cast<double>(s) / static_cast<double>(JOINT_PATH_SAMPLES);
-    JointAngles q{};
-    for (std::size_t j = 0; j < q.size(); ++j) q[j] = from[j] + t * (to[j] - from[j]);
-    const Eigen::Vector3d point = drivers::jaco::forward_kinematics(q).translation();
+    const Eigen::Vector3d point = tool_along(from, to, s);
     if (segment_blocked(previous, point, others, clearance_m)) return true;
     previous = point;
   }
@@ -263,16 +262,11 @@ bool joint_path_blocked(const JointAngles& from, const JointAngles& to,
 }
 
 double joint_path_deviation(const JointAngles& from, const JointAngles& to) noexcept {
-  const Eigen::Vector3d a = drivers::jaco::forward_kinematics(from).translation();
-  const Eigen::Vector3d b = drivers::jaco::forward_kinematics(to).translation();
+  const Eigen::Vector3d a = tool_along(from, to, 0);
+  const Eigen::Vector3d b = tool_along(from, to, JOINT_PATH_SAMPLES);
   double worst = 0.0;
-  for (std::size_t s = 1; s < JOINT_PATH_SAMPLES; ++s) {
-    const double t = static_cast<double>(s) / static_cast<double>(JOINT_PATH_SAMPLES);
-    JointAngles q{};
-    for (std::size_t j = 0; j < q.size(); ++j) q[j] = from[j] + t * (to[j] - from[j]);
-    worst = std::max(worst,
-                     distance_to_segment(a, b, drivers::jaco::forward_kinematics(q).translation()));
-  }
+  for (std::size_t s = 1; s < JOINT_PATH_SAMPLES; ++s)
+    worst = std::max(worst, distance_to_segment(a, b, tool_along(from, to, s)));
   return worst;
 }
 
