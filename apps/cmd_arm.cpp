@@ -16,6 +16,7 @@
 #include "drivers/libusb_transport.hpp"
 #include "engine/arm_state_payload.hpp"
 #include "engine/ipc_pubsub.hpp"
+#include "graphs/arm_state_feed.hpp"
 #include "simulation/sim_jaco_transport.hpp"
 
 namespace orthoflow::apps {
@@ -165,7 +166,7 @@ namespace {
 
 using namespace arm_cli;
 
-constexpr std::string_view ARM_STATE_TOPIC = "orthoflow/jaco/state";
+constexpr std::string_view ARM_STATE_TOPIC = engine::ARM_STATE_TOPIC;
 
 void run_list(const ArmArgs& a) {
   auto transport = make_transport(a);
@@ -250,29 +251,11 @@ struct StatePublisher {
     }
     auto chunk = publisher->loan(sizeof(engine::ArmStatePayload));
     if (!chunk) return;  // counted by the publisher (loan_failures)
-    engine::ArmStatePayload p;
-    p.reset();
-    p.flags = (s.estop ? engine::ARM_ESTOP : 0U) | (s.fault ? engine::ARM_FAULT : 0U);
-    p.arm_state = static_cast<std::int32_t>(s.arm_state);
-    p.cycle = s.cycle;
-    p.stamp_ns = host_stamps ? std::chrono::duration_cast<std::chrono::nanoseconds>(
-                                   std::chrono::steady_clock::now().time_since_epoch())
-                                   .count()
-                             : s.stamp_ns;
-    p.control = static_cast<std::uint32_t>(s.control);
-    p.last_stop = static_cast<std::uint32_t>(s.last_stop);
-    p.watchdog_stops = s.watchdog_stops;
-    for (std::size_t j = 0; j < jaco::JOINTS; ++j) {
-      p.joints_deg[j] = s.joints[j];
-      p.velocity_deg_s[j] = s.velocity[j];
-      p.currents_a[j] = s.currents[j];
-    }
-    for (std::size_t f = 0; f < jaco::FINGERS; ++f) p.fingers[f] = s.fingers[f];
-    for (int i = 0; i < 3; ++i) {
-      p.position_m[i] = s.pose.position[i];
-      p.theta_rad[i] = s.pose.theta[i];
-    }
-    p.voltage_v = s.sensors.voltage_v;
+    const engine::ArmStatePayload p = graphs::arm_state_payload(
+        s, host_stamps ? std::chrono::duration_cast<std::chrono::nanoseconds>(
+                             std::chrono::steady_clock::now().time_since_epoch())
+                             .count()
+                       : s.stamp_ns);
     std::memcpy(chunk.value().data(), &p, sizeof p);
     if (publisher->publish(chunk.value())) published.fetch_add(1, std::memory_order_relaxed);
   }

@@ -65,7 +65,7 @@ struct RunOptions {
   std::string ui;             // --ui [ADDR:]PORT: the web view beside the graph (empty: off)
   std::string ui_token_file;  // --ui-token-file FILE
   std::string robot_frames;   // --robot-frames FILE: the robot-body filter in front of preprocess
-  std::string arm_state_topic = "orthoflow/jaco/state";
+  std::string arm_state_topic = engine::ARM_STATE_TOPIC;
   double arm_state_age_ms = 50.0;
   std::string exclude_zones;  // --exclude-zones: C_instructor capsules, camera frame
 };

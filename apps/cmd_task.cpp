@@ -1,8 +1,8 @@
-// `orthoflow task clear_table|serve_a_meal --robot-frames FRAMES.yaml --objects RUN.jsonl ...`:
-// the thesis's table tasks (chapter 8) planned on one frame of `orthoflow run --json-out`, from the
-// labels the learner gave (manipulation/table_tasks.hpp): which objects move, in which order, to
-// which spot, with each move's grasp and pick-and-place job (or why it cannot be done), and why
-// every other object stays. It plans; it moves nothing (docs/MANIPULATION.md section 5).
+// `orthoflow task plan clear_table|serve_a_meal --robot-frames FRAMES.yaml --objects RUN.jsonl
+// ...`: the thesis's table tasks (chapter 8) planned on one frame of `orthoflow run --json-out`,
+// from the labels the learner gave (manipulation/table_tasks.hpp): which objects move, in which
+// order, to which spot, with each move's grasp and pick-and-place job (or why it cannot be done),
+// and why every other object stays. It plans; it moves nothing (docs/MANIPULATION.md section 5).
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -128,8 +128,13 @@ void run_task(const TaskArgs& a) {
 
 void add_task_command(CLI::App& app) {
   auto a = std::make_shared<TaskArgs>();
-  auto* cmd = app.add_subcommand(
+  auto* task = app.add_subcommand(
       "task",
+      "the table tasks: plan one on a run's objects, or run them on the arm and start / stop them");
+  task->require_subcommand(1);
+  add_live_task_commands(task);
+  auto* cmd = task->add_subcommand(
+      "plan",
       "plan clear_table or serve_a_meal on a run's objects (which move, where, in which "
       "order, with their grasps and jobs; it moves nothing)");
   cmd->add_option("task", a->task, "clear_table or serve_a_meal")

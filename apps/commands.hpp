@@ -55,8 +55,11 @@ void add_calibrate_command(CLI::App& app);
 /// (apps/cmd_grasp.cpp).
 void add_grasp_command(CLI::App& app);
 void add_demo_command(CLI::App& app);
-/// @brief `orthoflow task clear_table|serve_a_meal`: the table tasks planned on a run's objects.
+/// @brief `orthoflow task plan clear_table|serve_a_meal`: the table tasks planned on a run's
+/// objects; `task run|start|stop|status` (apps/cmd_task_live.cpp): run them on the arm.
 void add_task_command(CLI::App& app);
+/// @brief `run`, `start`, `stop`, `status` under @p task (apps/cmd_task_live.cpp).
+void add_live_task_commands(CLI::App* task);
 
 /// @brief `run`: the tabletop graph on the embedded session or a given source; summary, JSON lines,
 /// snapshot.

@@ -13,7 +13,10 @@
 namespace orthoflow::engine {
 
 inline constexpr std::uint32_t ARM_STATE_TYPE_ID = 0x5341464FU;  ///< "OFAS" in little-endian bytes
-inline constexpr std::uint16_t ARM_STATE_VERSION = 2;            ///< 2: held_m
+/// @brief The topic an arm publishes its states on (`orthoflow arm state --publish`, `orthoflow
+/// task run`) and the robot-body filter reads by default.
+inline constexpr const char* ARM_STATE_TOPIC = "orthoflow/jaco/state";
+inline constexpr std::uint16_t ARM_STATE_VERSION = 2;  ///< 2: held_m
 
 /// @brief Flags of ArmStatePayload::flags.
 inline constexpr std::uint32_t ARM_ESTOP = 1U << 0;  ///< the emergency stop is latched

@@ -5,6 +5,40 @@
 
 namespace orthoflow::graphs {
 
+engine::ArmStatePayload arm_state_payload(const drivers::jaco::ArmSnapshot& s,
+                                          std::int64_t stamp_ns,
+                                          const manipulation::HeldObject& held) noexcept {
+  namespace jaco = drivers::jaco;
+  engine::ArmStatePayload p;
+  p.reset();
+  p.flags = (s.estop ? engine::ARM_ESTOP : 0U) | (s.fault ? engine::ARM_FAULT : 0U);
+  p.arm_state = static_cast<std::int32_t>(s.arm_state);
+  p.cycle = s.cycle;
+  p.stamp_ns = stamp_ns;
+  p.control = static_cast<std::uint32_t>(s.control);
+  p.last_stop = static_cast<std::uint32_t>(s.last_stop);
+  p.watchdog_stops = s.watchdog_stops;
+  for (std::size_t j = 0; j < jaco::JOINTS; ++j) {
+    p.joints_deg[j] = s.joints[j];
+    p.velocity_deg_s[j] = s.velocity[j];
+    p.currents_a[j] = s.currents[j];
+  }
+  for (std::size_t f = 0; f < jaco::FINGERS; ++f) p.fingers[f] = s.fingers[f];
+  for (int i = 0; i < 3; ++i) {
+    p.position_m[i] = s.pose.position[i];
+    p.theta_rad[i] = s.pose.theta[i];
+  }
+  p.voltage_v = s.sensors.voltage_v;
+  if (held.held()) {
+    for (int k = 0; k < 3; ++k) {
+      p.held_m[k] = held.a[k];
+      p.held_m[3 + k] = held.b[k];
+    }
+    p.held_m[6] = held.radius_m;
+  }
+  return p;
+}
+
 void ArmStateChannel::write(const engine::ArmStatePayload& state) noexcept {
   std::array<std::uint64_t, WORDS> words;
   std::memcpy(words.data(), &state, sizeof state);

@@ -14,10 +14,18 @@
 #include <string>
 
 #include "core/result.hpp"
+#include "drivers/jaco_controller.hpp"
 #include "engine/arm_state_payload.hpp"
 #include "engine/ipc_pubsub.hpp"
+#include "manipulation/arm_body.hpp"
 
 namespace orthoflow::graphs {
+
+/// @brief The arm-state sample of snapshot @p s stamped @p stamp_ns (the clock of the frames), with
+/// what the hand holds (@p held, none by default) for the body filter. No allocation.
+[[nodiscard]] engine::ArmStatePayload arm_state_payload(
+    const drivers::jaco::ArmSnapshot& s, std::int64_t stamp_ns,
+    const manipulation::HeldObject& held = {}) noexcept;
 
 /// @brief Arm states as they arrive.
 class ArmStateFeed {

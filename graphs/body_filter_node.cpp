@@ -355,7 +355,7 @@ NodeResult make_body_filter(const ParamMap& params, const engine::NodeContext& c
   if (!settings) return err(settings.error());
   auto state = params.choice("state", "ipc", {"ipc", "channel"});
   if (!state) return err(state.error());
-  auto topic = params.text("state_topic", "orthoflow/jaco/state");
+  auto topic = params.text("state_topic", engine::ARM_STATE_TOPIC);
   if (!topic) return err(topic.error());
   if (auto parsed = engine::parse_topic(*topic); !parsed)
     return err("body_filter: state_topic: " + engine::to_string(parsed.error()));

@@ -26,14 +26,14 @@
 
 #include "core/result.hpp"
 #include "manipulation/execution_manager.hpp"
+#include "manipulation/table_task_runner.hpp"
 #include "manipulation/table_tasks.hpp"
 #include "simulation/object_catalog.hpp"
 #include "simulation/synthetic_scene.hpp"
 
 namespace orthoflow::graphs {
 
-enum class TableTask : std::uint8_t { CLEAR_TABLE, SERVE_A_MEAL };
-[[nodiscard]] const char* to_string(TableTask task) noexcept;
+using TableTask = manipulation::TableTaskKind;
 
 /// @brief Trouble a script makes during one move (the aborts).
 enum class TaskEvent : std::uint8_t {
@@ -82,28 +82,16 @@ struct TableTaskConfig {
   [[nodiscard]] static manipulation::ExecutionLimits default_limits() noexcept;
 };
 
-/// @brief One primitive operator of a move: the phase and how long it took.
-struct OperatorTime {
-  std::string phase;
-  double seconds = 0.0;
-};
+using manipulation::OperatorTime;
 
-struct MoveReport {
-  std::uint32_t track = 0;
-  std::string label;  ///< the learner's
+/// @brief A move as the runner recorded it, and what the world says of it (ground truth).
+struct MoveReport : manipulation::MoveRecord {
   std::string truth;  ///< the world's category of the object perceived there ("" if none)
-  Eigen::Vector2d to = Eigen::Vector2d::Zero();
-  std::string grasp;  ///< "top" / "side", or "" when none was planned
-  std::vector<OperatorTime> operators;
-  bool done = false;  ///< the execution manager finished the move
   /// The world's object rests on the table, moved as planned within 5 cm: its displacement is the
   /// spot minus its perceived centre (ground truth, what a person watching would judge).
   bool arrived = false;
   double error_m = -1.0;  ///< that displacement's error (m); -1 when it was not moved
   bool held = false;      ///< the world's object was in the hand at some point (ground truth)
-  std::string failure;    ///< why not (an abort's reason, a planning refusal, ...)
-  double seconds = 0.0;
-  std::vector<std::string> decisions;  ///< the manager's log: "t phase -> phase: why"
 };
 
 struct StayReport {

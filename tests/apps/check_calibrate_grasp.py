@@ -103,7 +103,7 @@ with tempfile.TemporaryDirectory() as tmp:
             code=None)
     expect(p.returncode != 0 and "not a coordinate" in p.stderr, p.stderr)
     # orthoflow task: the table tasks planned on the same frame, from the learner's labels.
-    task = json.loads(run(cli, "task", "clear_table", "--robot-frames", frames_yaml, "--objects", objects,
+    task = json.loads(run(cli, "task", "plan", "clear_table", "--robot-frames", frames_yaml, "--objects", objects,
                           "--area=-0.45,-0.75,0.15,-0.6", "--keep", "plate", "--json").stdout)
     dist = [math.hypot(m["from_m"][0], m["from_m"][1]) for m in task["moves"]]
     expect(task["moves"] and dist == sorted(dist), f"clear_table: nearest to the base first: {task}")
@@ -113,11 +113,11 @@ with tempfile.TemporaryDirectory() as tmp:
            and all(s["reason"] == "unknown" for s in task["stays"] if s["label"] is None),
            f"clear_table: an Unknown object stays: {task['stays']}")
     expect(all(("job" in m) != ("blocked" in m) for m in task["moves"]), f"each move ready or blocked: {task}")
-    serve = json.loads(run(cli, "task", "serve_a_meal", "--robot-frames", frames_yaml, "--objects", objects,
+    serve = json.loads(run(cli, "task", "plan", "serve_a_meal", "--robot-frames", frames_yaml, "--objects", objects,
                            "--bring", "bowl,mug", "--user-place=-0.3,-0.3", "--json").stdout)
     expect([m["label"] for m in serve["moves"]] == ["bowl", "mug"][:len(serve["moves"])] and serve["moves"],
            f"serve_a_meal: in the order asked: {serve}")
-    p = run(cli, "task", "clear_table", "--robot-frames", frames_yaml, "--objects", objects, code=None)
+    p = run(cli, "task", "plan", "clear_table", "--robot-frames", frames_yaml, "--objects", objects, code=None)
     expect(p.returncode != 0 and "needs --area" in p.stderr, p.stderr)
     text = run(cli, "grasp", "--robot-frames", frames_yaml, "--objects", objects, "--frame", "3").stdout
     expect(text.startswith("frame 3: "), text)
