@@ -53,7 +53,9 @@ nlohmann::json to_json(const graphs::TableTaskReport& r) {
                      {"error_m", m.error_m},
                      {"failure", m.failure},
                      {"seconds", m.seconds},
-                     {"decisions", m.decisions}});
+                     {"decisions", m.decisions},
+                     {"attempt", m.attempt},
+                     {"retry_of", m.attempt > 1 ? nlohmann::json(m.retry_of) : nlohmann::json()}});
   }
   nlohmann::json stays = nlohmann::json::array();
   for (const graphs::StayReport& s : r.stays)
@@ -81,9 +83,10 @@ void print(const graphs::TableTaskReport& r) {
   }
   int n = 0;
   for (const graphs::MoveReport& m : r.moves) {
-    std::printf("  %d. track %u %s (truth %s) to [%.2f, %.2f]: %s grasp, %s in %.1f s%s%s\n", ++n,
-                m.track, m.label.c_str(), m.truth.empty() ? "-" : m.truth.c_str(), m.to.x(),
-                m.to.y(), m.grasp.empty() ? "no" : m.grasp.c_str(),
+    std::printf("  %d.%s track %u %s (truth %s) to [%.2f, %.2f]: %s grasp, %s in %.1f s%s%s\n", ++n,
+                m.attempt > 1 ? " retry:" : "", m.track, m.label.c_str(),
+                m.truth.empty() ? "-" : m.truth.c_str(), m.to.x(), m.to.y(),
+                m.grasp.empty() ? "no" : m.grasp.c_str(),
                 m.arrived ? "placed"
                           : (m.done ? (m.held ? "done, not at the spot" : "done, missed the object")
                                     : "FAILED"),
@@ -103,10 +106,11 @@ void print(const graphs::TableTaskReport& r) {
                 s.truth.empty() ? "-" : s.truth.c_str(), s.reason.c_str());
   if (!r.stopped.empty()) std::printf("  stopped: %s\n", r.stopped.c_str());
   std::printf(
-      "  %zu of %zu moves placed; %.1f s simulated, %llu frames, %llu dropped by the body "
-      "filter, %zu fell off the table\n",
-      r.arrived(), r.moves.size(), r.seconds, static_cast<unsigned long long>(r.frames),
-      static_cast<unsigned long long>(r.body_dropped), r.fallen);
+      "  %zu of %zu objects placed (%zu retried); %.1f s simulated, %llu frames, %llu dropped by "
+      "the body filter, %zu fell off the table\n",
+      r.arrived(), r.first_moves(), r.moves.size() - r.first_moves(), r.seconds,
+      static_cast<unsigned long long>(r.frames), static_cast<unsigned long long>(r.body_dropped),
+      r.fallen);
 }
 
 void run_demo(const DemoArgs& a) {
@@ -133,7 +137,7 @@ void run_demo(const DemoArgs& a) {
   else
     marks.user_place = &config.user_place;
   nlohmann::json all = nlohmann::json::array();
-  std::size_t moves = 0, placed = 0, refused = 0, stopped = 0;
+  std::size_t moves = 0, placed = 0, refused = 0, stopped = 0, retries = 0, placed_on_retry = 0;
   double placed_seconds = 0.0;
   std::map<std::string, std::size_t> failures;
   for (std::uint32_t k = 0; k < a.scenes; ++k) {
@@ -170,13 +174,24 @@ void run_demo(const DemoArgs& a) {
       print(r);
     refused += r.refused.empty() ? 0 : 1;
     stopped += r.stopped.empty() ? 0 : 1;
+    // Per object to move: its last attempt (a failed move is retried once, at the end).
+    std::vector<const graphs::MoveReport*> last(r.first_moves(), nullptr);
     for (const graphs::MoveReport& m : r.moves) {
-      ++moves;
-      if (m.arrived) {
-        ++placed;
-        placed_seconds += m.seconds;
+      if (m.attempt == 1) {
+        ++moves;
+        last[static_cast<std::size_t>(&m - r.moves.data())] = &m;
       } else {
-        ++failures[m.failure.empty() ? std::string("not at the spot") : m.failure];
+        ++retries;
+        last[m.retry_of] = &m;
+      }
+    }
+    for (const graphs::MoveReport* m : last) {
+      if (m->arrived) {
+        ++placed;
+        placed_seconds += m->seconds;
+        if (m->attempt > 1) ++placed_on_retry;
+      } else {
+        ++failures[m->failure.empty() ? std::string("not at the spot") : m->failure];
       }
     }
   }
@@ -188,6 +203,8 @@ void run_demo(const DemoArgs& a) {
                                  {{"scenes", a.scenes},
                                   {"moves", moves},
                                   {"placed", placed},
+                                  {"retries", retries},
+                                  {"placed_on_retry", placed_on_retry},
                                   {"mean_seconds_per_placed",
                                    placed ? placed_seconds / static_cast<double>(placed) : 0.0},
                                   {"refused", refused},
@@ -197,11 +214,12 @@ void run_demo(const DemoArgs& a) {
               << '\n';
   } else if (a.scenes > 1) {
     std::printf(
-        "%u scenes: %zu of %zu moves placed (%.1f %%), %.1f s per placed object; %zu "
-        "refused, %zu stopped\n",
+        "%u scenes: %zu of %zu objects placed (%.1f %%; %zu on a retry, of %zu retried), %.1f s "
+        "per placed object; %zu refused, %zu stopped\n",
         a.scenes, placed, moves,
         moves ? 100.0 * static_cast<double>(placed) / static_cast<double>(moves) : 0.0,
-        placed ? placed_seconds / static_cast<double>(placed) : 0.0, refused, stopped);
+        placed_on_retry, retries, placed ? placed_seconds / static_cast<double>(placed) : 0.0,
+        refused, stopped);
     for (const auto& [why, count] : failures)
       std::printf("  failed: %zu x %s\n", count, why.c_str());
   }

@@ -6,6 +6,7 @@
 #include <type_traits>
 
 #include "core/label_text.hpp"
+#include "graphs/payload_decode.hpp"
 
 namespace orthoflow::graphs {
 
@@ -21,23 +22,7 @@ constexpr std::uint32_t PROBLEM_BAD_POSITION = 254;
 template <class Payload>
 bool read_whole(std::span<const std::byte> bytes, std::uint32_t type_id, Payload& out,
                 std::string& error) {
-  static_assert(std::is_trivially_copyable_v<Payload>);
-  if (bytes.size() < sizeof(Payload)) {
-    error = "payload of " + std::to_string(bytes.size()) + " bytes, expected " +
-            std::to_string(sizeof(Payload));
-    return false;
-  }
-  std::memcpy(&out, bytes.data(), sizeof(Payload));
-  if (out.type_id != type_id || out.version != LEARNING_IPC_VERSION) {
-    error = "wrong payload type or version";
-    return false;
-  }
-  if (out.payload_bytes != sizeof(Payload)) {
-    error = "payload_bytes " + std::to_string(out.payload_bytes) + ", expected " +
-            std::to_string(sizeof(Payload));
-    return false;
-  }
-  return true;
+  return read_whole_payload(bytes, type_id, LEARNING_IPC_VERSION, out, error);
 }
 
 // A text another process wrote: zero-terminated within its capacity, else refused.

@@ -61,6 +61,11 @@ std::size_t TableTaskReport::arrived() const noexcept {
       std::count_if(moves.begin(), moves.end(), [](const MoveReport& m) { return m.arrived; }));
 }
 
+std::size_t TableTaskReport::first_moves() const noexcept {
+  return static_cast<std::size_t>(std::count_if(
+      moves.begin(), moves.end(), [](const MoveReport& m) { return m.attempt == 1; }));
+}
+
 Isometry3d synthetic_base_from_camera(const simulation::TableSpec& table) {
   const simulation::TableFrame t = simulation::table_frame(table);
   constexpr double BASE_BEYOND_CENTRE_M = 0.28284271247461906;  // 0.98995 - 0.70711 (the yaml)
@@ -110,6 +115,7 @@ class Session final : public WorldFeed {
   void arm_cycle() noexcept;
   void fire_event();
   void copy_records();
+  void grow_reports();
   [[nodiscard]] std::string truth_near(const Vector3d& base_point) const;
   [[nodiscard]] std::int64_t now() const noexcept { return sim_.clock().now_ns(); }
   [[nodiscard]] Vector3d to_base(const simulation::Vec3& p) const {
@@ -303,12 +309,23 @@ void Session::plan_task() {
   copy_records();
 }
 
+void Session::grow_reports() {
+  // The runner's retries (a failed move tried once more at the end) get a report each.
+  while (report_.moves.size() < runner_->moves().size()) {
+    MoveReport r;
+    r.truth = report_.moves[runner_->moves()[report_.moves.size()].retry_of].truth;
+    report_.moves.push_back(std::move(r));
+  }
+}
+
 void Session::copy_records() {
+  grow_reports();
   for (std::size_t m = 0; m < report_.moves.size(); ++m)
     static_cast<manipulation::MoveRecord&>(report_.moves[m]) = runner_->moves()[m];
 }
 
 void Session::move_started(std::size_t /*move*/, const manipulation::SeenObject& s) {
+  grow_reports();
   target_object_ = -1;
   double best = 0.10;
   for (std::size_t i = 0; i < world_->scene().objects.size(); ++i) {

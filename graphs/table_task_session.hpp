@@ -117,6 +117,8 @@ struct TableTaskReport {
   std::uint64_t body_dropped = 0;  ///< frames the body filter dropped (no fresh arm state)
   std::size_t fallen = 0;          ///< objects that fell off the table
   [[nodiscard]] std::size_t arrived() const noexcept;
+  /// @brief Moves of the first pass: the objects the task moves (the rest are retries).
+  [[nodiscard]] std::size_t first_moves() const noexcept;
 };
 
 /// @brief Runs one task. @return the report, or why the loop could not be built (a graph error).

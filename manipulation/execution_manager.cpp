@@ -7,6 +7,32 @@
 
 namespace orthoflow::manipulation {
 
+ArmInput arm_input(const drivers::jaco::ArmSnapshot& s) noexcept {
+  ArmInput a;
+  a.joints = s.joints;
+  a.fingers = {s.fingers[0], s.fingers[1], s.fingers[2]};
+  a.idle = s.control == drivers::jaco::ControlState::IDLE;
+  a.fault = s.fault;
+  a.estop = s.estop;
+  return a;
+}
+
+drivers::jaco::ArmCommand arm_command(const ArmRequest& r) noexcept {
+  using Kind = drivers::jaco::ArmCommand::Kind;
+  drivers::jaco::ArmCommand c;
+  c.speed_fraction = r.speed_fraction;
+  if (r.kind == ArmRequest::Kind::MOVE_JOINTS) {
+    c.kind = Kind::MOVE_JOINTS;
+    c.joints = r.joints;
+  } else if (r.kind == ArmRequest::Kind::MOVE_FINGERS) {
+    c.kind = Kind::MOVE_FINGERS;
+    c.fingers = {r.fingers, r.fingers, r.fingers};
+  } else {
+    c.kind = Kind::STOP;
+  }
+  return c;
+}
+
 namespace {
 
 using drivers::jaco::JointAngles;

@@ -28,6 +28,7 @@
 
 #include <Eigen/Geometry>
 
+#include "drivers/jaco_controller.hpp"
 #include "drivers/jaco_kinematics.hpp"
 
 namespace orthoflow::manipulation {
@@ -118,6 +119,9 @@ struct ArmInput {
   bool estop = false;
 };
 
+/// @brief The manager's view of the driver's snapshot @p s. No allocation.
+[[nodiscard]] ArmInput arm_input(const drivers::jaco::ArmSnapshot& s) noexcept;
+
 /// @brief Another object, as a sphere in the base frame.
 struct Obstacle {
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
@@ -171,6 +175,10 @@ struct ArmRequest {
   double fingers = 0.0;  ///< all three fingers to this
   double speed_fraction = 1.0;
 };
+
+/// @brief The driver's command for @p r (MOVE_JOINTS, MOVE_FINGERS on all three fingers, or STOP
+/// for STOP and NONE). No allocation.
+[[nodiscard]] drivers::jaco::ArmCommand arm_command(const ArmRequest& r) noexcept;
 
 /// @brief One decision: a phase change and why.
 struct Decision {

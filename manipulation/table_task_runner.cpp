@@ -107,7 +107,8 @@ void TableTaskRunner::step(std::int64_t now_ns, const jaco::ArmSnapshot& arm,
                            const Submit& submit) {
   if (state_ != State::MOVING) return;
   waiting_ = false;
-  while (state_ == State::MOVING && move_ < moves_.size() && !waiting_)
+  while (state_ == State::MOVING && !waiting_ &&
+         (move_ < moves_.size() || (options_.retry_failed && !retried_ && add_retries() > 0)))
     start_move(now_ns, arm, submit);
   if (state_ == State::MOVING && !waiting_) state_ = State::FINISHED;
 }
@@ -325,28 +326,9 @@ bool TableTaskRunner::cycle(std::int64_t now_ns, const jaco::ArmSnapshot& arm,
         !in.target_seen && (cut || (target_centre_ - tool_base).norm() < HAND_HIDES_M ||
                             arm_hides(target_centre_, radius));
     in.others = std::span(others_).first(fill_obstacles(t, tool_base, holding));
-    ArmInput a;
-    a.joints = arm.joints;
-    a.fingers = {arm.fingers[0], arm.fingers[1], arm.fingers[2]};
-    a.idle = arm.control == jaco::ControlState::IDLE;
-    a.fault = arm.fault;
-    a.estop = arm.estop;
     was_holding_ = manager_.holding();
-    const ArmRequest r = manager_.step(now_ns, a, in);
-    if (r.kind != ArmRequest::Kind::NONE) {
-      jaco::ArmCommand c;
-      c.speed_fraction = r.speed_fraction;
-      if (r.kind == ArmRequest::Kind::MOVE_JOINTS) {
-        c.kind = jaco::ArmCommand::Kind::MOVE_JOINTS;
-        c.joints = r.joints;
-      } else if (r.kind == ArmRequest::Kind::MOVE_FINGERS) {
-        c.kind = jaco::ArmCommand::Kind::MOVE_FINGERS;
-        c.fingers = {r.fingers, r.fingers, r.fingers};
-      } else {
-        c.kind = jaco::ArmCommand::Kind::STOP;
-      }
-      if (!submit(c)) manager_.refused(now_ns);
-    }
+    const ArmRequest r = manager_.step(now_ns, arm_input(arm), in);
+    if (r.kind != ArmRequest::Kind::NONE && !submit(arm_command(r))) manager_.refused(now_ns);
   }
   return manager_.running() || parking_;
 }
@@ -387,6 +369,23 @@ void TableTaskRunner::finish_move(std::int64_t now_ns) {
     return;
   }
   state_ = State::MOVING;
+}
+
+std::size_t TableTaskRunner::add_retries() {
+  retried_ = true;
+  const std::size_t first_pass = moves_.size();
+  for (std::size_t k = 0; k < first_pass; ++k) {
+    if (moves_[k].done) continue;
+    MoveRecord r;
+    r.track = moves_[k].track;
+    r.label = moves_[k].label;
+    r.to = moves_[k].to;
+    r.attempt = 2;
+    r.retry_of = k;
+    moves_.push_back(std::move(r));
+    planned_.push_back(planned_[k]);
+  }
+  return moves_.size() - first_pass;
 }
 
 void TableTaskRunner::end_task(const std::string& why) {

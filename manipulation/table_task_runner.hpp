@@ -72,6 +72,9 @@ struct TableTaskOptions {
   /// A move whose object is unseen (or hidden by the arm) waits this many perception frames for it
   /// before it fails ("the object is no longer seen").
   std::uint32_t look_again_frames = 30;
+  /// Once every move was tried, each one that failed (and did not stop the task) is tried once
+  /// more, to the same spot: the objects moved since may have cleared its way.
+  bool retry_failed = true;
 };
 
 struct OperatorTime {
@@ -90,6 +93,8 @@ struct MoveRecord {
   std::string failure;  ///< why not (an abort's reason, a planning refusal, ...)
   double seconds = 0.0;
   std::vector<std::string> decisions;  ///< the manager's log: "t phase -> phase: why"
+  std::uint32_t attempt = 1;           ///< 2: the retry of a failed move (retry_of says which)
+  std::size_t retry_of = 0;
 };
 
 /// @brief An object the task leaves where it is, and why.
@@ -157,6 +162,8 @@ class TableTaskRunner {
   void start_move(std::int64_t now_ns, const drivers::jaco::ArmSnapshot& arm, const Submit& submit);
   void finish_move(std::int64_t now_ns);
   void end_task(const std::string& why);
+  /// Appends a retry of every failed move of the first pass. @return how many.
+  std::size_t add_retries();
   bool park(const drivers::jaco::ArmSnapshot& arm, const Submit& submit);
   std::size_t fill_obstacles(const SeenObject* target, const Eigen::Vector3d& hand, bool holding);
   std::size_t add_spheres(const SeenObject& o, std::size_t used);
@@ -190,6 +197,7 @@ class TableTaskRunner {
   bool parking_ = false;
   bool waiting_ = false;
   bool stop_requested_ = false;
+  bool retried_ = false;
   std::uint32_t unseen_frames_ = 0;
   std::array<kernels::Capsule, ARM_BODY_CAPSULES> sight_{};
   std::size_t sight_count_ = 0;

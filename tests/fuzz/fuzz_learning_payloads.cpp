@@ -12,6 +12,7 @@
 
 #include "core/label_text.hpp"
 #include "graphs/learning_payloads.hpp"
+#include "tests/fuzz/fuzz_payload_support.hpp"
 
 namespace g = orthoflow::graphs;
 
@@ -19,25 +20,8 @@ namespace {
 
 using Kind = g::LearningCommand::Kind;
 
-template <class Payload>
-std::unique_ptr<Payload> filled(const std::uint8_t* data, std::size_t size, bool fix_header) {
-  auto p = std::make_unique<Payload>();
-  g::reset_header(*p);
-  std::memcpy(static_cast<void*>(p.get()), data, std::min(size, sizeof(Payload)));
-  if (fix_header) {
-    Payload fresh;
-    g::reset_header(fresh);
-    p->type_id = fresh.type_id;
-    p->version = fresh.version;
-    p->payload_bytes = fresh.payload_bytes;
-  }
-  return p;
-}
-
-template <class Payload>
-std::span<const std::byte> bytes_of(const Payload& p, std::size_t size) {
-  return {reinterpret_cast<const std::byte*>(&p), std::min(size, sizeof(Payload))};
-}
+using orthoflow::fuzz::bytes_of;
+using orthoflow::fuzz::filled;
 
 void check_command(const std::uint8_t* data, std::size_t size, bool fix, bool whole) {
   const auto p = filled<g::LearningCommandPayload>(data, size, fix);

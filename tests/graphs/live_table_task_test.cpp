@@ -77,6 +77,8 @@ class LiveRig {
     e.flags = engine::OBJECT_DESCRIBED;
   }
 
+  void clear_objects() { list_->count = 0; }
+
   [[nodiscard]] std::int64_t now() const { return sim_.clock().now_ns(); }
 
   /// @p ms of arm cycles; an object list (stamped now) every 100 ms.
@@ -172,6 +174,29 @@ TEST(LiveTableTask, AStartMovesTheArmAndAStopBacksItAwayAndEndsTheTask) {
   EXPECT_EQ(rig.send(TaskCommand::Kind::STOP), TaskAnswer::REFUSED);
   EXPECT_EQ(rig.statuses.back().message, "no task is running");
   EXPECT_EQ(rig.send(TaskCommand::Kind::START), TaskAnswer::STARTED);
+}
+
+TEST(LiveTableTask, AFailedMoveIsTriedOnceMoreAtTheEndThenTheTaskEnds) {
+  LiveRig rig;
+  rig.add_object(3, "bottle", Vector3d(-0.20, -0.40, 0.10));
+  rig.run(300);
+  ASSERT_EQ(rig.send(TaskCommand::Kind::START), TaskAnswer::STARTED);
+  rig.clear_objects();  // someone takes the bottle away before the arm gets there
+  rig.run(100);
+  ASSERT_TRUE(rig.task->running());
+  rig.run(4000);  // the move looks for it 30 frames; then its retry does, 30 more
+  rig.run(4000);
+  EXPECT_FALSE(rig.task->running());
+  const auto& moves = rig.task->runner()->moves();
+  ASSERT_EQ(moves.size(), 2U);
+  EXPECT_EQ(moves[0].failure, "the object is no longer seen");
+  EXPECT_EQ(moves[1].attempt, 2U);
+  EXPECT_EQ(moves[1].retry_of, 0U);
+  EXPECT_EQ(moves[1].to, moves[0].to);  // to the same spot
+  EXPECT_EQ(moves[1].failure, "the object is no longer seen");
+  EXPECT_EQ(rig.task->runner()->stopped(), "");  // the task ended, it was not stopped
+  EXPECT_EQ(rig.statuses.back().state, TaskState::FINISHED);
+  EXPECT_EQ(rig.statuses.back().moves, 2U);
 }
 
 TEST(LiveTableTask, AStartWithoutFreshObjectsIsRefused) {

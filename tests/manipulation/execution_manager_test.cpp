@@ -63,16 +63,7 @@ struct World {
   Vector3d tool() const {
     return jaco::forward_kinematics(rig.controller->snapshot().joints).translation();
   }
-  ArmInput arm_input() const {
-    const auto s = rig.controller->snapshot();
-    ArmInput a;
-    a.joints = s.joints;
-    a.fingers = {s.fingers[0], s.fingers[1], s.fingers[2]};
-    a.idle = s.control == jaco::ControlState::IDLE;
-    a.fault = s.fault;
-    a.estop = s.estop;
-    return a;
-  }
+  ArmInput arm_input() const { return manipulation::arm_input(rig.controller->snapshot()); }
   void update_world(const PickPlaceJob& job) {
     const auto s = rig.controller->snapshot();
     const bool closed = s.fingers[0] >= job.close_fingers - 100.0;
@@ -109,18 +100,7 @@ struct World {
       step_allocations += test::g_allocations.load();
       if (r.kind != ArmRequest::Kind::NONE) {
         sent.push_back(r);
-        jaco::ArmCommand c;
-        c.speed_fraction = r.speed_fraction;
-        if (r.kind == ArmRequest::Kind::MOVE_JOINTS) {
-          c.kind = jaco::ArmCommand::Kind::MOVE_JOINTS;
-          c.joints = r.joints;
-        } else if (r.kind == ArmRequest::Kind::MOVE_FINGERS) {
-          c.kind = jaco::ArmCommand::Kind::MOVE_FINGERS;
-          c.fingers = {r.fingers, r.fingers, r.fingers};
-        } else {
-          c.kind = jaco::ArmCommand::Kind::STOP;
-        }
-        if (!rig.controller->submit(c)) {
+        if (!rig.controller->submit(arm_command(r))) {
           ++refusals;
           manager.refused(rig.now());
         }
