@@ -164,11 +164,13 @@ ArmRequest ExecutionManager::enter(Phase next, std::int64_t now_ns, AbortReason 
   const double slow = limits_.approach_speed;
   switch (next) {
     case Phase::GO_INITIAL:
-      return move_to(job_.initial, 1.0);
+      risen_reached_ = !job_.rise_first;
+      return risen_reached_ ? move_to(job_.initial, 1.0) : move_to(job_.risen, slow);
     case Phase::OPEN:
       return fingers_to(job_.open_fingers, 1.0);
     case Phase::PRE_GRASP:
-      return move_to(job_.pre_grasp, 1.0);
+      above_reached_ = !job_.via_above;
+      return move_to(above_reached_ ? job_.pre_grasp : job_.above_pre_grasp, 1.0);
     case Phase::APPROACH:
       return move_to(job_.grasp, slow);
     case Phase::CLOSE:
@@ -213,6 +215,11 @@ ArmRequest ExecutionManager::abort(std::int64_t now_ns, AbortReason reason,
   return enter(Phase::ABORTED, now_ns, reason, why);  // stop and hold where it is
 }
 
+void ExecutionManager::note(std::int64_t now_ns, const char* why) noexcept {
+  log_[logged_ % LOG_SIZE] = Decision{now_ns, phase_, phase_, AbortReason::NONE, why};
+  ++logged_;
+}
+
 void ExecutionManager::refused(std::int64_t now_ns) noexcept {
   if (running()) pending_ = abort(now_ns, AbortReason::REFUSED, "the arm refused the command");
 }
@@ -226,9 +233,9 @@ void ExecutionManager::request_stop(std::int64_t now_ns) noexcept {
 const JointAngles* ExecutionManager::joint_goal(Phase phase) const noexcept {
   switch (phase) {
     case Phase::GO_INITIAL:
-      return &job_.initial;
+      return risen_reached_ ? &job_.initial : &job_.risen;
     case Phase::PRE_GRASP:
-      return &job_.pre_grasp;
+      return above_reached_ ? &job_.pre_grasp : &job_.above_pre_grasp;
     case Phase::APPROACH:
       return &job_.grasp;
     case Phase::LIFT:
@@ -340,7 +347,12 @@ ArmRequest ExecutionManager::step(std::int64_t now_ns, const ArmInput& arm,
   // Success checks: each operator ends on the arm's state (and the lift on perception).
   switch (phase_) {
     case Phase::GO_INITIAL:
-      if (at_joints(arm, job_.initial))
+      if (!risen_reached_ && at_joints(arm, job_.risen)) {
+        risen_reached_ = true;
+        note(now_ns, "risen above where it was");
+        return move_to(job_.initial, 1.0);
+      }
+      if (risen_reached_ && at_joints(arm, job_.initial))
         return enter(Phase::OPEN, now_ns, {}, "at the initial pose");
       break;
     case Phase::OPEN:
@@ -348,7 +360,12 @@ ArmRequest ExecutionManager::step(std::int64_t now_ns, const ArmInput& arm,
         return enter(Phase::PRE_GRASP, now_ns, {}, "the hand is open");
       break;
     case Phase::PRE_GRASP:
-      if (at_joints(arm, job_.pre_grasp))
+      if (!above_reached_ && at_joints(arm, job_.above_pre_grasp)) {
+        above_reached_ = true;
+        note(now_ns, "above the pre-grasp pose");
+        return move_to(job_.pre_grasp, limits_.approach_speed);
+      }
+      if (above_reached_ && at_joints(arm, job_.pre_grasp))
         return enter(Phase::APPROACH, now_ns, {}, "at the pre-grasp pose");
       break;
     case Phase::APPROACH:

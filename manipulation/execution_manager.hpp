@@ -75,6 +75,14 @@ struct PickPlaceJob {
   Eigen::Vector3d target_centre = Eigen::Vector3d::Zero();  ///< base frame, when planned
   Eigen::Vector3d up = Eigen::Vector3d::UnitZ();  ///< the table's normal (base frame, unit)
   drivers::jaco::JointAngles initial{}, pre_grasp{}, grasp{}, lift{}, carry{}, place{}, retreat{};
+  /// A way in from above (add_way_in_from_above): PRE_GRASP first goes to above_pre_grasp, the
+  /// pre-grasp pose raised along the table's normal, then down to the pre-grasp.
+  bool via_above = false;
+  drivers::jaco::JointAngles above_pre_grasp{};
+  /// A way out from above (add_rise_first): GO_INITIAL first raises the hand from where the arm
+  /// was when the job was planned (risen), then goes to the initial pose.
+  bool rise_first = false;
+  drivers::jaco::JointAngles risen{};
   double open_fingers = 0.0;   ///< the model's units (0 open)
   double close_fingers = 0.0;  ///< the model's units
   double lift_m = 0.10;        ///< how far the lift raises the hand (the grasp check uses half)
@@ -219,6 +227,8 @@ class ExecutionManager {
  private:
   ArmRequest enter(Phase next, std::int64_t now_ns, AbortReason reason, const char* why) noexcept;
   ArmRequest abort(std::int64_t now_ns, AbortReason reason, const char* why) noexcept;
+  /// Logs a step within a phase (from = to = the phase).
+  void note(std::int64_t now_ns, const char* why) noexcept;
   [[nodiscard]] bool at_joints(const ArmInput& arm,
                                const drivers::jaco::JointAngles& goal) const noexcept;
   [[nodiscard]] bool at_fingers(const ArmInput& arm, double goal) const noexcept;
@@ -234,6 +244,9 @@ class ExecutionManager {
   AbortReason reason_ = AbortReason::NONE;
   std::int64_t entered_ns_ = 0;
   std::int64_t target_last_seen_ns_ = 0;
+  bool above_reached_ = false;
+  bool risen_reached_ = false;  ///< GO_INITIAL of a job with rise_first: the rise is behind  ///<
+                                ///< PRE_GRASP of a job with via_above: the way-point is behind
   bool back_away_after_open_ = false;  ///< an abort while closing: open, then back away
   bool stop_requested_ = false;
   std::int64_t stop_requested_ns_ = 0;

@@ -99,6 +99,39 @@ Result<PickPlaceJob, std::string> make_pick_place_job(std::uint32_t track_id,
   return job;
 }
 
+Result<void, std::string> add_way_in_from_above(PickPlaceJob& job, const Grasp& grasp,
+                                                double height_m,
+                                                const JobOptions& options) noexcept {
+  if (!std::isfinite(height_m) || height_m <= 0.0)
+    return err(std::string("a way in from above needs a positive height"));
+  const drivers::jaco::ArmGeometry& geometry =
+      options.grasp.geometry != nullptr ? *options.grasp.geometry : drivers::jaco::jaco2_geometry();
+  Eigen::Isometry3d above = grasp.pre_grasp;
+  above.translation() += height_m * options.grasp.table.normal.normalized();
+  auto q = drivers::jaco::inverse_kinematics(above, job.pre_grasp, options.grasp.limits,
+                                             options.grasp.tolerance, geometry);
+  if (!q) return err(std::string("above the pre-grasp: ") + drivers::jaco::to_string(q.error()));
+  job.via_above = true;
+  job.above_pre_grasp = *q;
+  return {};
+}
+
+Result<void, std::string> add_rise_first(PickPlaceJob& job, const drivers::jaco::JointAngles& now,
+                                         double height_m, const JobOptions& options) noexcept {
+  if (!std::isfinite(height_m) || height_m <= 0.0)
+    return err(std::string("a rise needs a positive height"));
+  const drivers::jaco::ArmGeometry& geometry =
+      options.grasp.geometry != nullptr ? *options.grasp.geometry : drivers::jaco::jaco2_geometry();
+  Eigen::Isometry3d risen = drivers::jaco::forward_kinematics(now, geometry);
+  risen.translation() += height_m * options.grasp.table.normal.normalized();
+  auto q = drivers::jaco::inverse_kinematics(risen, now, options.grasp.limits,
+                                             options.grasp.tolerance, geometry);
+  if (!q) return err(std::string("the rise: ") + drivers::jaco::to_string(q.error()));
+  job.rise_first = true;
+  job.risen = *q;
+  return {};
+}
+
 Result<void, std::string> check_job_paths(const PickPlaceJob& job,
                                           const drivers::jaco::JointAngles& now,
                                           std::span<const Obstacle> others, double clearance_m,
@@ -108,14 +141,20 @@ Result<void, std::string> check_job_paths(const PickPlaceJob& job,
     const drivers::jaco::JointAngles* from;
     const drivers::jaco::JointAngles* to;
     bool straight;
-  } moves[] = {{"initial", &now, &job.initial, false},
-               {"pre_grasp", &job.initial, &job.pre_grasp, false},
+  } moves[] = {{"rise", &now, &job.risen, true},
+               {"initial", job.rise_first ? &job.risen : &now, &job.initial, false},
+               {job.via_above ? "above the pre_grasp" : "pre_grasp", &job.initial,
+                job.via_above ? &job.above_pre_grasp : &job.pre_grasp, false},
+               {"down to the pre_grasp", &job.above_pre_grasp, &job.pre_grasp, true},
                {"approach", &job.pre_grasp, &job.grasp, true},
                {"lift", &job.grasp, &job.lift, true},
                {"carry", &job.lift, &job.carry, false},
                {"place", &job.carry, &job.place, true},
                {"retreat", &job.place, &job.retreat, true}};
   for (const auto& m : moves) {
+    if ((m.from == &job.above_pre_grasp && !job.via_above) ||
+        (m.to == &job.risen && !job.rise_first))
+      continue;
     if (auto safe = drivers::jaco::check_joint_move(limits, *m.from, *m.to); !safe)
       return err(std::string(m.name) + ": " + drivers::jaco::describe(safe.error()));
     if (joint_path_blocked(*m.from, *m.to, others, clearance_m))

@@ -36,6 +36,23 @@ struct JobOptions {
     std::uint32_t track_id, const Eigen::Vector3d& target_centre, const Grasp& grasp,
     const Eigen::Vector3d& place_centre, const JobOptions& options) noexcept;
 
+/// @brief Gives @p job (made from @p grasp) a way in from above: its pre-grasp pose raised
+/// @p height_m along the table's normal, which the manager reaches before the pre-grasp (the hand
+/// then comes straight down to it), for when the direct way to the pre-grasp passes another
+/// object. @return the IK error of the raised pose (the job is unchanged then).
+[[nodiscard]] Result<void, std::string> add_way_in_from_above(PickPlaceJob& job, const Grasp& grasp,
+                                                              double height_m,
+                                                              const JobOptions& options) noexcept;
+
+/// @brief Gives @p job a way out from above: from the arm's joints @p now (where it stands when the
+/// job starts), the hand first rises @p height_m along the table's normal, then goes to the
+/// initial pose; for when the direct way to the initial pose passes another object (the last job
+/// left the hand low beside the object it placed). @return the IK error of the risen pose.
+[[nodiscard]] Result<void, std::string> add_rise_first(PickPlaceJob& job,
+                                                       const drivers::jaco::JointAngles& now,
+                                                       double height_m,
+                                                       const JobOptions& options) noexcept;
+
 /// @brief How far a straight move of a job may stray from its line (check_job_paths).
 inline constexpr double MAX_SWING_M = 0.03;
 

@@ -262,34 +262,49 @@ void TableTaskRunner::start_move(std::int64_t now_ns, const jaco::ArmSnapshot& a
   // along its joint-space path and inside the safety limits, with a margin first (a perceived box
   // shifts by a centimetre or two between frames, and the manager checks every frame), then
   // without.
+  // When no job at any spot is clear, the same search again with a way in from above (the hand
+  // rises over what is in the way, then comes down to the pre-grasp), 10 then 20 cm; then with a
+  // way out from above as well (the hand first rises from where the last job left it).
+  constexpr std::array<std::pair<double, double>, 6> WAYS{
+      {{0.0, 0.0}, {0.10, 0.0}, {0.20, 0.0}, {0.0, 0.15}, {0.10, 0.15}, {0.20, 0.15}}};
   std::vector<std::pair<PickPlaceJob, const Grasp*>> made;
   std::size_t spot = move_;
-  for (; spot < moves_.size() && !job; ++spot) {
-    const Vector3d place(moves_[spot].to.x(), moves_[spot].to.y(), s->centre.z());
-    made.clear();
-    for (std::size_t k = 0; k < plan->feasible_count; ++k) {
-      for (auto l = lifts.begin(); l != lifts_end; ++l) {
-        job_options.lift_m = *l;
-        auto m = make_pick_place_job(s->track, s->centre, plan->feasible[k], place, job_options);
-        if (m)
-          made.emplace_back(*m, &plan->feasible[k]);
-        else if (spot == move_ && k == 0 && l == lifts.begin())
-          why = "no job: " + m.error();
-      }
-    }
-    for (const double margin : {PLAN_MARGIN_M, 0.0}) {
-      for (const auto& [candidate, grasp] : made) {
-        auto ok =
-            check_job_paths(candidate, arm.joints, obstacles, clear + margin, jaco::SafetyLimits{});
-        if (ok) {
-          job = candidate;
-          r.grasp = to_string(grasp->kind);
-          break;
+  for (const auto& [above, rise] : WAYS) {
+    for (spot = move_; spot < moves_.size() && !job; ++spot) {
+      const Vector3d place(moves_[spot].to.x(), moves_[spot].to.y(), s->centre.z());
+      made.clear();
+      for (std::size_t k = 0; k < plan->feasible_count; ++k) {
+        for (auto l = lifts.begin(); l != lifts_end; ++l) {
+          job_options.lift_m = *l;
+          auto m = make_pick_place_job(s->track, s->centre, plan->feasible[k], place, job_options);
+          const bool ways =
+              m &&
+              (above == 0.0 || add_way_in_from_above(*m, plan->feasible[k], above, job_options)) &&
+              (rise == 0.0 || add_rise_first(*m, arm.joints, rise, job_options));
+          if (ways)
+            made.emplace_back(*m, &plan->feasible[k]);
+          else if (!m && spot == move_ && k == 0 && l == lifts.begin() && above == 0.0 &&
+                   rise == 0.0)
+            why = "no job: " + m.error();
         }
-        if (why.empty() && margin == 0.0) why = "no clear job: " + ok.error();
       }
-      if (job) break;
+      for (const double margin : {PLAN_MARGIN_M, 0.0}) {
+        for (const auto& [candidate, grasp] : made) {
+          auto ok = check_job_paths(candidate, arm.joints, obstacles, clear + margin,
+                                    jaco::SafetyLimits{});
+          if (ok) {
+            job = candidate;
+            r.grasp = to_string(grasp->kind);
+            if (above > 0.0) r.grasp += " from above";
+            if (rise > 0.0) r.grasp += ", rising first";
+            break;
+          }
+          if (why.empty() && margin == 0.0) why = "no clear job: " + ok.error();
+        }
+        if (job) break;
+      }
     }
+    if (job) break;
   }
   if (job && spot - 1 != move_) std::swap(r.to, moves_[spot - 1].to);
   target_place_ = r.to;
@@ -343,8 +358,11 @@ void TableTaskRunner::finish_move(std::int64_t now_ns) {
   std::array<Decision, ExecutionManager::LOG_SIZE> log{};
   const std::size_t n = manager_.decisions(log);
   for (std::size_t i = 0; i < n; ++i) {
-    const std::int64_t end = i + 1 < n ? log[i + 1].stamp_ns : now_ns;
-    if (log[i].to != Phase::DONE && log[i].to != Phase::ABORTED)
+    // An operator lasts until the next phase change (a note within a phase is not one).
+    std::size_t next = i + 1;
+    while (next < n && log[next].from == log[next].to) ++next;
+    const std::int64_t end = next < n ? log[next].stamp_ns : now_ns;
+    if (log[i].from != log[i].to && log[i].to != Phase::DONE && log[i].to != Phase::ABORTED)
       r.operators.push_back(
           {to_string(log[i].to), 1e-9 * static_cast<double>(end - log[i].stamp_ns)});
     char line[160];

@@ -156,6 +156,52 @@ TEST(ExecutionManager, PicksAndPlacesTheMugOnTheSimulatedArm) {
   EXPECT_LT(joint_distance(world.rig.controller->snapshot().joints, job.retreat), 1.0);
 }
 
+TEST(ExecutionManager, AWayInFromAboveGoesOverThenDownToThePreGrasp) {
+  World world;
+  ExecutionManager manager;
+  PickPlaceJob job = mug_job();
+  auto plan = plan_grasp(mug(), JobOptions{}.grasp);
+  ASSERT_TRUE(plan && plan->best() != nullptr);
+  ASSERT_TRUE(add_way_in_from_above(job, *plan->best(), 0.15, JobOptions{}));
+  ASSERT_TRUE(job.via_above);
+  const Vector3d above = jaco::forward_kinematics(job.above_pre_grasp).translation();
+  const Vector3d pre = jaco::forward_kinematics(job.pre_grasp).translation();
+  EXPECT_NEAR(above.z() - pre.z(), 0.15, 0.005);
+  EXPECT_NEAR((above - pre).head<2>().norm(), 0.0, 0.005);
+  double highest_near_pre = -1.0;  // the tool's height while above the pre-grasp's footprint
+  world.event = [&](World& w, const ExecutionManager& m) {
+    const Vector3d tool =
+        jaco::forward_kinematics(w.rig.controller->snapshot().joints).translation();
+    if (m.phase() == Phase::PRE_GRASP && (tool - pre).head<2>().norm() < 0.01)
+      highest_near_pre = std::max(highest_near_pre, tool.z());
+  };
+  world.run(manager, job);
+  EXPECT_EQ(manager.phase(), Phase::DONE) << log_text(manager);
+  EXPECT_NE(log_text(manager).find("pre_grasp -> pre_grasp (none: above the pre-grasp pose)"),
+            std::string::npos)
+      << log_text(manager);
+  EXPECT_GT(highest_near_pre, pre.z() + 0.14) << "the hand came down onto the pre-grasp";
+  EXPECT_EQ(world.step_allocations, 0U);
+}
+
+TEST(ExecutionManager, AWayOutFromAboveRisesBeforeGoingToTheInitialPose) {
+  World world;
+  ExecutionManager manager;
+  PickPlaceJob job = mug_job();
+  const jaco::JointAngles start = world.rig.controller->snapshot().joints;
+  ASSERT_TRUE(add_rise_first(job, start, 0.10, JobOptions{}));
+  const Vector3d from = jaco::forward_kinematics(start).translation();
+  const Vector3d risen = jaco::forward_kinematics(job.risen).translation();
+  EXPECT_NEAR(risen.z() - from.z(), 0.10, 0.005);
+  EXPECT_NEAR((risen - from).head<2>().norm(), 0.0, 0.005);
+  world.run(manager, job);
+  EXPECT_EQ(manager.phase(), Phase::DONE) << log_text(manager);
+  const std::string log = log_text(manager);
+  const std::size_t rose = log.find("go_initial -> go_initial (none: risen above where it was)");
+  ASSERT_NE(rose, std::string::npos) << log;
+  EXPECT_LT(rose, log.find("go_initial -> open")) << "it rises before it reaches the initial pose";
+}
+
 TEST(ExecutionManager, TheTargetMovingDuringTheApproachBacksTheArmAway) {
   World world;
   ExecutionManager manager;

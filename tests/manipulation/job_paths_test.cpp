@@ -92,6 +92,43 @@ TEST(JobPaths, TheFirstBlockedMoveIsNamedInOrder) {
   EXPECT_EQ(blocked.error().rfind("pre_grasp: ", 0), 0U) << blocked.error();
 }
 
+TEST(JobPaths, AWayInFromAboveIsCheckedOverAndDown) {
+  PickPlaceJob job = mug_job();
+  const JobOptions options;
+  auto plan = plan_grasp(mug(), options.grasp);
+  ASSERT_TRUE(plan && plan->best() != nullptr);
+  ASSERT_TRUE(add_way_in_from_above(job, *plan->best(), 0.15, options));
+  const jaco::SafetyLimits limits;
+  EXPECT_TRUE(check_job_paths(job, jaco::HOME_JOINTS, {}, 0.02, limits));
+  // Something between the raised pose and the pre-grasp blocks the way down, and is named so.
+  const Vector3d down = tool_at(job.above_pre_grasp, job.pre_grasp, 0.5);
+  const std::array<Obstacle, 1> under{{{down, 0.01}}};
+  const auto blocked = check_job_paths(job, jaco::HOME_JOINTS, under, 0.01, limits);
+  ASSERT_FALSE(blocked);
+  EXPECT_EQ(blocked.error().rfind("above the pre_grasp: ", 0) == 0 ||
+                blocked.error().rfind("down to the pre_grasp: ", 0) == 0,
+            true)
+      << blocked.error();
+  // A height the arm cannot reach is refused and leaves the job as it was.
+  PickPlaceJob direct = mug_job();
+  EXPECT_FALSE(add_way_in_from_above(direct, *plan->best(), 2.0, options));
+  EXPECT_FALSE(direct.via_above);
+  EXPECT_FALSE(add_way_in_from_above(direct, *plan->best(), -0.1, options));
+}
+
+TEST(JobPaths, AWayOutFromAboveIsCheckedUpThenAcross) {
+  PickPlaceJob job = mug_job();
+  const jaco::JointAngles now = job.pre_grasp;  // the hand low, where a last job may leave it
+  ASSERT_TRUE(add_rise_first(job, now, 0.15, JobOptions{}));
+  const jaco::SafetyLimits limits;
+  EXPECT_TRUE(check_job_paths(job, now, {}, 0.02, limits));
+  const std::array<Obstacle, 1> over{{{tool_at(now, job.risen, 0.5), 0.01}}};
+  const auto blocked = check_job_paths(job, now, over, 0.01, limits);
+  ASSERT_FALSE(blocked);
+  EXPECT_EQ(blocked.error().rfind("rise: ", 0), 0U) << blocked.error();
+  EXPECT_FALSE(add_rise_first(job, now, 0.0, JobOptions{}));
+}
+
 TEST(JobPaths, AMoveTheSafetyLayerWouldRefuseIsNamed) {
   const PickPlaceJob job = mug_job();
   jaco::SafetyLimits limits;
