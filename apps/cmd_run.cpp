@@ -24,6 +24,7 @@
 #include "engine/graph.hpp"
 #include "engine/ipc_runtime.hpp"
 #include "engine/object_list_payload.hpp"
+#include "graphs/arm_world_feed.hpp"
 #include "graphs/body_filter_node.hpp"
 #include "graphs/descriptor_params.hpp"
 #include "graphs/embedded_graphs.hpp"
@@ -32,6 +33,7 @@
 #include "graphs/learning_ipc_bridge.hpp"
 #include "graphs/learning_payloads.hpp"
 #include "graphs/tabletop.hpp"
+#include "graphs/world_source.hpp"
 
 namespace orthoflow::apps {
 
@@ -225,6 +227,19 @@ void finish_outputs(const RunOptions& o, graphs::SessionLog& log, const engine::
   if (exit_code != EXIT_OK) throw CLI::RuntimeError(exit_code);
 }
 
+// --source world:SEED: the world of that seed, following the arm states on --arm-state-topic.
+std::unique_ptr<graphs::ArmWorldFeed> open_world(const RunOptions& o) {
+  const std::string digits = o.source.substr(6);
+  if (digits.empty() || digits.size() > 19 ||
+      digits.find_first_not_of("0123456789") != std::string::npos)
+    fail("--source world:SEED needs a decimal seed, not '" + digits + "'", EXIT_USAGE);
+  if (auto init = engine::init_ipc_runtime("orthoflow_" + std::to_string(::getpid())); !init)
+    fail("--source world: " + engine::to_string(init.error()), EXIT_NO_ROUDI);
+  auto world = graphs::ArmWorldFeed::create(std::stoull(digits), o.arm_state_topic, o.frames);
+  if (!world) fail(world.error(), EXIT_FAILURE_GENERIC);
+  return std::move(*world);
+}
+
 void run(const RunOptions& o) {
   auto spec = o.graph.empty() ? engine::parse_graph(std::string(graphs::embedded_tabletop_yaml()),
                                                     "embedded:tabletop.yaml")
@@ -274,8 +289,12 @@ void run(const RunOptions& o) {
   }
   // The web view reads every frame's objects through the hub (only when --ui asks for it).
   graphs::ObjectsHub objects;
-  const auto registry = graphs::make_tabletop_registry(
-      **learning, log, o.ui.empty() ? nullptr : &objects, labels.get());
+  auto registry = graphs::make_tabletop_registry(**learning, log, o.ui.empty() ? nullptr : &objects,
+                                                 labels.get());
+  // --source world:SEED: the simulated table and camera, reacting to the arm's streamed states.
+  std::unique_ptr<graphs::ArmWorldFeed> world;
+  if (o.source.rfind("world:", 0) == 0) world = open_world(o);
+  graphs::add_world_source_node(registry, world.get());
   auto graph = engine::build_graph(*spec, registry);
   if (!graph) fail(engine::to_string(graph.error()), EXIT_BAD_INPUT);
   g_run_stop.store(false);
@@ -314,6 +333,12 @@ void run(const RunOptions& o) {
   std::cout << "orthoflow run: graph '" << (*graph)->spec.name << "'"
             << (reason == engine::StopReason::STOP_REQUESTED ? " (stopped by signal)" : "") << "\n";
   print_summary(log.summary(), engine.stats(), **learning);
+  if (world) {
+    const graphs::WorldTally t = world->tally();
+    std::cout << "world: " << t.objects << " objects, " << t.moved << " moved, " << t.fallen
+              << " fell, " << t.arm_states << " arm states applied over " << t.frames
+              << " frames\n";
+  }
   std::cout << engine::format_table(engine.stats());
   const bool roudi_lost = engine::ipc_roudi_lost();
   if (roudi_lost) {
@@ -330,9 +355,12 @@ void add_run_command(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "run", "Run the tabletop graph (default: the embedded synthetic session) and summarise");
   cmd->add_option("--graph", o->graph, "graph file (default: the embedded graphs/tabletop.yaml)");
-  cmd->add_option("--source", o->source,
-                  "synthetic:SEED, pcd:DIR, kinect[:SERIAL] (the camera over USB) or "
-                  "kinect-sim[:SEED] (the simulated camera) (default: the graph's source)");
+  cmd->add_option(
+      "--source", o->source,
+      "synthetic:SEED, pcd:DIR, kinect[:SERIAL] (the camera over USB), "
+      "kinect-sim[:SEED] (the simulated camera), replay:DIR, or world:SEED (a simulated "
+      "table seen by the simulated camera, reacting to the arm states on "
+      "--arm-state-topic; needs RouDi) (default: the graph's source)");
   cmd->add_option("--frames", o->frames, "stop after N frames (synthetic: session length)");
   cmd->add_option(
       "--robot-frames", o->robot_frames,

@@ -61,8 +61,9 @@ struct LiveArgs {
   std::vector<double> area{0.20, -0.50, 0.56, -0.15};
   std::vector<std::string> keep{"plate"};
   std::vector<double> user_place{-0.35, -0.50};
-  double seconds = 0.0;    // run: 0 = until a signal
-  double timeout_s = 5.0;  // start / stop / status: wait this long for the answer
+  double seconds = 0.0;              // run: 0 = until a signal
+  double timeout_s = 5.0;            // start / stop / status: wait this long for the answer
+  double perception_age_ms = 300.0;  // the stale-perception interlock
   bool exit_when_done = false;
   bool json = false;
 };
@@ -153,6 +154,7 @@ manipulation::TableTaskOptions task_options(const LiveArgs& a) {
     o.limits.timeout_ns[static_cast<std::size_t>(p)] = 20'000'000'000;
   o.limits.obstacle_clearance_m = 0.02;
   o.limits.target_moved_m = 0.06;
+  o.limits.perception_max_age_ns = static_cast<std::int64_t>(a.perception_age_ms * 1e6);
   // One object list per graph frame (30 Hz live): look for a hidden object 3 s, as the demo does.
   o.look_again_frames = 90;
   return o;
@@ -426,6 +428,10 @@ void add_live_task_commands(CLI::App* task) {
   run->add_option("--bring", a->bring, "with --start serve_a_meal: the categories, in order")
       ->delimiter(',');
   add_area_options(run, a);
+  run->add_option("--max-perception-age-ms", a->perception_age_ms,
+                  "the stale-perception interlock: a job stops when the newest objects are older "
+                  "than this (from the frame's exposure; default 300)")
+      ->check(CLI::Range(50.0, 2000.0));
   run->add_option("--seconds", a->seconds, "stop the task and exit after this long (0: never)")
       ->check(CLI::Range(0.0, 86400.0));
   run->add_flag("--exit-when-done", a->exit_when_done,

@@ -79,15 +79,50 @@ Isometry3d synthetic_base_from_camera(const simulation::TableSpec& table) {
   return camera_from_base.inverse();
 }
 
+simulation::Scene draw_task_table(const TableTaskConfig& config, std::uint64_t seed) {
+  simulation::SceneConfig scene_config;
+  scene_config.objects = std::min<std::uint32_t>(config.objects + 6, simulation::MAX_SCENE_OBJECTS);
+  scene_config.categories =
+      config.categories.empty()
+          ? std::vector<simulation::Category>{simulation::Category::BOTTLE,
+                                              simulation::Category::MUG, simulation::Category::CAN,
+                                              simulation::Category::FLASK,
+                                              simulation::Category::PLATE}
+          : config.categories;
+  simulation::Scene scene = simulation::make_scene(scene_config, seed);
+  scene.table = simulation::TableSpec{};  // the table the robot frames assume
+  const Isometry3d base_from_camera = synthetic_base_from_camera(scene.table);
+  const simulation::TableFrame frame = simulation::table_frame(scene.table);
+  // Keep the objects that stand on this table, clear of the arm's base column, up to the count.
+  std::vector<simulation::PlacedObject> kept;
+  for (const simulation::PlacedObject& o : scene.objects) {
+    const double r = o.model.footprint_radius;
+    const bool on_table = std::fabs(o.table_x) + r < 0.5 * scene.table.width_m - 0.02 &&
+                          std::fabs(o.table_y) + r < 0.5 * scene.table.depth_m - 0.02;
+    const simulation::Vec3 p = frame.point(o.table_x, o.table_y);
+    const Vector2d at = (base_from_camera * Vector3d(p[0], p[1], p[2])).head<2>();
+    // The placing area and the user's place start empty (a tray, a place setting).
+    const Vector2d margin(r + 0.02, r + 0.02);
+    const manipulation::TableArea area{config.area.min - margin, config.area.max + margin};
+    bool free = true;
+    if (config.task == TableTask::CLEAR_TABLE) {
+      free = !area.contains(at);
+    } else {
+      for (std::size_t k = 0; k < std::max<std::size_t>(config.bring.size(), 1); ++k)
+        free = free && (at - config.user_place - Vector2d(0.15 * double(k), 0.0)).norm() > r + 0.08;
+    }
+    if (on_table && free && at.norm() > 0.30 && kept.size() < config.objects) kept.push_back(o);
+  }
+  scene.objects = std::move(kept);
+  for (std::size_t i = 0; i < scene.objects.size(); ++i)
+    scene.objects[i].id = static_cast<std::uint32_t>(i);
+  return scene;
+}
+
 namespace {
 
 constexpr std::int64_t START_NS = 1'000'000'000;  // frame stamps must not be 0
 constexpr double ARRIVED_M = 0.05;
-
-std::vector<simulation::Category> default_categories() {
-  using simulation::Category;
-  return {Category::BOTTLE, Category::MUG, Category::CAN, Category::FLASK, Category::PLATE};
-}
 
 class Session final : public WorldFeed {
  public:
@@ -154,35 +189,8 @@ class Session final : public WorldFeed {
 };
 
 simulation::Scene Session::draw_scene(std::uint64_t seed) {
-  simulation::SceneConfig scene_config;
-  scene_config.objects =
-      std::min<std::uint32_t>(config_.objects + 6, simulation::MAX_SCENE_OBJECTS);
-  scene_config.categories = config_.categories.empty() ? default_categories() : config_.categories;
-  simulation::Scene scene = simulation::make_scene(scene_config, seed);
-  scene.table = simulation::TableSpec{};  // the table the robot frames assume
+  simulation::Scene scene = draw_task_table(config_, seed);
   base_from_camera_ = synthetic_base_from_camera(scene.table);
-  const simulation::TableFrame frame = simulation::table_frame(scene.table);
-  // Keep the objects that stand on this table, clear of the arm's base column, up to the count.
-  std::vector<simulation::PlacedObject> kept;
-  for (const simulation::PlacedObject& o : scene.objects) {
-    const double r = o.model.footprint_radius;
-    const bool on_table = std::fabs(o.table_x) + r < 0.5 * scene.table.width_m - 0.02 &&
-                          std::fabs(o.table_y) + r < 0.5 * scene.table.depth_m - 0.02;
-    const Vector2d at = to_base(frame.point(o.table_x, o.table_y)).head<2>();
-    // The placing area and the user's place start empty (a tray, a place setting).
-    const Vector2d margin(r + 0.02, r + 0.02);
-    const manipulation::TableArea area{config_.area.min - margin, config_.area.max + margin};
-    bool free = true;
-    if (config_.task == TableTask::CLEAR_TABLE) {
-      free = !area.contains(at);
-    } else {
-      for (std::size_t k = 0; k < std::max<std::size_t>(config_.bring.size(), 1); ++k)
-        free =
-            free && (at - config_.user_place - Vector2d(0.15 * double(k), 0.0)).norm() > r + 0.08;
-    }
-    if (on_table && free && at.norm() > 0.30 && kept.size() < config_.objects) kept.push_back(o);
-  }
-  scene.objects = std::move(kept);
   return scene;
 }
 

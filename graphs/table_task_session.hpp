@@ -124,6 +124,11 @@ struct TableTaskReport {
 /// @brief Runs one task. @return the report, or why the loop could not be built (a graph error).
 [[nodiscard]] Result<TableTaskReport, std::string> run_table_task(const TableTaskConfig& config);
 
+/// @brief The seeded table of a task: simulation::make_scene's objects on the synthetic table the
+/// robot frames describe, standing on it, clear of the arm's base column (0.3 m) and of the placing
+/// area (clear_table) or the user's place (serve_a_meal), up to config.objects; ids 0, 1, ...
+[[nodiscard]] simulation::Scene draw_task_table(const TableTaskConfig& config, std::uint64_t seed);
+
 /// @brief The camera pose the synthetic table implies (the arm's base on the table, 0.283 m
 /// beyond its centre, its z up, its y away from the camera): config/robot_frames_synthetic.yaml.
 [[nodiscard]] Eigen::Isometry3d synthetic_base_from_camera(const simulation::TableSpec& table);
