@@ -33,6 +33,7 @@
 #include "graphs/learning_ipc_bridge.hpp"
 #include "graphs/learning_payloads.hpp"
 #include "graphs/live_table_task.hpp"
+#include "graphs/table_task_session.hpp"
 #include "graphs/task_payloads.hpp"
 #include "manipulation/robot_frames.hpp"
 
@@ -147,13 +148,8 @@ manipulation::TableTaskOptions task_options(const LiveArgs& a) {
             Eigen::Vector2d(std::max(a.area[0], a.area[2]), std::max(a.area[1], a.area[3]))};
   o.keep = a.keep;
   o.user_place = Eigen::Vector2d(a.user_place[0], a.user_place[1]);
-  // The demo's limits (graphs::TableTaskConfig::default_limits): the same manager on a real arm.
-  o.limits.target_lost_ns = 5'000'000'000;
-  for (const manipulation::Phase p : {manipulation::Phase::APPROACH, manipulation::Phase::LIFT,
-                                      manipulation::Phase::PLACE, manipulation::Phase::RETREAT})
-    o.limits.timeout_ns[static_cast<std::size_t>(p)] = 20'000'000'000;
-  o.limits.obstacle_clearance_m = 0.02;
-  o.limits.target_moved_m = 0.06;
+  // The demo's limits: the same manager on a real arm.
+  o.limits = graphs::TableTaskConfig::default_limits();
   o.limits.perception_max_age_ns = static_cast<std::int64_t>(a.perception_age_ms * 1e6);
   // One object list per graph frame (30 Hz live): look for a hidden object 3 s, as the demo does.
   o.look_again_frames = 90;

