@@ -102,6 +102,23 @@ std::unique_ptr<engine::IpcSubscriber> subscriber(const std::string& topic,
   return std::move(*s);
 }
 
+/// Takes at most 64 samples of @p in, handing each one's bytes to @p use (false: it was refused).
+/// @return the samples refused, by the subscriber's header check or by @p use.
+template <class Use>
+std::uint64_t drain(engine::IpcSubscriber& in, const Use& use) {
+  std::uint64_t refused = 0;
+  for (int n = 0; n < 64; ++n) {
+    auto s = in.take();
+    if (!s) {
+      ++refused;
+      continue;
+    }
+    if (!s->has_value()) break;
+    if (!use((*s)->bytes())) ++refused;
+  }
+  return refused;
+}
+
 template <class Payload>
 void publish_pod(engine::IpcPublisher& out, const Payload& p) {
   (void)out.publish_copy({reinterpret_cast<const std::byte*>(&p), sizeof p});
@@ -237,44 +254,30 @@ void run_live(const LiveArgs& a) {
       code = EXIT_ROUDI_LOST;
       break;
     }
-    for (int n = 0; n < 64; ++n) {
-      auto s = objects_in->take();
-      if (!s) {
-        ++rejected;
-        continue;
-      }
-      if (!s->has_value()) break;
-      const auto bytes = (*s)->bytes();
-      if (bytes.size() < sizeof(engine::ObjectListPayload)) {
-        ++rejected;
-        continue;
-      }
+    rejected += drain(*objects_in, [&](std::span<const std::byte> bytes) {
+      if (bytes.size() < sizeof(engine::ObjectListPayload)) return false;
       std::memcpy(static_cast<void*>(list.get()), bytes.data(), sizeof(engine::ObjectListPayload));
       task.on_objects(*list);
       ++lists;
-    }
+      return true;
+    });
     if (auto s = categories_in->take(); s && s->has_value()) {
       if (auto st = graphs::decode_status((*s)->bytes()); st) {
         known.clear();
         for (const graphs::StatusCategory& c : st->categories) known.emplace_back(c.label.view());
       }
     }
-    for (int n = 0; n < 64; ++n) {
-      auto s = commands_in->take();
-      if (!s) {
-        ++rejected;
-        continue;
-      }
-      if (!s->has_value()) break;
+    rejected += drain(*commands_in, [&](std::span<const std::byte> bytes) {
       ++commands;
-      auto c = graphs::decode_task_command((*s)->bytes());
+      auto c = graphs::decode_task_command(bytes);
       if (!c)
         task.invalid(c.error(), now);
       else if (stop_at != 0 && c->command.kind == graphs::TaskCommand::Kind::START)
         task.invalid({c->client, c->request, "the task process is shutting down"}, now);
       else
         (void)task.command(*c, now);
-    }
+      return true;
+    });
     // --start: once the graph's objects (and, for serve_a_meal, its categories) have arrived.
     if (start && !started && lists > 0 &&
         (start->task != manipulation::TableTaskKind::SERVE_A_MEAL || !known.empty())) {

@@ -40,24 +40,15 @@ bool needs_label(Kind kind) {
 }  // namespace
 
 void reset_header(LearningCommandPayload& p) noexcept {
-  std::memset(static_cast<void*>(&p), 0, sizeof p);  // padding too: it crosses processes
-  p.type_id = LEARNING_COMMAND_TYPE_ID;
-  p.version = LEARNING_IPC_VERSION;
-  p.payload_bytes = sizeof p;
+  reset_payload_header(p, LEARNING_COMMAND_TYPE_ID, LEARNING_IPC_VERSION);
 }
 
 void reset_header(LearningAckPayload& p) noexcept {
-  std::memset(static_cast<void*>(&p), 0, sizeof p);  // padding too: it crosses processes
-  p.type_id = LEARNING_ACK_TYPE_ID;
-  p.version = LEARNING_IPC_VERSION;
-  p.payload_bytes = sizeof p;
+  reset_payload_header(p, LEARNING_ACK_TYPE_ID, LEARNING_IPC_VERSION);
 }
 
 void reset_header(StatusPayload& p) noexcept {
-  std::memset(static_cast<void*>(&p), 0, sizeof p);  // padding too: it crosses processes
-  p.type_id = STATUS_TYPE_ID;
-  p.version = LEARNING_IPC_VERSION;
-  p.payload_bytes = sizeof p;
+  reset_payload_header(p, STATUS_TYPE_ID, LEARNING_IPC_VERSION);
 }
 
 bool encode_command(const LearningCommand& command, std::uint64_t client, std::uint64_t request,

@@ -54,17 +54,11 @@ const char* to_string(TaskAnswer answer) noexcept {
 }
 
 void reset_header(TaskCommandPayload& p) noexcept {
-  std::memset(static_cast<void*>(&p), 0, sizeof p);  // padding too: it crosses processes
-  p.type_id = TASK_COMMAND_TYPE_ID;
-  p.version = TASK_IPC_VERSION;
-  p.payload_bytes = sizeof p;
+  reset_payload_header(p, TASK_COMMAND_TYPE_ID, TASK_IPC_VERSION);
 }
 
 void reset_header(TaskStatusPayload& p) noexcept {
-  std::memset(static_cast<void*>(&p), 0, sizeof p);  // padding too: it crosses processes
-  p.type_id = TASK_STATUS_TYPE_ID;
-  p.version = TASK_IPC_VERSION;
-  p.payload_bytes = sizeof p;
+  reset_payload_header(p, TASK_STATUS_TYPE_ID, TASK_IPC_VERSION);
 }
 
 bool encode_task_command(const TaskCommand& command, std::uint64_t client, std::uint64_t request,
