@@ -496,7 +496,7 @@ const simulation::Scene* Session::next_frame(kernels::PointCloud& cloud) noexcep
   body.margin_m = 0.0;
   const std::size_t n = manipulation::arm_body_capsules(joints, base_from_camera_, body,
                                                         jaco::jaco2_geometry(), capsules_);
-  runner_->on_arm_pose(joints);  // the same arm as the body filter cuts it: with its margin
+  runner_->on_arm_body(std::span(capsules_).first(n));  // the runner adds the filter's margin
   std::vector<simulation::BodyCapsule>& robot = world_->robot();
   robot.resize(n);
   for (std::size_t i = 0; i < n; ++i) {

@@ -60,10 +60,18 @@ void TableTaskRunner::on_arm_pose(const jaco::JointAngles& joints) noexcept {
   // The arm as the body filter cuts it: the link model, with its margin.
   ArmBodyModel body;
   body.margin_m = 0.0;
-  sight_count_ =
-      arm_body_capsules(joints, options_.base_from_camera, body, jaco::jaco2_geometry(), sight_);
-  for (std::size_t i = 0; i < sight_count_; ++i)
+  std::array<kernels::Capsule, ARM_BODY_CAPSULES> bare{};
+  const std::size_t n =
+      arm_body_capsules(joints, options_.base_from_camera, body, jaco::jaco2_geometry(), bare);
+  on_arm_body(std::span(bare).first(n));
+}
+
+void TableTaskRunner::on_arm_body(std::span<const kernels::Capsule> body) noexcept {
+  sight_count_ = std::min(body.size(), sight_.size());
+  for (std::size_t i = 0; i < sight_count_; ++i) {
+    sight_[i] = body[i];
     sight_[i].radius += static_cast<float>(ArmBodyModel{}.margin_m);
+  }
 }
 
 Result<void, std::string> TableTaskRunner::start(std::span<const std::string> known) {

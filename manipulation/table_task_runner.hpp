@@ -121,6 +121,9 @@ class TableTaskRunner {
   void on_objects(std::span<const SeenObject> objects, std::int64_t stamp_ns);
   /// @brief The arm as the camera sees it at the newest frame (from its joints): for occlusion.
   void on_arm_pose(const drivers::jaco::JointAngles& joints) noexcept;
+  /// @brief The same from the arm's capsules without margin (arm_body_capsules, margin 0) when the
+  /// caller has them already (the demo renders them).
+  void on_arm_body(std::span<const kernels::Capsule> body) noexcept;
 
   /// @brief Plans the task on the newest objects. @p known: the categories the learner knows
   /// (serve_a_meal refuses a category nobody taught). @return why the task cannot start.
