@@ -83,7 +83,11 @@ struct ControllerOptions {
   std::int64_t command_timeout_ns = 100'000'000;  ///< watchdog
   double gain_per_s = 4.0;                        ///< position correction while streaming
   double goal_tolerance_deg = 0.1;
-  double finger_tolerance = 0.01;                  ///< of the finger range
+  double finger_tolerance = 0.01;  ///< of the finger range
+  /// Fingers that travel less than this share of their range for finger_stall_ns have stopped
+  /// against something (a grasped object): the finger goal ends there (fingers_blocked).
+  double finger_stall_travel = 0.005;
+  std::int64_t finger_stall_ns = 300'000'000;
   std::int64_t settle_timeout_ns = 2'000'000'000;  ///< after the profile ends
   std::int64_t home_timeout_ns = 60'000'000'000;   ///< HOME / RETRACT
   std::int64_t double_send_gap_ns = 100'000'000;   ///< DSP >= 5 joystick quirk
@@ -97,7 +101,10 @@ struct ArmSnapshot {
   JointVelocity velocity{};   ///< from successive readings, deg/s
   JointVelocity commanded{};  ///< the last velocity point sent, deg/s
   std::array<double, FINGERS> fingers{};
-  CartesianPose pose{};  ///< forward kinematics of `joints`
+  bool fingers_moving = false;   ///< a finger goal is under way
+  bool fingers_blocked = false;  ///< the last finger goal ended short: the fingers stalled against
+                                 ///< something (ControllerOptions::finger_stall_ns)
+  CartesianPose pose{};          ///< forward kinematics of `joints`
   std::array<float, JOINTS> currents{};
   SensorInfo sensors{};
   ArmState arm_state = ArmState::NOINIT;
@@ -163,6 +170,8 @@ class JacoController {
   void stop_arm(StopReason reason) noexcept;
   void fail(const JacoError& error) noexcept;
   std::array<double, FINGERS> finger_velocity() const noexcept;
+  /// True once the fingers have made no progress for finger_stall_ns (marks progress otherwise).
+  bool fingers_stalled(std::int64_t now) noexcept;
 
   UsbTransport* transport_;
   const MonotonicClock* clock_;
@@ -186,6 +195,8 @@ class JacoController {
   std::int64_t motion_start_ns_ = 0;
   JointVelocity last_velocity_{};
   std::optional<std::array<double, FINGERS>> finger_goal_;
+  std::array<double, FINGERS> finger_mark_{};  ///< where the fingers were at finger_mark_ns_
+  std::int64_t finger_mark_ns_ = 0;            ///< the fingers' last progress
   bool button_pressed_ = false;
   std::int64_t button_sent_ns_ = 0;
   bool button_resent_ = false;

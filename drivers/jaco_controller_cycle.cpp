@@ -60,6 +60,7 @@ void JacoController::fail(const JacoError& error) noexcept {
   last_velocity_ = {};
   state_.commanded = {};
   finger_goal_.reset();
+  state_.fingers_moving = false;
 }
 
 void JacoController::stop_arm(StopReason reason) noexcept {
@@ -77,6 +78,7 @@ void JacoController::stop_arm(StopReason reason) noexcept {
   last_velocity_ = {};
   state_.commanded = {};
   finger_goal_.reset();
+  state_.fingers_moving = false;
   if (state_.control != ControlState::ESTOP) state_.control = ControlState::IDLE;
   state_.last_stop = reason;
 }
@@ -127,6 +129,18 @@ std::array<double, FINGERS> JacoController::finger_velocity() const noexcept {
   return v;
 }
 
+bool JacoController::fingers_stalled(std::int64_t now) noexcept {
+  double travel = 0.0;
+  for (std::size_t f = 0; f < FINGERS; ++f)
+    travel = std::max(travel, std::abs(state_.fingers[f] - finger_mark_[f]));
+  if (travel > options_.finger_stall_travel * options_.limits.max_finger) {
+    finger_mark_ = state_.fingers;
+    finger_mark_ns_ = now;
+    return false;
+  }
+  return now - finger_mark_ns_ > options_.finger_stall_ns;
+}
+
 void JacoController::start_pending(std::int64_t now) noexcept {
   std::optional<ArmCommand> motion;
   std::optional<ArmCommand> fingers;
@@ -138,7 +152,12 @@ void JacoController::start_pending(std::int64_t now) noexcept {
     stop = std::exchange(pending_stop_, false);
   }
   if (stop) stop_arm(StopReason::STOPPED);
-  if (fingers) finger_goal_ = fingers->fingers;
+  if (fingers) {
+    finger_goal_ = fingers->fingers;
+    finger_mark_ = state_.fingers;
+    finger_mark_ns_ = now;
+    state_.fingers_blocked = false;
+  }
   if (!motion || state_.fault) return;
   const SafetyLimits& limits = options_.limits;
   // A new command ends the button sequence of an earlier HOME / RETRACT.
@@ -209,8 +228,14 @@ void JacoController::run_motion(std::int64_t now) noexcept {
       fingers_done = fingers_done && std::abs((*finger_goal_)[f] - state_.fingers[f]) <=
                                          options_.finger_tolerance * limits.max_finger;
     }
-    if (fingers_done) finger_goal_.reset();
+    if (fingers_done) {
+      finger_goal_.reset();
+    } else if (fingers_stalled(now)) {
+      finger_goal_.reset();
+      state_.fingers_blocked = true;
+    }
   }
+  state_.fingers_moving = finger_goal_.has_value();
   const bool moving = std::any_of(v.begin(), v.end(), [](double x) { return x != 0.0; });
   const bool was_moving =
       std::any_of(last_velocity_.begin(), last_velocity_.end(), [](double x) { return x != 0.0; });

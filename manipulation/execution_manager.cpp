@@ -11,7 +11,8 @@ ArmInput arm_input(const drivers::jaco::ArmSnapshot& s) noexcept {
   ArmInput a;
   a.joints = s.joints;
   a.fingers = {s.fingers[0], s.fingers[1], s.fingers[2]};
-  a.idle = s.control == drivers::jaco::ControlState::IDLE;
+  a.idle = s.control == drivers::jaco::ControlState::IDLE && !s.fingers_moving;
+  a.fingers_blocked = s.fingers_blocked;
   a.fault = s.fault;
   a.estop = s.estop;
   return a;
@@ -178,7 +179,8 @@ ArmRequest ExecutionManager::enter(Phase next, std::int64_t now_ns, AbortReason 
     case Phase::LIFT:
       return move_to(job_.lift, slow);
     case Phase::CARRY:
-      return move_to(job_.carry, 0.5);
+      aside_reached_ = !job_.via_aside;
+      return move_to(aside_reached_ ? job_.carry : job_.aside, 0.5);
     case Phase::PLACE:
       return move_to(job_.place, slow);
     case Phase::RELEASE:
@@ -241,7 +243,7 @@ const JointAngles* ExecutionManager::joint_goal(Phase phase) const noexcept {
     case Phase::LIFT:
       return &job_.lift;
     case Phase::CARRY:
-      return &job_.carry;
+      return aside_reached_ ? &job_.carry : &job_.aside;
     case Phase::PLACE:
       return &job_.place;
     case Phase::RETREAT:
@@ -265,6 +267,16 @@ bool ExecutionManager::at_fingers(const ArmInput& arm, double goal) const noexce
   if (!arm.idle) return false;
   for (double f : arm.fingers) {
     if (!(std::fabs(f - goal) <= limits_.finger_tolerance)) return false;
+  }
+  return true;
+}
+
+bool ExecutionManager::closed_beyond_open(const ArmInput& arm) const noexcept {
+  // Stopped on the way, each finger past a quarter of the way from open to the goal (not blocked
+  // right where it started).
+  const double quarter = job_.open_fingers + 0.25 * (job_.close_fingers - job_.open_fingers);
+  for (double f : arm.fingers) {
+    if (!(f >= quarter)) return false;
   }
   return true;
 }
@@ -374,6 +386,9 @@ ArmRequest ExecutionManager::step(std::int64_t now_ns, const ArmInput& arm,
     case Phase::CLOSE:
       if (at_fingers(arm, job_.close_fingers))
         return enter(Phase::LIFT, now_ns, {}, "the hand is closed");
+      // A rigid object stops the fingers short of a goal narrower than it: closed on it.
+      if (arm.idle && arm.fingers_blocked && closed_beyond_open(arm))
+        return enter(Phase::LIFT, now_ns, {}, "the hand is closed on the object");
       break;
     case Phase::LIFT:
       if (at_joints(arm, job_.lift)) {
@@ -385,7 +400,13 @@ ArmRequest ExecutionManager::step(std::int64_t now_ns, const ArmInput& arm,
       }
       break;
     case Phase::CARRY:
-      if (at_joints(arm, job_.carry)) return enter(Phase::PLACE, now_ns, {}, "above the place");
+      if (!aside_reached_ && at_joints(arm, job_.aside)) {
+        aside_reached_ = true;
+        note(now_ns, "beside what is in the way");
+        return move_to(job_.carry, 0.5);
+      }
+      if (aside_reached_ && at_joints(arm, job_.carry))
+        return enter(Phase::PLACE, now_ns, {}, "above the place");
       break;
     case Phase::PLACE:
       if (at_joints(arm, job_.place)) return enter(Phase::RELEASE, now_ns, {}, "placed");

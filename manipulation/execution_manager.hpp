@@ -83,6 +83,10 @@ struct PickPlaceJob {
   /// was when the job was planned (risen), then goes to the initial pose.
   bool rise_first = false;
   drivers::jaco::JointAngles risen{};
+  /// A way round (add_way_round): CARRY first goes to aside, the carry's midpoint moved sideways
+  /// along the table at the carry height, then on to above the place.
+  bool via_aside = false;
+  drivers::jaco::JointAngles aside{};
   double open_fingers = 0.0;   ///< the model's units (0 open)
   double close_fingers = 0.0;  ///< the model's units
   double lift_m = 0.10;        ///< how far the lift raises the hand (the grasp check uses half)
@@ -123,6 +127,8 @@ struct ArmInput {
   drivers::jaco::JointAngles joints{};
   std::array<double, 3> fingers{};
   bool idle = true;  ///< no motion under way (the controller's IDLE)
+  /// The fingers stopped short of their last goal against something: a grasped object.
+  bool fingers_blocked = false;
   bool fault = false;
   bool estop = false;
 };
@@ -233,6 +239,8 @@ class ExecutionManager {
                                const drivers::jaco::JointAngles& goal) const noexcept;
   [[nodiscard]] bool at_fingers(const ArmInput& arm, double goal) const noexcept;
   [[nodiscard]] const drivers::jaco::JointAngles* joint_goal(Phase phase) const noexcept;
+  /// True if every finger closed past a quarter of the way from the open value to the close one.
+  [[nodiscard]] bool closed_beyond_open(const ArmInput& arm) const noexcept;
   /// True if the target seen at @p seen has moved from the plan (ExecutionLimits::target_moved_m).
   [[nodiscard]] bool moved(const Eigen::Vector3d& seen) const noexcept;
   [[nodiscard]] bool path_blocked(const ArmInput& arm,
@@ -244,9 +252,9 @@ class ExecutionManager {
   AbortReason reason_ = AbortReason::NONE;
   std::int64_t entered_ns_ = 0;
   std::int64_t target_last_seen_ns_ = 0;
-  bool above_reached_ = false;
-  bool risen_reached_ = false;  ///< GO_INITIAL of a job with rise_first: the rise is behind  ///<
-                                ///< PRE_GRASP of a job with via_above: the way-point is behind
+  bool risen_reached_ = false;  ///< GO_INITIAL of a job with rise_first: the rise is behind
+  bool above_reached_ = false;  ///< PRE_GRASP of a job with via_above: the way-point is behind
+  bool aside_reached_ = false;  ///< CARRY of a job with via_aside: the way-point is behind
   bool back_away_after_open_ = false;  ///< an abort while closing: open, then back away
   bool stop_requested_ = false;
   std::int64_t stop_requested_ns_ = 0;

@@ -132,6 +132,28 @@ Result<void, std::string> add_rise_first(PickPlaceJob& job, const drivers::jaco:
   return {};
 }
 
+Result<void, std::string> add_way_round(PickPlaceJob& job, const Grasp& grasp, double side_m,
+                                        const JobOptions& options) noexcept {
+  if (!std::isfinite(side_m) || side_m == 0.0)
+    return err(std::string("a way round needs a finite, non-zero side"));
+  const drivers::jaco::ArmGeometry& geometry =
+      options.grasp.geometry != nullptr ? *options.grasp.geometry : drivers::jaco::jaco2_geometry();
+  const Eigen::Vector3d up = options.grasp.table.normal.normalized();
+  const Eigen::Vector3d from = drivers::jaco::forward_kinematics(job.lift, geometry).translation();
+  const Eigen::Vector3d to = drivers::jaco::forward_kinematics(job.carry, geometry).translation();
+  Eigen::Vector3d along = to - from;
+  along -= along.dot(up) * up;
+  if (along.norm() < 0.02) return err(std::string("the carry is too short to go round"));
+  Eigen::Isometry3d aside = carry_pose(grasp, options.grasp.table, job.lift_m);
+  aside.translation() = 0.5 * (from + to) + side_m * up.cross(along.normalized());
+  auto q = drivers::jaco::inverse_kinematics(aside, job.lift, options.grasp.limits,
+                                             options.grasp.tolerance, geometry);
+  if (!q) return err(std::string("beside the carry: ") + drivers::jaco::to_string(q.error()));
+  job.via_aside = true;
+  job.aside = *q;
+  return {};
+}
+
 Result<void, std::string> check_job_paths(const PickPlaceJob& job,
                                           const drivers::jaco::JointAngles& now,
                                           std::span<const Obstacle> others, double clearance_m,
@@ -148,12 +170,13 @@ Result<void, std::string> check_job_paths(const PickPlaceJob& job,
                {"down to the pre_grasp", &job.above_pre_grasp, &job.pre_grasp, true},
                {"approach", &job.pre_grasp, &job.grasp, true},
                {"lift", &job.grasp, &job.lift, true},
-               {"carry", &job.lift, &job.carry, false},
+               {"carry", &job.lift, job.via_aside ? &job.aside : &job.carry, false},
+               {"carry on from beside", &job.aside, &job.carry, false},
                {"place", &job.carry, &job.place, true},
                {"retreat", &job.place, &job.retreat, true}};
   for (const auto& m : moves) {
     if ((m.from == &job.above_pre_grasp && !job.via_above) ||
-        (m.to == &job.risen && !job.rise_first))
+        (m.to == &job.risen && !job.rise_first) || (m.from == &job.aside && !job.via_aside))
       continue;
     if (auto safe = drivers::jaco::check_joint_move(limits, *m.from, *m.to); !safe)
       return err(std::string(m.name) + ": " + drivers::jaco::describe(safe.error()));

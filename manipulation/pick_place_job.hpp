@@ -25,7 +25,7 @@ struct JobOptions {
   GraspOptions grasp{};  ///< the planner's options: table, hand, limits, geometry
   drivers::jaco::JointAngles initial = drivers::jaco::HOME_JOINTS;
   double lift_m = 0.10;           ///< lift and carry height above the grasp
-  double squeeze_m = 0.01;        ///< the fingers close this much narrower than the width
+  double squeeze_m = 0.02;        ///< the fingers close this much narrower than the width
   double finger_closed = 6400.0;  ///< the model's finger value when closed (JACO2 ~6400)
 };
 
@@ -52,6 +52,15 @@ struct JobOptions {
                                                        const drivers::jaco::JointAngles& now,
                                                        double height_m,
                                                        const JobOptions& options) noexcept;
+
+/// @brief Gives @p job (made from @p grasp) a way round: the carry first goes to a way-point at the
+/// carry height, beside the middle of the carry's line by @p side_m along the table (positive to
+/// the left of the way from the lift to above the place, seen from above), then on to above the
+/// place; for when the direct carry passes another object and no higher lift is in reach.
+/// @return the IK error of the way-point, or a carry too short to have a side.
+[[nodiscard]] Result<void, std::string> add_way_round(PickPlaceJob& job, const Grasp& grasp,
+                                                      double side_m,
+                                                      const JobOptions& options) noexcept;
 
 /// @brief How far a straight move of a job may stray from its line (check_job_paths).
 inline constexpr double MAX_SWING_M = 0.03;

@@ -26,6 +26,9 @@ constexpr double PLAN_MARGIN_M = 0.02;
 constexpr double LOWEST_LIFT_M = 0.10;
 /// From the place on, an object this near the move's spot is the target, put down.
 constexpr double PLACED_NEAR_M = 0.06;
+/// After a move, its object seen this near (along the table) to where it was planned from was left
+/// behind.
+constexpr double LEFT_BEHIND_M = 0.04;
 
 }  // namespace
 
@@ -272,12 +275,24 @@ void TableTaskRunner::start_move(std::int64_t now_ns, const jaco::ArmSnapshot& a
   // without.
   // When no job at any spot is clear, the same search again with a way in from above (the hand
   // rises over what is in the way, then comes down to the pre-grasp), 10 then 20 cm; then with a
-  // way out from above as well (the hand first rises from where the last job left it).
-  constexpr std::array<std::pair<double, double>, 6> WAYS{
-      {{0.0, 0.0}, {0.10, 0.0}, {0.20, 0.0}, {0.0, 0.15}, {0.10, 0.15}, {0.20, 0.15}}};
+  // way out from above as well (the hand first rises from where the last job left it); then with a
+  // way round (the carry passes beside the middle of its line, 12 then 24 cm to either side).
+  struct Way {
+    double above, rise, aside;
+  };
+  constexpr std::array<Way, 10> WAYS{{{0.0, 0.0, 0.0},
+                                      {0.10, 0.0, 0.0},
+                                      {0.20, 0.0, 0.0},
+                                      {0.0, 0.15, 0.0},
+                                      {0.10, 0.15, 0.0},
+                                      {0.20, 0.15, 0.0},
+                                      {0.0, 0.0, 0.12},
+                                      {0.0, 0.0, -0.12},
+                                      {0.0, 0.0, 0.24},
+                                      {0.0, 0.0, -0.24}}};
   std::vector<std::pair<PickPlaceJob, const Grasp*>> made;
   std::size_t spot = move_;
-  for (const auto& [above, rise] : WAYS) {
+  for (const auto& [above, rise, aside] : WAYS) {
     for (spot = move_; spot < moves_.size() && !job; ++spot) {
       const Vector3d place(moves_[spot].to.x(), moves_[spot].to.y(), s->centre.z());
       made.clear();
@@ -288,11 +303,12 @@ void TableTaskRunner::start_move(std::int64_t now_ns, const jaco::ArmSnapshot& a
           const bool ways =
               m &&
               (above == 0.0 || add_way_in_from_above(*m, plan->feasible[k], above, job_options)) &&
-              (rise == 0.0 || add_rise_first(*m, arm.joints, rise, job_options));
+              (rise == 0.0 || add_rise_first(*m, arm.joints, rise, job_options)) &&
+              (aside == 0.0 || add_way_round(*m, plan->feasible[k], aside, job_options));
           if (ways)
             made.emplace_back(*m, &plan->feasible[k]);
           else if (!m && spot == move_ && k == 0 && l == lifts.begin() && above == 0.0 &&
-                   rise == 0.0)
+                   rise == 0.0 && aside == 0.0)
             why = "no job: " + m.error();
         }
       }
@@ -305,6 +321,7 @@ void TableTaskRunner::start_move(std::int64_t now_ns, const jaco::ArmSnapshot& a
             r.grasp = to_string(grasp->kind);
             if (above > 0.0) r.grasp += " from above";
             if (rise > 0.0) r.grasp += ", rising first";
+            if (aside != 0.0) r.grasp += ", carried round";
             break;
           }
           if (why.empty() && margin == 0.0) why = "no clear job: " + ok.error();
@@ -381,6 +398,7 @@ void TableTaskRunner::finish_move(std::int64_t now_ns) {
   }
   r.done = manager_.phase() == Phase::DONE;
   if (!r.done) r.failure = to_string(manager_.abort_reason());
+  if (r.done) check_left_behind(move_);
   if (on_move_ended) on_move_ended(move_);
   const AbortReason why = manager_.abort_reason();
   ++move_;
@@ -395,6 +413,27 @@ void TableTaskRunner::finish_move(std::int64_t now_ns) {
     return;
   }
   state_ = State::MOVING;
+}
+
+void TableTaskRunner::check_left_behind(std::size_t move) {
+  MoveRecord& r = moves_[move];
+  const Vector3d& from = planned_[move];
+  const SupportPlane& table = options_.job.grasp.table;
+  const auto along_table = [&](const Vector3d& d) {
+    return (d - d.dot(table.normal) * table.normal).norm();
+  };
+  bool at_spot = false, left = false;
+  for (const SeenObject& o : seen_) {
+    if ((o.centre.head<2>() - r.to).norm() < PLACED_NEAR_M) at_spot = true;
+    if ((o.label == r.label || o.track == r.track) &&
+        along_table(o.centre - from) < LEFT_BEHIND_M &&
+        !arm_hides(o.centre, 0.5 * o.box.extents.head<2>().norm()))
+      left = true;
+  }
+  if (left && !at_spot) {
+    r.done = false;
+    r.failure = "left behind: the object still stands where it was";
+  }
 }
 
 std::size_t TableTaskRunner::add_retries() {

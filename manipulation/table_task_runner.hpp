@@ -164,6 +164,10 @@ class TableTaskRunner {
  private:
   void start_move(std::int64_t now_ns, const drivers::jaco::ArmSnapshot& arm, const Submit& submit);
   void finish_move(std::int64_t now_ns);
+  /// After a move the manager calls done: if its object (its label) still stands where it was
+  /// planned from, and not at its spot, the grasp missed it unseen (the hand hid the lift): the
+  /// move is failed, so that it is retried. A view the arm cuts is no evidence either way.
+  void check_left_behind(std::size_t move);
   void end_task(const std::string& why);
   /// Appends a retry of every failed move of the first pass. @return how many.
   std::size_t add_retries();

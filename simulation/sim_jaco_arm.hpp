@@ -244,6 +244,10 @@ class SimJacoArm {
   /// @brief The arm's time: the last step() or receive() time.
   [[nodiscard]] std::int64_t now_ns() const noexcept { return now_ns_; }
   [[nodiscard]] double finger_max() const noexcept { return finger_max_; }
+  /// @brief Something rigid between the fingers (a grasped object, for a test or a simulated
+  /// world): no finger closes past @p finger (model units; 0 open) while it is there; they still
+  /// open. nullopt: nothing between them.
+  void set_finger_stop(std::optional<double> finger) noexcept { finger_stop_ = finger; }
 
  private:
   enum class Head : std::uint8_t { NONE, POSITION, VELOCITY, DELAY, IDLE };
@@ -300,6 +304,7 @@ class SimJacoArm {
   std::array<double, drivers::jaco::FINGERS> fingers_{};
   std::array<double, drivers::jaco::FINGERS> finger_velocity_{};
   std::array<double, drivers::jaco::FINGERS> finger_target_{};
+  std::optional<double> finger_stop_{};  ///< set_finger_stop
   drivers::jaco::CartesianPose pose_{};
   std::optional<std::int64_t> last_motion_ns_{};
 

@@ -277,6 +277,8 @@ void SimJacoArm::move_fingers() noexcept {
       fingers_[f] = std::abs(error) <= max_step ? finger_target_[f]
                                                 : fingers_[f] + std::copysign(max_step, error);
     }
+    if (finger_stop_ && fingers_[f] > before && fingers_[f] > *finger_stop_)
+      fingers_[f] = std::max(before, *finger_stop_);  // closing against what is between them
     finger_velocity_[f] = (fingers_[f] - before) / DT_S;
   }
 }

@@ -121,6 +121,42 @@ TEST(JacoControllerSim, FingersCloseAndOpen) {
   EXPECT_EQ(refused.error().violation.limit, jaco::SafetyViolation::Limit::FINGER);
 }
 
+// A grasped object stops the fingers short of their goal: the controller sees them stall, ends the
+// goal there and says so (the execution manager takes that as closed on the object), instead of
+// pushing against it for ever.
+TEST(JacoControllerSim, FingersStoppedByAnObjectEndTheirGoalAsBlocked) {
+  JacoRig rig;
+  ArmCommand c;
+  c.kind = Kind::MOVE_FINGERS;
+  c.fingers = {6000.0, 6000.0, 6000.0};
+  rig.arm().set_finger_stop(3500.0);
+  ASSERT_TRUE(rig.controller->submit(c).has_value());
+  rig.cycle(true);
+  EXPECT_TRUE(rig.controller->snapshot().fingers_moving);
+  for (int i = 0; i < 600; ++i) rig.cycle(true);
+  jaco::ArmSnapshot s = rig.controller->snapshot();
+  for (double f : rig.arm().fingers()) EXPECT_NEAR(f, 3500.0, 1.0);
+  EXPECT_FALSE(s.fingers_moving) << "the goal ended where they stalled";
+  EXPECT_TRUE(s.fingers_blocked);
+  EXPECT_EQ(s.control, jaco::ControlState::IDLE);
+  EXPECT_FALSE(s.fault);
+  // Opening is not blocked, and a goal that is reached is not blocked.
+  c.fingers = {0.0, 0.0, 0.0};
+  ASSERT_TRUE(rig.controller->submit(c).has_value());
+  for (int i = 0; i < 600; ++i) rig.cycle(true);
+  s = rig.controller->snapshot();
+  for (double f : rig.arm().fingers()) EXPECT_NEAR(f, 0.0, 0.02 * 6400.0);
+  EXPECT_FALSE(s.fingers_blocked);
+  EXPECT_FALSE(s.fingers_moving);
+  // Slow fingers are not a stall: nothing in the way, the goal is reached.
+  rig.arm().set_finger_stop(std::nullopt);
+  c.fingers = {6000.0, 6000.0, 6000.0};
+  ASSERT_TRUE(rig.controller->submit(c).has_value());
+  for (int i = 0; i < 600; ++i) rig.cycle(true);
+  for (double f : rig.arm().fingers()) EXPECT_NEAR(f, 6000.0, 0.02 * 6400.0);
+  EXPECT_FALSE(rig.controller->snapshot().fingers_blocked);
+}
+
 // The watchdog: after the client's last word the arm's motion has stopped within 100 ms of
 // simulated time, measured on the simulator's own record of when a joint last moved.
 TEST(JacoControllerSim, WatchdogStopsTheArmWithin100msOfTheLastCommand) {

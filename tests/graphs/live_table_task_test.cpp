@@ -199,6 +199,27 @@ TEST(LiveTableTask, AFailedMoveIsTriedOnceMoreAtTheEndThenTheTaskEnds) {
   EXPECT_EQ(rig.statuses.back().moves, 2U);
 }
 
+TEST(LiveTableTask, AJobWhoseObjectStillStandsWhereItWasHasLeftItBehindAndIsRetried) {
+  // The bottle here never moves, whatever the hand does (a grasp that missed it while the hand hid
+  // it from the lift check): the manager finishes its job, but the object stands where it was,
+  // not at its spot. The move is failed, not done, and tried once more.
+  LiveRig rig;
+  rig.add_object(3, "bottle", Vector3d(-0.20, -0.40, 0.10));
+  rig.run(300);
+  ASSERT_EQ(rig.send(TaskCommand::Kind::START), TaskAnswer::STARTED);
+  for (int k = 0; k < 60 && rig.task->running(); ++k) rig.run(5000);
+  ASSERT_FALSE(rig.task->running());
+  const auto& moves = rig.task->runner()->moves();
+  ASSERT_EQ(moves.size(), 2U);
+  for (const auto& m : moves) {
+    EXPECT_FALSE(m.done);
+    EXPECT_EQ(m.failure, "left behind: the object still stands where it was");
+    EXPECT_NE(m.decisions.back().find("retreat -> done"), std::string::npos)
+        << "the manager's own job ended: " << m.decisions.back();
+  }
+  EXPECT_EQ(moves[1].retry_of, 0U);
+}
+
 TEST(LiveTableTask, AStartWithoutFreshObjectsIsRefused) {
   LiveRig rig;
   rig.frames = false;

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -47,6 +48,8 @@ struct World {
   Vector3d mug = ::orthoflow::manipulation::mug().base_from_object.translation();
   bool attached = false;
   bool slippery = false;  ///< the fingers never hold it
+  /// The mug is rigid: around it, the fingers stop at the finger value `contact`.
+  std::optional<double> contact;
   Vector3d grip_offset = Vector3d::Zero();
   Vector3d seen_offset = Vector3d::Zero();  ///< perception's error on the mug's centre
   std::vector<Obstacle> obstacles;
@@ -66,8 +69,10 @@ struct World {
   ArmInput arm_input() const { return manipulation::arm_input(rig.controller->snapshot()); }
   void update_world(const PickPlaceJob& job) {
     const auto s = rig.controller->snapshot();
-    const bool closed = s.fingers[0] >= job.close_fingers - 100.0;
-    if (!attached && closed && !slippery && (tool() - mug).norm() < 0.04) {
+    const bool around = (tool() - mug).norm() < 0.04;
+    rig.arm().set_finger_stop(contact && around ? contact : std::nullopt);
+    const bool closed = s.fingers[0] >= (contact ? *contact - 50.0 : job.close_fingers - 100.0);
+    if (!attached && closed && !slippery && around) {
       attached = true;
       grip_offset = mug - tool();
     } else if (attached && !closed) {
@@ -156,6 +161,34 @@ TEST(ExecutionManager, PicksAndPlacesTheMugOnTheSimulatedArm) {
   EXPECT_LT(joint_distance(world.rig.controller->snapshot().joints, job.retreat), 1.0);
 }
 
+TEST(ExecutionManager, FingersStoppedByTheMugHaveClosedOnItAndTheJobGoesOn) {
+  // A real hand closing to a goal narrower than the mug stops against it; the controller ends the
+  // goal as blocked, and that is a closed hand.
+  World world;
+  ExecutionManager manager;
+  const PickPlaceJob job = mug_job();
+  world.contact = finger_for_opening(0.078, JobOptions{});
+  ASSERT_LT(*world.contact, job.close_fingers - 500.0) << "the goal lies beyond the contact";
+  world.run(manager, job);
+  EXPECT_EQ(manager.phase(), Phase::DONE) << log_text(manager);
+  EXPECT_NE(log_text(manager).find("close -> lift (none: the hand is closed on the object)"),
+            std::string::npos)
+      << log_text(manager);
+  EXPECT_LT((world.mug - PLACE).norm(), 0.02) << "the mug stands at the place";
+  EXPECT_EQ(world.step_allocations, 0U);
+}
+
+TEST(ExecutionManager, FingersBlockedRightWhereTheyStartAreNotAGrasp) {
+  World world;
+  ExecutionManager manager;
+  const PickPlaceJob job = mug_job();
+  world.contact = job.open_fingers + 0.1 * (job.close_fingers - job.open_fingers);
+  world.run(manager, job);
+  EXPECT_EQ(manager.phase(), Phase::ABORTED) << log_text(manager);
+  EXPECT_EQ(manager.abort_reason(), AbortReason::TIMEOUT) << log_text(manager);
+  EXPECT_EQ(log_text(manager).find("close -> lift"), std::string::npos) << log_text(manager);
+}
+
 TEST(ExecutionManager, AWayInFromAboveGoesOverThenDownToThePreGrasp) {
   World world;
   ExecutionManager manager;
@@ -200,6 +233,32 @@ TEST(ExecutionManager, AWayOutFromAboveRisesBeforeGoingToTheInitialPose) {
   const std::size_t rose = log.find("go_initial -> go_initial (none: risen above where it was)");
   ASSERT_NE(rose, std::string::npos) << log;
   EXPECT_LT(rose, log.find("go_initial -> open")) << "it rises before it reaches the initial pose";
+}
+
+TEST(ExecutionManager, AWayRoundCarriesTheMugBesideTheMiddleOfItsLine) {
+  World world;
+  ExecutionManager manager;
+  PickPlaceJob job = mug_job();
+  auto plan = plan_grasp(mug(), JobOptions{}.grasp);
+  ASSERT_TRUE(plan && plan->best() != nullptr);
+  ASSERT_TRUE(add_way_round(job, *plan->best(), 0.15, JobOptions{}));
+  const Vector3d aside = jaco::forward_kinematics(job.aside).translation();
+  double nearest_aside = 1.0;  // how near the held mug's hand came to the way-point
+  world.event = [&](World& w, const ExecutionManager& m) {
+    const Vector3d tool =
+        jaco::forward_kinematics(w.rig.controller->snapshot().joints).translation();
+    if (m.phase() == Phase::CARRY && w.attached)
+      nearest_aside = std::min(nearest_aside, (tool - aside).norm());
+  };
+  world.run(manager, job);
+  EXPECT_EQ(manager.phase(), Phase::DONE) << log_text(manager);
+  const std::string log = log_text(manager);
+  const std::size_t beside = log.find("carry -> carry (none: beside what is in the way)");
+  ASSERT_NE(beside, std::string::npos) << log;
+  EXPECT_LT(beside, log.find("carry -> place")) << "beside it before above the place";
+  EXPECT_LT(nearest_aside, 0.01) << "the hand, holding the mug, passed the way-point";
+  EXPECT_LT((world.mug - PLACE).norm(), 0.02) << "the mug stands at the place";
+  EXPECT_EQ(world.step_allocations, 0U);
 }
 
 TEST(ExecutionManager, TheTargetMovingDuringTheApproachBacksTheArmAway) {

@@ -129,6 +129,52 @@ TEST(JobPaths, AWayOutFromAboveIsCheckedUpThenAcross) {
   EXPECT_FALSE(add_rise_first(job, now, 0.0, JobOptions{}));
 }
 
+TEST(JobPaths, AWayRoundPassesBesideWhatBlocksTheCarry) {
+  const JobOptions options;
+  auto plan = plan_grasp(mug(), options.grasp);
+  ASSERT_TRUE(plan && plan->best() != nullptr);
+  const PickPlaceJob direct = mug_job();
+  const jaco::SafetyLimits limits;
+  // Something in the middle of the carry's line blocks the direct carry.
+  const Vector3d middle = tool_at(direct.lift, direct.carry, 0.5);
+  const std::array<Obstacle, 1> in_the_way{{{middle, 0.02}}};
+  const auto blocked = check_job_paths(direct, jaco::HOME_JOINTS, in_the_way, 0.02, limits);
+  ASSERT_FALSE(blocked);
+  EXPECT_EQ(blocked.error().rfind("carry: ", 0), 0U) << blocked.error();
+  // A way round on either side passes it: its way-point is at the carry height, beside the
+  // middle of the carry's line (positive side: left of the way, seen from above).
+  for (const double side : {0.15, -0.15}) {
+    PickPlaceJob job = direct;
+    ASSERT_TRUE(add_way_round(job, *plan->best(), side, options)) << side;
+    ASSERT_TRUE(job.via_aside);
+    const Vector3d from = jaco::forward_kinematics(job.lift).translation();
+    const Vector3d to = jaco::forward_kinematics(job.carry).translation();
+    const Vector3d aside = jaco::forward_kinematics(job.aside).translation();
+    EXPECT_NEAR(aside.z(), 0.5 * (from.z() + to.z()), 0.005);
+    const Vector3d along = (to - from).normalized();
+    const Vector3d left = Vector3d::UnitZ().cross(along);
+    EXPECT_NEAR((aside - 0.5 * (from + to)).dot(left), side, 0.005) << side;
+    EXPECT_TRUE(check_job_paths(job, jaco::HOME_JOINTS, in_the_way, 0.02, limits)) << side;
+    // Something on the way to the way-point, or on from it, blocks it and is named so.
+    const std::array<Obstacle, 1> first{{{tool_at(job.lift, job.aside, 0.5), 0.01}}};
+    const auto to_aside = check_job_paths(job, jaco::HOME_JOINTS, first, 0.01, limits);
+    ASSERT_FALSE(to_aside);
+    EXPECT_EQ(to_aside.error().rfind("carry: ", 0), 0U) << to_aside.error();
+    const std::array<Obstacle, 1> second{{{tool_at(job.aside, job.carry, 0.5), 0.01}}};
+    const auto on = check_job_paths(job, jaco::HOME_JOINTS, second, 0.01, limits);
+    ASSERT_FALSE(on);
+    EXPECT_EQ(on.error().rfind("carry on from beside: ", 0), 0U) << on.error();
+  }
+  // No side, an unreachable side, or a carry with no length is refused; the job stays direct.
+  PickPlaceJob job = direct;
+  EXPECT_FALSE(add_way_round(job, *plan->best(), 0.0, options));
+  EXPECT_FALSE(add_way_round(job, *plan->best(), 3.0, options));
+  EXPECT_FALSE(add_way_round(job, *plan->best(), std::nan(""), options));
+  job.carry = job.lift;
+  EXPECT_FALSE(add_way_round(job, *plan->best(), 0.15, options));
+  EXPECT_FALSE(job.via_aside);
+}
+
 TEST(JobPaths, AMoveTheSafetyLayerWouldRefuseIsNamed) {
   const PickPlaceJob job = mug_job();
   jaco::SafetyLimits limits;
