@@ -59,6 +59,7 @@ struct RunOptions {
   std::string labels_out;
   std::string snapshot;
   std::string telemetry_json;
+  bool publish_frames = false;   // every frame to orthoflow/<graph>/frames over iceoryx
   bool publish_objects = false;  // every frame's objects to orthoflow/<graph>/objects over iceoryx
   bool ipc_learning =
       false;  // learning commands in, acks and status out over iceoryx (and objects)
@@ -100,6 +101,27 @@ void add_objects_publisher(engine::GraphSpec& spec) {
   publish.params.assign("type", "objects");
   publish.params.assign("max_bytes", std::to_string(sizeof(engine::ObjectListPayload)));
   spec.edges.push_back(engine::EdgeSpec{output->name, "objects", publish.name, "in", 0});
+  spec.nodes.push_back(std::move(publish));
+}
+
+// --publish-frames: an ipc_publish node on the objects_output node's out port (each frame as it
+// leaves the graph, with its objects decided), topic orthoflow/<graph>/frames: what `orthoflow
+// bridge dds --frames` reads. RouDi needs a pool of the graph's block size
+// (config/roudi_frames.toml).
+void add_frames_publisher(engine::GraphSpec& spec) {
+  const auto output =
+      std::find_if(spec.nodes.begin(), spec.nodes.end(),
+                   [](const engine::NodeSpec& n) { return n.kind == "objects_output"; });
+  if (output == spec.nodes.end())
+    fail("--publish-frames needs a graph with an objects_output node", EXIT_USAGE);
+  if (!graphs::graph_topics(spec.name))
+    fail("--publish-frames: graph name '" + spec.name + "' is not a topic name part", EXIT_USAGE);
+  engine::NodeSpec publish;
+  publish.name = "publish_frames";
+  publish.kind = "ipc_publish";
+  publish.params.assign("topic", "orthoflow/" + spec.name + "/frames");
+  publish.params.assign("type", "frame");
+  spec.edges.push_back(engine::EdgeSpec{output->name, "out", publish.name, "in", 0});
   spec.nodes.push_back(std::move(publish));
 }
 
@@ -260,6 +282,7 @@ void run(const RunOptions& o) {
     if (auto ok = graphs::insert_body_filter(*spec, body); !ok) fail(ok.error(), EXIT_USAGE);
   }
   if (o.publish_objects || o.ipc_learning) add_objects_publisher(*spec);
+  if (o.publish_frames) add_frames_publisher(*spec);
   auto learning = graphs::LearningService::open(learning_settings(*spec, o));
   if (!learning) fail(learning.error(), EXIT_FAILURE_GENERIC);
   for (const std::string& warning : (*learning)->open_warnings()) {
@@ -407,6 +430,9 @@ void add_run_command(CLI::App& app) {
   cmd->add_flag(
       "--publish-objects", o->publish_objects,
       "publish every frame's objects on the iceoryx topic orthoflow/<graph>/objects (needs RouDi)");
+  cmd->add_flag("--publish-frames", o->publish_frames,
+                "publish every frame on the iceoryx topic orthoflow/<graph>/frames (RouDi needs a "
+                "pool of the graph's block size: config/roudi_frames.toml)");
   cmd->add_flag("--ipc-learning", o->ipc_learning,
                 "also take learning commands from other processes over iceoryx (orthoflow ui; "
                 "orthoflow/<graph>/learning_commands, answers on .../learning_acks, memory and "

@@ -64,6 +64,9 @@ void add_live_task_commands(CLI::App* task);
 /// @brief `run`: the tabletop graph on the embedded session or a given source; summary, JSON lines,
 /// snapshot.
 void add_run_command(CLI::App& app);
+/// @brief `orthoflow bridge dds`: a graph's objects, frames and learning commands on DDS with
+/// ROS 2's names (apps/cmd_bridge.cpp, docs/DDS.md).
+void add_bridge_command(CLI::App& app);
 /// @brief `orthoflow ui`: the web view over a graph in another process (apps/run_ui.cpp).
 void add_ui_command(CLI::App& app);
 /// @brief `evaluate --dataset DIR --protocol ...`: cross-validation, simulated teacher, context
