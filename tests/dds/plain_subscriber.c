@@ -4,7 +4,7 @@
  * first tracked object a label and waits for the acknowledgement, and prints what it got:
  *
  *   plain_subscriber --graph G [--domain N] [--seconds S] [--points] [--teach LABEL]
- *                    [--raw-command KIND LABEL] [--objects-min N]
+ *                    [--raw-command KIND LABEL] [--track N] [--objects-min N]
  *
  * Discovery and interface come from CYCLONEDDS_URI (the test sets the bridge's loopback XML).
  * Exit 0 when it saw at least --objects-min object lists (and an ack when teaching). */
@@ -48,6 +48,7 @@ int main(int argc, char** argv) {
   int raw_kind = -1;
   const char* raw_label = "";
   int domain = 0, points = 0, objects_min = 1;
+  long long track = -1; /* --track N: command this track instead of the first one seen */
   double seconds = 10.0;
   for (int i = 1; i < argc; ++i) {
     if (!strcmp(argv[i], "--graph") && i + 1 < argc) graph = argv[++i];
@@ -59,6 +60,7 @@ int main(int argc, char** argv) {
       raw_kind = atoi(argv[++i]);
       raw_label = argv[++i];
     } else if (!strcmp(argv[i], "--objects-min") && i + 1 < argc) objects_min = atoi(argv[++i]);
+    else if (!strcmp(argv[i], "--track") && i + 1 < argc) track = atoll(argv[++i]);
     else {
       fprintf(stderr, "plain_subscriber: unknown argument %s\n", argv[i]);
       return 2;
@@ -134,13 +136,13 @@ int main(int argc, char** argv) {
           c.client = client;
           c.request = 1;
           c.kind = (uint8_t)(raw_kind >= 0 ? raw_kind : 0);
-          c.track_id = (uint32_t)o->track_id;
+          c.track_id = track >= 0 ? (uint32_t)track : (uint32_t)o->track_id;
           c.label = (char*)(raw_kind >= 0 ? raw_label : teach);
           const dds_return_t rc = dds_write(w_cmd, &c);
           if (rc < 0) fprintf(stderr, "command: %s\n", dds_strretcode(rc));
           else {
             sent = 1;
-            taught_track = o->track_id;
+            taught_track = c.track_id;
             printf("command: kind %d track %" PRIu64 " label '%s'\n", c.kind, taught_track, c.label);
           }
         }

@@ -124,6 +124,10 @@ pid_t Sandbox::spawn_orthoflow(const std::string& name, const std::vector<std::s
   return spawn(name, argv, false);
 }
 
+pid_t Sandbox::spawn_program(const std::string& name, const std::vector<std::string>& argv) {
+  return spawn(name, argv, false);
+}
+
 pid_t Sandbox::start_roudi(const std::string& config) {
   const pid_t pid = spawn("roudi", {"/usr/bin/iox-roudi", "-c", config}, true);
   const auto until = Clock::now() + std::chrono::seconds(5);

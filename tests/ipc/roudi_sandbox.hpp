@@ -26,6 +26,8 @@ class Sandbox {
  public:
   /// @brief Starts `orthoflow ARGS...` with stdout/stderr in /tmp/NAME.{out,err}.
   pid_t spawn_orthoflow(const std::string& name, const std::vector<std::string>& args);
+  /// @brief Starts the program @p argv[0] (a path) with its arguments, output as spawn_orthoflow.
+  pid_t spawn_program(const std::string& name, const std::vector<std::string>& argv);
   /// @brief Starts `iox-roudi -c CONFIG` (default config/roudi_test.toml; setsid, stdin /dev/null)
   /// and waits at most 5 s until engine::probe_roudi succeeds. Records a failure and returns -1
   /// otherwise.
