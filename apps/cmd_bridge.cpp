@@ -1,5 +1,5 @@
 // `orthoflow bridge dds`: a running graph's objects (and frames) on DDS with ROS 2's topic and type
-// names, and learning commands from DDS into the graph (issue 23; dds/, docs/DDS.md). Loopback by
+// names, and learning commands from DDS into the graph (issue 23; bridge/, docs/DDS.md). Loopback by
 // default; its own process beside the graph (`orthoflow run --ipc-learning [--publish-frames]`).
 #include <atomic>
 #include <chrono>
@@ -13,13 +13,14 @@
 #include <thread>
 #include <vector>
 
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include "apps/commands.hpp"
 #include "apps/graph_run.hpp"
 #include "engine/ipc_runtime.hpp"
 #ifdef ORTHOFLOW_HAVE_DDS
-#include "dds/bridge_loop.hpp"
+#include "bridge/bridge_loop.hpp"
 #endif
 
 namespace orthoflow::apps {
@@ -46,10 +47,10 @@ struct BridgeOptions {
 };
 
 #ifdef ORTHOFLOW_HAVE_DDS
-dds::BridgeConfig config_of(const BridgeOptions& o) {
-  dds::BridgeConfig c;
+bridge::BridgeConfig config_of(const BridgeOptions& o) {
+  bridge::BridgeConfig c;
   if (!o.config_file.empty()) {
-    auto loaded = dds::load_bridge_config(o.config_file);
+    auto loaded = bridge::load_bridge_config(o.config_file);
     if (!loaded) fail(loaded.error(), EXIT_USAGE);
     c = *loaded;
   }
@@ -63,7 +64,7 @@ dds::BridgeConfig config_of(const BridgeOptions& o) {
   c.accept_network_commands = c.accept_network_commands || o.accept_network_commands;
   c.frames = c.frames || o.frames;
   if (o.max_frame_hz >= 0.0) c.max_frame_hz = o.max_frame_hz;
-  if (auto ok = dds::check_bridge_config(c); !ok) fail(ok.error(), EXIT_USAGE);
+  if (auto ok = bridge::check_bridge_config(c); !ok) fail(ok.error(), EXIT_USAGE);
   return c;
 }
 
@@ -74,9 +75,9 @@ std::uint64_t random_client_id() {
   return id;
 }
 
-void print_report(const dds::BridgeLoop& b) {
-  const dds::BridgeCounters& c = b.counters();
-  const dds::DdsStatus s = b.dds_status();
+void print_report(const bridge::BridgeLoop& b) {
+  const bridge::BridgeCounters& c = b.counters();
+  const bridge::DdsStatus s = b.dds_status();
   std::printf(
       "bridge: objects %llu, frames %llu (thinned %llu, bad %llu), data %.1f MB, write errors "
       "%llu\n",
@@ -98,20 +99,27 @@ void print_report(const dds::BridgeLoop& b) {
       "%u commands lost, %u rejected\n",
       s.objects_readers, s.points_readers, s.command_writers, s.inconsistent_topics,
       s.commands_lost, s.commands_rejected);
+  rusage usage{};
+  (void)::getrusage(RUSAGE_SELF, &usage);
+  const double cpu_s = static_cast<double>(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
+                       1e-6 * static_cast<double>(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
+  const double wall_s = 1e-9 * static_cast<double>(b.stats().elapsed_ns.load());
+  std::printf("cpu: %.2f s over %.1f s (%.1f %% of one core)\n", cpu_s, wall_s,
+              wall_s > 0.0 ? 100.0 * cpu_s / wall_s : 0.0);
   std::printf("%s%s", engine::format_table(b.stats()).c_str(), b.ipc_lines().c_str());
   std::fflush(stdout);
 }
 
 void run_bridge(const BridgeOptions& o) {
-  const dds::BridgeConfig config = config_of(o);
+  const bridge::BridgeConfig config = config_of(o);
   if (auto init = engine::init_ipc_runtime("orthoflow_dds_" + std::to_string(::getpid())); !init)
     fail(to_string(init.error()), init.error().code == engine::IpcError::Code::ROUDI_UNREACHABLE
                                       ? EXIT_NO_ROUDI
                                       : EXIT_FAILURE_GENERIC);
-  auto opened = dds::BridgeLoop::open(config, random_client_id());
+  auto opened = bridge::BridgeLoop::open(config, random_client_id());
   if (!opened) fail(opened.error());
-  dds::BridgeLoop& bridge = **opened;
-  const dds::BridgeTopics& t = bridge.topics();
+  bridge::BridgeLoop& bridge = **opened;
+  const bridge::BridgeTopics& t = bridge.topics();
   std::printf("bridge dds: graph %s, domain %u on %s: %s%s, %s -> %s\n", config.graph.c_str(),
               config.domain, config.interface.c_str(), t.objects.c_str(),
               config.frames ? (", " + t.points).c_str() : "", t.learning_commands.c_str(),

@@ -31,7 +31,9 @@ ALLOWED = {
                "manipulation"],
     "ui": ["core", "memory_pool", "kernels", "engine", "formats", "simulation", "drivers", "learning",
            "manipulation", "graphs"],
-    "apps": ["core", "memory_pool", "kernels", "engine", "formats", "simulation", "drivers", "learning",
+    "bridge": ["core", "memory_pool", "kernels", "engine", "formats", "simulation", "drivers", "learning",
+               "manipulation", "graphs"],
+    "apps": ["core", "memory_pool", "kernels", "engine", "formats", "simulation", "drivers", "learning", "bridge",
              "evaluation", "graphs", "ui", "manipulation"],
 }
 # Top-level folders beside the product that product code never includes (STYLE rule 1).
