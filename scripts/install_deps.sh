@@ -10,6 +10,8 @@ PACKAGES=(
   liblzf-dev libcairo2-dev libpng-dev libleveldb-dev libusb-1.0-0-dev
   libcivetweb-dev  # the web view's HTTP + WebSocket server (ui/, `orthoflow run --ui`)
   iceoryx libiceoryx-posh-dev libiceoryx-hoofs-dev
+  cyclonedds-dev cyclonedds-tools  # the DDS bridge (bridge/, issue 23): libddsc and idlc
+  nftables  # test-only: packet loss and a partition between two network namespaces (tests/bridge)
   libgtest-dev libgmock-dev libbenchmark-dev
   clang-14 libclang-rt-14-dev clang-format-14
   libpcl-dev
