@@ -1,6 +1,6 @@
 // `orthoflow bridge dds`: a running graph's objects (and frames) on DDS with ROS 2's topic and type
-// names, and learning commands from DDS into the graph (issue 23; bridge/, docs/DDS.md). Loopback by
-// default; its own process beside the graph (`orthoflow run --ipc-learning [--publish-frames]`).
+// names, and learning commands from DDS into the graph (issue 23; bridge/, docs/DDS.md). Loopback
+// by default; its own process beside the graph (`orthoflow run --ipc-learning [--publish-frames]`).
 #include <atomic>
 #include <chrono>
 #include <csignal>

@@ -10,10 +10,10 @@
 #include <memory>
 #include <string>
 
-#include "core/result.hpp"
 #include "bridge/bridge_config.hpp"
 #include "bridge/command_relay.hpp"
 #include "bridge/ros_endpoints.hpp"
+#include "core/result.hpp"
 #include "engine/ipc_pubsub.hpp"
 #include "engine/telemetry.hpp"
 

@@ -11,10 +11,10 @@
 #include <string>
 #include <string_view>
 
-#include "core/result.hpp"
 #include "bridge/bridge_config.hpp"
 #include "bridge/command_relay.hpp"
 #include "bridge/ros_messages.hpp"
+#include "core/result.hpp"
 #include "engine/frame_payload.hpp"
 #include "engine/object_list_payload.hpp"
 

@@ -163,8 +163,7 @@ Result<graphs::LearningCommandPayload, CommandRefusal> from_ros(const RosLearnin
   if (needs_label) {
     // The whole DDS string, before the payload's 63 bytes could cut it.
     if (const core::LabelProblem p = core::check_label(label); p != core::LabelProblem::NONE)
-      return err(CommandRefusal{static_cast<std::uint32_t>(p),
-                                std::string(core::to_string(p))});
+      return err(CommandRefusal{static_cast<std::uint32_t>(p), std::string(core::to_string(p))});
     c.label.assign(label);
   }
   graphs::LearningCommandPayload payload{};

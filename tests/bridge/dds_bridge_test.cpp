@@ -1,9 +1,10 @@
 // The DDS bridge across processes (issue 23): a graph (`orthoflow run --ipc-learning
 // --publish-frames`), the bridge (`orthoflow bridge dds --frames`) and a plain Cyclone DDS node
-// (tests/bridge/plain_subscriber.c: the C API and the IDL's generated types, no orthoflow code), each
-// its own process, on loopback. Objects and a frame stream reach the plain node; its teach reaches
-// the learner and is acknowledged; malformed commands, an unknown track and a graph that is gone
-// are answered, counted, and the bridge keeps running; the graph restarted, objects flow again.
+// (tests/bridge/plain_subscriber.c: the C API and the IDL's generated types, no orthoflow code),
+// each its own process, on loopback. Objects and a frame stream reach the plain node; its teach
+// reaches the learner and is acknowledged; malformed commands, an unknown track and a graph that is
+// gone are answered, counted, and the bridge keeps running; the graph restarted, objects flow
+// again.
 #include <gtest/gtest.h>
 
 #include <csignal>
@@ -56,9 +57,9 @@ TEST(DdsBridge, ObjectsFramesAndLessonsCrossToAPlainDdsNodeAndBack) {
         box.check(has(taught, "frame_id camera_depth_optical_frame"), "objects' frame", taught);
         box.check(has(taught, "points: 640x480, 4 fields (x), point_step 16, row_step 10240"),
                   "an organized PointCloud2 as ROS drivers publish it", taught);
-        box.check(has(taught, "status 0 outcome 'learned'") ||
-                      has(taught, "status 0 outcome 'stored'"),
-                  "the learner learned the teach and said so", taught);
+        box.check(
+            has(taught, "status 0 outcome 'learned'") || has(taught, "status 0 outcome 'stored'"),
+            "the learner learned the teach and said so", taught);
         box.check(!has(taught, "bad quaternion"), "unit quaternions", taught);
 
         const ProcResult asked = plain(box, "ask", {"--raw-command", "3", ""});
@@ -76,8 +77,8 @@ TEST(DdsBridge, ObjectsFramesAndLessonsCrossToAPlainDdsNodeAndBack) {
         // The graph goes away: commands are answered, the bridge stays.
         ::kill(run, SIGTERM);
         box.check(box.wait(run, 60s).exit_code == 0, "the graph stops");
-        const ProcResult gone = plain(box, "gone", {"--raw-command", "3", "", "--objects-min", "0",
-                                                    "--seconds", "3"});
+        const ProcResult gone =
+            plain(box, "gone", {"--raw-command", "3", "", "--objects-min", "0", "--seconds", "3"});
         box.check(!has(gone, "status 0"), "no learner answers while the graph is gone", gone);
         run = start_graph(box, "run2");
         const ProcResult again = plain(box, "again", {"--objects-min", "5"});

@@ -75,9 +75,8 @@ TEST(DdsNetns, ReliableObjectsSurviveLossAndAPartitionAcrossTwoNamespaces) {
   const Outcome outcome = run_isolated(
       [&](Sandbox& box) {
         if (box.start_roudi(ORTHOFLOW_SOURCE_DIR "/config/roudi_frames.toml") < 0) return;
-        const pid_t run = box.spawn_orthoflow(
-            "run", {"run", "--ipc-learning", "--publish-frames", "--frames", "100000", "--rate",
-                    "10"});
+        const pid_t run = box.spawn_orthoflow("run", {"run", "--ipc-learning", "--publish-frames",
+                                                      "--frames", "100000", "--rate", "10"});
         box.check(box.wait_for_output(run, "learning commands on", 60s), "the graph runs");
         // Reliable objects keep 200 lists: a 3 s partition at 10 Hz fits (docs/DDS.md, QoS).
         {
@@ -85,11 +84,28 @@ TEST(DdsNetns, ReliableObjectsSurviveLossAndAPartitionAcrossTwoNamespaces) {
           std::fputs("qos:\n  objects: {reliability: reliable, depth: 200}\n", f);
           std::fclose(f);
         }
-        const pid_t bridge = box.spawn_program(
-            "bridge", {"/usr/sbin/ip", "netns", "exec", link.a, ORTHOFLOW, "bridge", "dds",
-                       "--config", "/tmp/bridge.yaml", "--interface", "va", "--allow-network",
-                       "--accept-network-commands", "--peer", "10.77.0.2", "--domain", "212",
-                       "--frames", "--max-frame-hz", "5", "--seconds", "120"});
+        const pid_t bridge = box.spawn_program("bridge", {"/usr/sbin/ip",
+                                                          "netns",
+                                                          "exec",
+                                                          link.a,
+                                                          ORTHOFLOW,
+                                                          "bridge",
+                                                          "dds",
+                                                          "--config",
+                                                          "/tmp/bridge.yaml",
+                                                          "--interface",
+                                                          "va",
+                                                          "--allow-network",
+                                                          "--accept-network-commands",
+                                                          "--peer",
+                                                          "10.77.0.2",
+                                                          "--domain",
+                                                          "212",
+                                                          "--frames",
+                                                          "--max-frame-hz",
+                                                          "5",
+                                                          "--seconds",
+                                                          "120"});
         box.check(box.wait_for_output(bridge, "bridge dds: graph", 30s), "the bridge runs");
         bridge::BridgeConfig far;
         far.interface = "vb";
@@ -98,9 +114,9 @@ TEST(DdsNetns, ReliableObjectsSurviveLossAndAPartitionAcrossTwoNamespaces) {
         ::setenv("CYCLONEDDS_URI", bridge::cyclone_xml(far).c_str(), 1);
         const auto subscriber = [&](const std::string& name, const std::string& seconds,
                                     std::vector<std::string> extra) {
-          std::vector<std::string> argv{"/usr/sbin/ip", "netns", "exec", link.b, SUBSCRIBER,
-                                        "--domain", "212", "--points", "--all", "--seconds",
-                                        seconds};
+          std::vector<std::string> argv{"/usr/sbin/ip", "netns",     "exec", link.b,
+                                        SUBSCRIBER,     "--domain",  "212",  "--points",
+                                        "--all",        "--seconds", seconds};
           argv.insert(argv.end(), extra.begin(), extra.end());
           return box.spawn_program(name, argv);
         };

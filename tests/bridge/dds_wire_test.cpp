@@ -1,8 +1,8 @@
 // ROS 2 wire compatibility without ROS 2 (issue 23): real PointCloud2 messages a ROS 2 system
-// recorded (tests/bridge/data/SOURCE.md: a public rosbag2 file's CDR payloads) are decoded by Cyclone
-// DDS with the types the bridge generates from its IDL (bridge/idl), the same way a sample from the
-// network is, and encoding the decoded message again gives the same bytes. Also: such a payload
-// written raw on a bridge-typed topic reaches a reader as the same message.
+// recorded (tests/bridge/data/SOURCE.md: a public rosbag2 file's CDR payloads) are decoded by
+// Cyclone DDS with the types the bridge generates from its IDL (bridge/idl), the same way a sample
+// from the network is, and encoding the decoded message again gives the same bytes. Also: such a
+// payload written raw on a bridge-typed topic reaches a reader as the same message.
 #include <gtest/gtest.h>
 
 #include <cstring>

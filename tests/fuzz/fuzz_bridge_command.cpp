@@ -59,13 +59,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (ddsi_serdata_to_sample(sd, &c, nullptr, nullptr)) {
     auto payload = b::from_ros(c, 7, 1);
     if (payload) {
-      auto decoded = orthoflow::graphs::decode_command(
-          std::as_bytes(std::span<const orthoflow::graphs::LearningCommandPayload, 1>(&*payload, 1)));
+      auto decoded = orthoflow::graphs::decode_command(std::as_bytes(
+          std::span<const orthoflow::graphs::LearningCommandPayload, 1>(&*payload, 1)));
       if (!decoded) __builtin_trap();  // the bridge let through what the graph refuses
       if (static_cast<std::uint8_t>(decoded->command.kind) != c.kind) __builtin_trap();
       if (decoded->command.track_id != c.track_id || c.client == 0) __builtin_trap();
       const bool labelled = c.kind <= 2;
-      if (labelled && (c.label == nullptr || decoded->command.label.view() != std::string_view(c.label)))
+      if (labelled &&
+          (c.label == nullptr || decoded->command.label.view() != std::string_view(c.label)))
         __builtin_trap();
     } else if (payload.error().message.empty()) {
       __builtin_trap();
