@@ -1,6 +1,7 @@
 #include "bridge/bridge_loop.hpp"
 
 #include <chrono>
+#include <algorithm>
 #include <cstring>
 
 #include "engine/frame_payload.hpp"
@@ -129,11 +130,19 @@ std::size_t BridgeLoop::pump_objects(std::int64_t /*now_ns*/) {
 std::size_t BridgeLoop::pump_frame(std::int64_t now_ns) {
   auto taken = frames_->take();
   if (!taken || !taken->has_value()) return 0;
-  const std::int64_t min_gap =
-      config_.max_frame_hz > 0.0 ? static_cast<std::int64_t>(1e9 / config_.max_frame_hz) : 0;
-  if (last_frame_ns_ != 0 && now_ns - last_frame_ns_ < min_gap) {
-    ++counters_.frames_thinned;
-    return 1;
+  // A token bucket of two frames refilled at max_frame_hz: the rate is held on average, and a
+  // frame that comes a little early after a late one is not thinned (graphs jitter).
+  if (config_.max_frame_hz > 0.0) {
+    if (last_frame_ns_ != 0)
+      frame_tokens_ = std::min(
+          2.0, frame_tokens_ + 1e-9 * static_cast<double>(now_ns - last_frame_ns_) *
+                                   config_.max_frame_hz);
+    last_frame_ns_ = now_ns;
+    if (frame_tokens_ < 1.0) {
+      ++counters_.frames_thinned;
+      return 1;
+    }
+    frame_tokens_ -= 1.0;
   }
   auto view = engine::view_frame((*taken)->bytes());
   if (!view) {
@@ -148,7 +157,6 @@ std::size_t BridgeLoop::pump_frame(std::int64_t now_ns) {
     ++counters_.write_errors;
     return 1;
   }
-  last_frame_ns_ = now_ns;
   ++counters_.frames_out;
   counters_.data_bytes_out += *written;
   points_stats_->service.record(t1 - t0);

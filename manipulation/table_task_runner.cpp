@@ -229,10 +229,7 @@ void TableTaskRunner::start_move(std::int64_t now_ns, const jaco::ArmSnapshot& a
   unseen_frames_ = 0;
   JobOptions job_options = options_.job;
   GraspOptions& g = job_options.grasp;
-  // The IK of the grasp poses starts from the initial pose, where every job starts (GO_INITIAL):
-  // seeded from where the arm stands after the last job, it could take another branch, far from
-  // the initial pose, and the way to the pre-grasp then outlasts its phase.
-  g.seed = options_.job.initial;
+  g.seed = arm.joints;
   const auto plan = plan_grasp(s->box, g);
   if (!plan.has_value()) {
     r.failure = std::string("no grasp: ") + to_string(plan.error());
