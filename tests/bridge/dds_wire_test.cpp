@@ -15,6 +15,7 @@
 #include <dds/ddsi/ddsi_serdata.h>
 
 #include "bridge/bridge_config.hpp"
+#include "bridge/ros_endpoints.hpp"
 #include "bridge/ros_messages.hpp"
 
 namespace orthoflow::bridge {
@@ -148,6 +149,43 @@ TEST_F(Wire, ATruncatedOrCorruptPayloadIsRefusedNotDecoded) {
     EXPECT_EQ(in, nullptr) << "a count at offset " << at << " beyond the payload";
     if (in != nullptr) ddsi_serdata_unref(in);
   }
+}
+
+// A peer that publishes another type under the bridge's command topic name never reaches the
+// bridge: Cyclone does not match the two (the type names differ). Cyclone 0.10.2 does not count
+// it as an inconsistent topic (measured: 0), so the bridge cannot report it either.
+TEST(WirePeers, AnotherTypeOnTheCommandTopicIsNotMatched) {
+  BridgeConfig config;
+  config.domain = 202;
+  auto ends = RosEndpoints::open(config);
+  ASSERT_TRUE(ends) << ends.error();
+  const dds_entity_t peer = dds_create_participant(config.domain, nullptr, nullptr);
+  ASSERT_GT(peer, 0);
+  // The acks' type on the commands' topic name.
+  const dds_entity_t wrong =
+      dds_create_topic(peer, &orthoflow_msgs_msg_dds__LearningAck__desc,
+                       (*ends)->topics().learning_commands.c_str(), nullptr, nullptr);
+  ASSERT_GT(wrong, 0) << dds_strretcode(wrong);
+  dds_qos_t* qos = dds_create_qos();
+  dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
+  const dds_entity_t writer = dds_create_writer(peer, wrong, qos, nullptr);
+  dds_delete_qos(qos);
+  ASSERT_GT(writer, 0);
+  RosLearningAck sample{};
+  sample.client = 1;
+  sample.outcome = const_cast<char*>("x");
+  sample.problem = const_cast<char*>("");
+  sample.label = const_cast<char*>("mug");
+  std::size_t taken = 0;
+  for (int i = 0; i < 50; ++i) {  // 0.5 s: discovery has long finished in one process
+    (void)dds_write(writer, &sample);
+    dds_sleepfor(DDS_MSECS(10));
+    taken += (*ends)->take_commands(16, [](const RosLearningCommand&) {});
+  }
+  EXPECT_EQ(taken, 0U) << "nothing of the other type reached the bridge";
+  const DdsStatus status = (*ends)->status();
+  EXPECT_EQ(status.command_writers, 0U);
+  dds_delete(peer);
 }
 
 }  // namespace
