@@ -181,8 +181,9 @@ void add_bridge_command(CLI::App& app) {
   cmd->add_option("--interface", o->interface,
                   "Network interface name or address (default lo: this host only)");
   cmd->add_option("--peer", o->peers, "A peer's address for unicast discovery (repeat)");
-  cmd->add_flag("--allow-network", o->allow_network,
-                "Allow an interface other than loopback (no DDS Security: anyone there reads)");
+  cmd->add_flag(
+      "--allow-network", o->allow_network,
+      "Allow an interface other than loopback (no DDS Security set up: anyone there reads)");
   cmd->add_flag("--accept-network-commands", o->accept_network_commands,
                 "Take learning commands on a non-loopback interface (unauthenticated)");
   cmd->add_flag("--frames", o->frames, "Also bridge orthoflow/<graph>/frames as PointCloud2");

@@ -114,10 +114,11 @@ Result<void, std::string> check_bridge_config(const BridgeConfig& c) {
   for (const std::string& p : c.peers)
     if (!std::regex_match(p, ADDRESS)) return err("peer '" + p + "': a host name or an address");
   if (!is_loopback(c.interface) && !c.allow_network)
-    return err("interface '" + c.interface +
-               "' is not loopback: pass --allow-network (allow_network: true) to publish there; "
-               "Debian's Cyclone DDS has no DDS Security, so anyone on that network reads the "
-               "objects (docs/DDS.md)");
+    return err(
+        "interface '" + c.interface +
+        "' is not loopback: pass --allow-network (allow_network: true) to publish there; "
+        "the bridge does not configure DDS Security yet, so anyone on that network reads the "
+        "objects (docs/DDS.md)");
   if (!std::isfinite(c.max_frame_hz) || c.max_frame_hz < 0.0 || c.max_frame_hz > 1000.0)
     return err("max_frame_hz: 0..1000");
   if (c.ack_timeout_ms < 100 || c.ack_timeout_ms > 600000)

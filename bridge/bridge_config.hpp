@@ -3,7 +3,9 @@
 /// @brief The DDS bridge's configuration (issue 23): the graph it serves, the DDS domain, the
 /// network it binds, its peers and each topic's QoS; from a YAML file and the command line
 /// (docs/DDS.md lists every key). Loopback by default: binding another interface is a deliberate
-/// choice (--allow-network), because Debian's Cyclone DDS has no DDS Security to authenticate with,
+/// choice (--allow-network), because the bridge does not configure DDS Security yet (Debian ships
+/// Cyclone's plugins in libddsc0debian/, but nothing sets up their certificates), so nothing on DDS
+/// is authenticated,
 /// and learning commands from such a network are taken only with --accept-network-commands.
 #include <cstdint>
 #include <string>
