@@ -1,7 +1,7 @@
 #include "bridge/bridge_loop.hpp"
 
-#include <chrono>
 #include <algorithm>
+#include <chrono>
 #include <cstring>
 
 #include "engine/frame_payload.hpp"
@@ -134,9 +134,9 @@ std::size_t BridgeLoop::pump_frame(std::int64_t now_ns) {
   // frame that comes a little early after a late one is not thinned (graphs jitter).
   if (config_.max_frame_hz > 0.0) {
     if (last_frame_ns_ != 0)
-      frame_tokens_ = std::min(
-          2.0, frame_tokens_ + 1e-9 * static_cast<double>(now_ns - last_frame_ns_) *
-                                   config_.max_frame_hz);
+      frame_tokens_ =
+          std::min(2.0, frame_tokens_ + 1e-9 * static_cast<double>(now_ns - last_frame_ns_) *
+                                            config_.max_frame_hz);
     last_frame_ns_ = now_ns;
     if (frame_tokens_ < 1.0) {
       ++counters_.frames_thinned;

@@ -62,8 +62,8 @@ class BridgeLoop {
   std::unique_ptr<engine::IpcSubscriber> objects_, frames_, acks_;
   std::unique_ptr<engine::IpcPublisher> commands_;
   std::unique_ptr<engine::ObjectListPayload> list_;  // aligned copy of the newest list
-  std::int64_t last_frame_ns_ = 0;  ///< the last frame taken (thinning)
-  double frame_tokens_ = 1.0;       ///< frames that may go now (a bucket of 2 at max_frame_hz)
+  std::int64_t last_frame_ns_ = 0;                   ///< the last frame taken (thinning)
+  double frame_tokens_ = 1.0;  ///< frames that may go now (a bucket of 2 at max_frame_hz)
   std::int64_t start_ns_ = 0;
   BridgeCounters counters_;
   engine::GraphStats stats_;
