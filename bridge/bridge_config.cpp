@@ -1,7 +1,7 @@
 #include "bridge/bridge_config.hpp"
 
 #include <cmath>
-#include <regex>
+#include <string_view>
 
 #include <yaml-cpp/yaml.h>
 
@@ -9,6 +9,22 @@
 
 namespace orthoflow::bridge {
 namespace {
+
+// True if @p text is min..max characters, each a letter, a digit or one of @p also.
+bool made_of(const std::string& text, std::size_t min, std::size_t max, std::string_view also) {
+  if (text.size() < min || text.size() > max) return false;
+  for (const char c : text) {
+    const bool alnum = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9');
+    if (!alnum && also.find(c) == std::string_view::npos) return false;
+  }
+  return true;
+}
+
+// A ROS name token: a letter, then letters, digits and '_' (at most 64).
+bool ros_token(const std::string& text) {
+  return made_of(text, 1, 64, "_") &&
+         ((text[0] >= 'a' && text[0] <= 'z') || (text[0] >= 'A' && text[0] <= 'Z'));
+}
 
 Result<void, std::string> read_qos(const YAML::Node& node, const std::string& key, TopicQos& out) {
   for (const auto& kv : node) {
@@ -101,10 +117,9 @@ Result<void, std::string> check_bridge_config(const BridgeConfig& c) {
   if (auto topics = graphs::graph_topics(c.graph); !topics)
     return err("graph '" + c.graph + "': " + topics.error());
   if (c.domain > 232) return err("domain: 0..232");
-  static const std::regex NAME("[A-Za-z][A-Za-z0-9_]{0,63}");
-  if (!std::regex_match(c.topic_prefix, NAME))
+  if (!ros_token(c.topic_prefix))
     return err("topic_prefix '" + c.topic_prefix + "': a ROS name token ([A-Za-z][A-Za-z0-9_]*)");
-  if (!std::regex_match(c.graph, NAME))
+  if (!ros_token(c.graph))
     return err("graph '" + c.graph + "': a ROS topic needs [A-Za-z][A-Za-z0-9_]*");
   static const std::regex FRAME("[A-Za-z0-9_/.-]{1,100}");
   if (!std::regex_match(c.camera_frame, FRAME))
