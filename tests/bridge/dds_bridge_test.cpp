@@ -44,11 +44,16 @@ TEST(DdsBridge, ObjectsFramesAndLessonsCrossToAPlainDdsNodeAndBack) {
       [](Sandbox& box) {
         if (box.start_roudi(ORTHOFLOW_SOURCE_DIR "/config/roudi_frames.toml") < 0) return;
         // The plain node finds the bridge as the bridge's own loopback configuration says.
-        ::setenv("CYCLONEDDS_URI", bridge::cyclone_xml(bridge::BridgeConfig{}).c_str(), 1);
+        // ... with a socket receive buffer that holds a whole 4.9 MB cloud (docs/DDS.md: the kernel
+        // caps the request at rmem_max; under ASan a slow reader lost every cloud without it).
+        std::string xml = bridge::cyclone_xml(bridge::BridgeConfig{});
+        xml.replace(xml.find("</General>"), 10,
+                    "</General><Internal><SocketReceiveBufferSize max=\"32MB\"/></Internal>");
+        ::setenv("CYCLONEDDS_URI", xml.c_str(), 1);
         pid_t run = start_graph(box, "run");
         const pid_t bridge = box.spawn_orthoflow(
-            "bridge", {"bridge", "dds", "--frames", "--domain", DOMAIN_ID, "--seconds", "200",
-                       "--telemetry-json", "/tmp/bridge.json"});
+            "bridge", {"bridge", "dds", "--frames", "--max-frame-hz", "2", "--domain", DOMAIN_ID,
+                       "--seconds", "200", "--telemetry-json", "/tmp/bridge.json"});
         box.check(box.wait_for_output(bridge, "rt/orthoflow/tabletop/objects", 30s),
                   "the bridge names its topics");
 
