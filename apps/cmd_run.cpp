@@ -114,12 +114,13 @@ void add_frames_publisher(engine::GraphSpec& spec) {
                    [](const engine::NodeSpec& n) { return n.kind == "objects_output"; });
   if (output == spec.nodes.end())
     fail("--publish-frames needs a graph with an objects_output node", EXIT_USAGE);
-  if (!graphs::graph_topics(spec.name))
-    fail("--publish-frames: graph name '" + spec.name + "' is not a topic name part", EXIT_USAGE);
+  const auto topics = graphs::graph_topics(spec.name);
+  if (!topics)
+    fail("--publish-frames: graph name '" + spec.name + "': " + topics.error(), EXIT_USAGE);
   engine::NodeSpec publish;
   publish.name = "publish_frames";
   publish.kind = "ipc_publish";
-  publish.params.assign("topic", "orthoflow/" + spec.name + "/frames");
+  publish.params.assign("topic", topics->frames.str());
   publish.params.assign("type", "frame");
   spec.edges.push_back(engine::EdgeSpec{output->name, "out", publish.name, "in", 0});
   spec.nodes.push_back(std::move(publish));

@@ -46,10 +46,9 @@ Result<std::unique_ptr<BridgeLoop>, std::string> BridgeLoop::open(const BridgeCo
   if (!objects) return err(ipc("objects", objects.error()));
   b->objects_ = std::move(*objects);
   if (config.frames) {
-    auto topic = engine::parse_topic("orthoflow/" + config.graph + "/frames");
-    if (!topic) return err(ipc("frames", topic.error()));
     auto frames = engine::IpcSubscriber::create(
-        *topic, {{engine::FRAME_TYPE_ID, engine::FRAME_VERSION}, engine::IpcPolicy::LATEST, 1, 0});
+        topics->frames,
+        {{engine::FRAME_TYPE_ID, engine::FRAME_VERSION}, engine::IpcPolicy::LATEST, 1, 0});
     if (!frames) return err(ipc("frames", frames.error()));
     b->frames_ = std::move(*frames);
   }

@@ -53,6 +53,7 @@ void fill_status(const LearningService& learning, const engine::GraphStats& stat
 Result<GraphTopics, std::string> graph_topics(const std::string& graph) {
   GraphTopics topics;
   for (auto [topic, name] : {std::pair{&topics.objects, "orthoflow/" + graph + "/objects"},
+                             std::pair{&topics.frames, "orthoflow/" + graph + "/frames"},
                              std::pair{&topics.commands, learning_commands_topic(graph)},
                              std::pair{&topics.acks, learning_acks_topic(graph)},
                              std::pair{&topics.status, status_topic(graph)}}) {

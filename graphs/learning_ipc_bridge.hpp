@@ -27,6 +27,7 @@ namespace orthoflow::graphs {
 /// them.
 struct GraphTopics {
   engine::IpcTopic objects, commands, acks, status;
+  engine::IpcTopic frames;  ///< `orthoflow run --publish-frames` (the DDS bridge reads it)
 };
 /// @brief The topics of graph @p graph. Errors: @p graph is not a topic name part (1..100 of
 /// [A-Za-z0-9_.-]).
