@@ -67,6 +67,9 @@ void add_run_command(CLI::App& app);
 /// @brief `orthoflow bridge dds`: a graph's objects, frames and learning commands on DDS with
 /// ROS 2's names (apps/cmd_bridge.cpp, docs/DDS.md).
 void add_bridge_command(CLI::App& app);
+/// @brief `orthoflow image check|render`: a robot image's configuration (apps/cmd_image.cpp,
+/// docs/DEPLOY.md).
+void add_image_command(CLI::App& app);
 /// @brief `orthoflow ui`: the web view over a graph in another process (apps/run_ui.cpp).
 void add_ui_command(CLI::App& app);
 /// @brief `evaluate --dataset DIR --protocol ...`: cross-validation, simulated teacher, context

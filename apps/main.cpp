@@ -28,6 +28,7 @@ int main(int argc, char** argv) {
   orthoflow::apps::add_task_command(app);
   orthoflow::apps::add_demo_command(app);
   orthoflow::apps::add_bridge_command(app);
+  orthoflow::apps::add_image_command(app);
   orthoflow::apps::check_numeric_options(app);  // every numeric option: finite and non-negative
   app.set_version_flag("--version", ORTHOFLOW_VERSION);
   try {

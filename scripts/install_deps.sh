@@ -17,6 +17,9 @@ PACKAGES=(
   libpcl-dev
   libfreenect-dev libfreenect-bin  # test-only: libfreenect against the simulated Kinect (tests/support/sim_libusb)
   chromium chromium-driver  # test-only: the web view in a real, headless browser (tests/ui/check_browser.py)
+  # The robot image (scripts/build_image.sh, issue 24): Debian's tools to build it, qemu to boot it.
+  mmdebstrap arch-test qemu-user-static e2fsprogs dosfstools mtools fdisk zstd grub-efi-amd64-bin grub-efi-arm64-bin
+  qemu-system-x86 qemu-system-arm ovmf qemu-efi-aarch64 curl  # test-only: booting the images (scripts/test_image.sh)
 )
 
 missing=()

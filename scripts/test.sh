@@ -8,6 +8,9 @@
 #      ctest under qemu, then
 #      `cpack` of the release and aarch64 builds (one check each: orthoflow_<ver>_<arch>.deb).
 #      AARCH64=0 skips the stage.
+#   5. image (after the aarch64 stage, from its two packages): an amd64 and an arm64 robot image built
+#      by scripts/build_image.sh from tests/image/robot.yaml and booted under qemu-system by
+#      scripts/test_image.sh (issue 24). IMAGE=0 skips the stage; IMAGE_ARCHES picks (default both).
 # Prints a closing line "tests: N passed, M failed" and exits non-zero on any failure.
 set -uo pipefail
 cd "$(dirname "$0")/.."
@@ -154,9 +157,43 @@ run_aarch64() {
   [ -f build/release/CPackConfig.cmake ] && check_deb build/release amd64
 }
 
+# The image stage (issue 24): build each architecture's robot image from the packages check_deb made,
+# boot it under qemu-system and check it from the host (scripts/test_image.sh). One check per image.
+run_image() {
+  local t0 arch out=build/image
+  t0=$(date +%s)
+  mkdir -p "$out"
+  # The packages come from the aarch64 stage; made here when that stage did not run.
+  ls build/release/deb/orthoflow_*_amd64.deb >/dev/null 2>&1 || check_deb build/release amd64
+  for arch in ${IMAGE_ARCHES:-amd64 arm64}; do
+    echo "=== image $arch: build"
+    if ! bash scripts/build_image.sh --arch "$arch" --out "$out" --config tests/image/robot.yaml \
+        >"$logdir/image_build_$arch.log" 2>&1; then
+      tail -n 40 "$logdir/image_build_$arch.log"
+      echo "image $arch: build FAILED"
+      failed=$((failed + 1)); failures="${failures}image $arch: build"$'\n'
+      continue
+    fi
+    tail -n 7 "$logdir/image_build_$arch.log"
+    echo "=== image $arch: boot"
+    if bash scripts/test_image.sh --arch "$arch" --dir "$out" --token tests/image/ui-token \
+        >"$logdir/image_boot_$arch.log" 2>&1; then
+      cat "$out/boot-$arch.txt"
+      passed=$((passed + 1))
+    else
+      tail -n 80 "$logdir/image_boot_$arch.log"
+      echo "image $arch: boot test FAILED"
+      failed=$((failed + 1)); failures="${failures}image $arch: boot"$'\n'
+    fi
+    rm -f "$out/orthoflow-$arch.img"  # 2 GiB each; the tarball, lists and logs stay
+  done
+  note_time "image" "$t0"
+}
+
 for p in $PRESETS; do run_ctest_preset "$p"; done
 if [ "$FUZZ_SECONDS" -gt 0 ]; then run_fuzzers; fi
 if [ "${AARCH64:-1}" != 0 ]; then run_aarch64; fi
+if [ "${IMAGE:-1}" != 0 ]; then run_image; fi
 echo "--- time per stage"
 printf "%s" "$timings"
 [ -n "${CMAKE_CXX_COMPILER_LAUNCHER:-}" ] && ccache -s 2>/dev/null | grep -E "^(Cacheable calls|  Hits|  Misses)" || true
