@@ -47,13 +47,15 @@ case "$arch" in
   *) die "--arch must be amd64 or arm64, not '$arch'" ;;
 esac
 [ -n "$out" ] || die "--out DIR is required"
-[ "$(id -u)" = 0 ] || die "needs root (mmdebstrap's root mode keeps the image's owners right)"
 [ -r "$config" ] || die "the robot configuration $config cannot be read"
 if [ -z "$orthoflow" ]; then
   orthoflow="$here/build/release/apps/orthoflow"
   [ -x "$orthoflow" ] || orthoflow=$(command -v orthoflow || true)
 fi
 [ -n "$orthoflow" ] && [ -x "$orthoflow" ] || die "no orthoflow binary for this machine (--orthoflow BIN)"
+# The configuration first: a bad one is refused, naming the key, before anything else is needed.
+"$orthoflow" image check "$config" || die "$config: not a valid robot configuration (above)"
+[ "$(id -u)" = 0 ] || die "needs root (mmdebstrap's root mode keeps the image's owners right)"
 if [ -z "$deb" ]; then
   build=release; [ "$arch" = arm64 ] && build=aarch64
   deb=$(ls "$here"/build/$build/deb/orthoflow_*_"$arch".deb 2>/dev/null | head -n 1 || true)
@@ -87,8 +89,7 @@ out=$(cd "$out" && pwd)
 work=$(mktemp -d "${TMPDIR:-/tmp}/orthoflow-image.XXXXXX")
 trap 'rm -rf "$work"' EXIT
 
-# 1. The configuration: checked, then rendered (errors name the key, before anything is fetched).
-"$orthoflow" image check "$config" || die "$config: not a valid robot configuration (above)"
+# 1. The configuration's files (checked above; the graph file it names is checked here).
 "$orthoflow" image render "$config" --arch "$arch" --out "$work/render" >/dev/null
 if [ -f "$work/render/rootfs/etc/orthoflow/graph.yaml" ]; then
   "$orthoflow" graph check "$work/render/rootfs/etc/orthoflow/graph.yaml" ||
