@@ -116,6 +116,7 @@ export SOURCE_DATE_EPOCH
 # orthoflow package, in one apt run: it points /etc/resolv.conf at a resolver that only runs on the
 # booted robot, so nothing can be fetched after it.
 mmdebstrap --verbose --mode=root --variant=minbase --arch="$arch" --include="$packages" "${initramfs_hooks[@]}" \
+  --aptopt='Acquire::Retries "3"' \
   --dpkgopt='path-exclude=/usr/share/man/*' --dpkgopt='path-exclude=/usr/share/doc/*' \
   --dpkgopt='path-include=/usr/share/doc/*/copyright' --dpkgopt='path-exclude=/usr/share/locale/*' \
   --dpkgopt='path-exclude=/usr/share/info/*' \
