@@ -6,6 +6,8 @@
 #      line systemd's state goes into), the web view answers with the bearer token and has processed
 #      frames of the simulated Kinect; a track is taught (acknowledged as durable); then qemu is killed
 #      (a power cut, nothing shut down).
+#   Then the update in place of DEPLOY.md: the boot loader and root partitions written again from the
+#   image with dd, the data partition untouched.
 #   2. The same disk again: the service is back and the perceptual memory still holds the category.
 #   3. The kernel booted directly with orthoflow.source=kinect and no Kinect attached: the service fails,
 #      systemd restarts it, the reason is in the health line, the system stays up (no reboot loop).
@@ -130,6 +132,14 @@ note "boot 1: $(last_health)"
   fail "boot 1: the web view answered without the token"
 power_cut
 note "boot 1: power cut (qemu killed) $(elapsed) s after power-on"
+
+# --- the documented update in place (docs/DEPLOY.md section 7): the boot loader and root partitions
+# rewritten from the image, the data partition left as it is.
+data_start=$(sfdisk -d "$scratch/disk.img" | awk -F'[=,]' '/orthoflow-data/ {gsub(/ /, "", $2); print $2}')
+[ -n "$data_start" ] || fail "update: no orthoflow-data partition in the image's partition table"
+count=$(( data_start / 2048 - 1 ))
+dd if="$dir/orthoflow-$arch.img" of="$scratch/disk.img" bs=1M skip=1 seek=1 count=$count conv=notrunc,fsync status=none
+note "update: partitions 1-2 rewritten from the image (dd bs=1M skip=1 seek=1 count=$count), data partition kept"
 
 # --- boot 2: the memory survived
 boot 2 -bios "$firmware"
