@@ -1,9 +1,9 @@
 // `orthoflow image check|render`: a robot image's configuration (issue 24, docs/DEPLOY.md).
 // `check ROBOT.yaml` validates it; `render ROBOT.yaml --arch A --out DIR` writes what
 // scripts/build_image.sh puts into the image: DIR/rootfs/ (files over the root file system: host
-// name, fstab, network, the orthoflow unit and its settings, the robot.yaml itself, the token and
-// graph files it names), DIR/grub.cfg (the boot loader's configuration), DIR/cmdline (the kernel
-// command line) and DIR/layout (partition sizes, extra packages).
+// name, fstab, network, the orthoflow unit and its settings, the robot.yaml itself, the token,
+// graph and SSH key files it names), DIR/grub.cfg (the boot loader's configuration), DIR/cmdline
+// (the kernel command line) and DIR/layout (partition sizes, extra packages).
 #include <sys/stat.h>
 
 #include <filesystem>
@@ -41,6 +41,17 @@ deploy::RobotConfig load_or_throw(const std::string& path) {
     const fs::path token = fs::path(path).parent_path() / config->ui.token_file;
     if (auto t = ui::read_token_file(token.string()); !t)
       fail(path + ": ui.token_file: " + t.error(), EXIT_BAD_INPUT);
+  }
+  if (!config->admin.ssh_authorized_keys.empty()) {
+    const fs::path keys = fs::path(path).parent_path() / config->admin.ssh_authorized_keys;
+    std::ifstream in(keys, std::ios::binary);
+    if (!in)
+      fail(path + ": admin.ssh_authorized_keys: " + keys.string() + " cannot be read",
+           EXIT_BAD_INPUT);
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (auto ok = deploy::check_authorized_keys(text); !ok)
+      fail(path + ": admin.ssh_authorized_keys: " + keys.string() + ": " + ok.error(),
+           EXIT_BAD_INPUT);
   }
   if (config->graph != "tabletop") {
     const fs::path graph = fs::path(path).parent_path() / config->graph;
@@ -81,6 +92,12 @@ void render(const ImageArgs& a) {
     copy_file(here / config.ui.token_file, root / "etc/orthoflow/ui-token", 0640);
   if (config.graph != "tabletop")
     copy_file(here / config.graph, root / "etc/orthoflow/graph.yaml", 0644);
+  if (!config.admin.ssh_authorized_keys.empty()) {
+    copy_file(here / config.admin.ssh_authorized_keys, root / "root/.ssh/authorized_keys", 0600);
+    if (::chmod((root / "root/.ssh").c_str(), 0700) != 0 ||
+        ::chmod((root / "root").c_str(), 0700) != 0)
+      fail("cannot set the mode of " + (root / "root/.ssh").string(), EXIT_FAILURE_GENERIC);
+  }
   write_file(out / "grub.cfg", deploy::grub_config(config, *arch), 0644);
   write_file(out / "cmdline", deploy::kernel_command_line(config, *arch) + "\n", 0644);
   write_file(out / "layout", deploy::image_layout(config), 0644);

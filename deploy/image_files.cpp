@@ -21,16 +21,30 @@ std::string fstab() {
   return std::string(
              "# orthoflow robot image (docs/DEPLOY.md): the root file system is read-only; the "
              "perceptual\n"
-             "# memory and the service's state live on the data partition. Update in place with\n"
-             "# `mount -o remount,rw /` (docs/DEPLOY.md).\n"
+             "# memory, the service's state and the SSH host keys live on the data partition. "
+             "Update in\n"
+             "# place: docs/DEPLOY.md section 7.\n"
              "LABEL=") +
          ROOT_LABEL + "  /  ext4  ro,noatime,errors=remount-ro  0 1\nLABEL=" + DATA_LABEL + "  " +
-         STATE_DIR +
-         "  ext4  rw,noatime,nosuid,nodev,noexec,errors=remount-ro  0 2\nLABEL=" + ESP_LABEL +
+         DATA_DIR + "  ext4  rw,noatime,nosuid,nodev,noexec,errors=remount-ro  0 2\n" + DATA_DIR +
+         "/orthoflow  " + STATE_DIR + "  none  bind,x-systemd.requires-mounts-for=" + DATA_DIR +
+         "  0 0\nLABEL=" + ESP_LABEL +
          "  /boot/efi  vfat  ro,noauto,umask=0077  0 0\n"
          "tmpfs  /tmp  tmpfs  mode=1777,nosuid,nodev,size=25%  0 0\n"
          "tmpfs  /var/tmp  tmpfs  mode=1777,nosuid,nodev,size=64M  0 0\n"
          "tmpfs  /var/log  tmpfs  mode=0755,nosuid,nodev,size=32M  0 0\n";
+}
+
+std::string sshd_config() {
+  return std::string(
+             "# orthoflow robot image (docs/DEPLOY.md): keys only, root by key only; the host keys "
+             "are this\n"
+             "# robot's own, made at its first boot on the data partition.\n"
+             "PasswordAuthentication no\n"
+             "KbdInteractiveAuthentication no\n"
+             "PermitRootLogin prohibit-password\n"
+             "HostKey ") +
+         DATA_DIR + "/ssh/ssh_host_ed25519_key\n";
 }
 
 std::string network_file(const NetworkSettings& n) {
@@ -93,7 +107,8 @@ std::string image_env(const RobotConfig& c) {
          "ORTHOFLOW_UI_PORT=" +
          std::to_string(ui_port(c)) +
          "\nORTHOFLOW_UI_TOKEN=" + (c.ui.enabled ? token_path_on_robot(c) : "") +
-         "\nORTHOFLOW_STATE_DIR=" + STATE_DIR + "\n";
+         "\nORTHOFLOW_STATE_DIR=" + STATE_DIR + "\nORTHOFLOW_DATA_DIR=" + DATA_DIR +
+         "\nORTHOFLOW_SSH=" + (c.admin.ssh_authorized_keys.empty() ? "0" : "1") + "\n";
 }
 
 }  // namespace
@@ -127,7 +142,7 @@ std::vector<std::string> service_arguments(const RobotConfig& c) {
 
 std::vector<ImageFile> root_files(const RobotConfig& c, Arch arch) {
   (void)arch;
-  return {
+  std::vector<ImageFile> files = {
       {"etc/hostname", c.hostname + "\n", 0644},
       {"etc/hosts",
        "127.0.0.1 localhost\n127.0.1.1 " + c.hostname +
@@ -138,6 +153,14 @@ std::vector<ImageFile> root_files(const RobotConfig& c, Arch arch) {
       {"etc/systemd/system/orthoflow.service", service_unit(c), 0644},
       {"etc/orthoflow/image.env", image_env(c), 0644},
   };
+  if (!c.admin.ssh_authorized_keys.empty()) {
+    files.push_back({"etc/ssh/sshd_config.d/orthoflow-image.conf", sshd_config(), 0644});
+    files.push_back({"etc/systemd/system/ssh.service.d/orthoflow-image.conf",
+                     "# orthoflow robot image: the host keys are made by the first boot\n[Unit]\n"
+                     "After=orthoflow-firstboot.service\nWants=orthoflow-firstboot.service\n",
+                     0644});
+  }
+  return files;
 }
 
 std::string kernel_command_line(const RobotConfig& c, Arch arch) {
@@ -166,10 +189,12 @@ std::string grub_config(const RobotConfig& c, Arch arch) {
 }
 
 std::string image_layout(const RobotConfig& c) {
+  std::vector<std::string> packages = c.image.packages;
+  if (!c.admin.ssh_authorized_keys.empty()) packages.emplace_back("openssh-server");
   return "esp_mib " + std::to_string(c.image.esp_mib) + "\nroot_mib " +
          std::to_string(c.image.root_mib) + "\ndata_mib " + std::to_string(c.image.data_mib) +
          "\nui_port " + std::to_string(ui_port(c)) + "\ninitramfs " + c.image.initramfs +
-         "\npackages " + join(c.image.packages, " ") + "\n";
+         "\npackages " + join(packages, " ") + "\n";
 }
 
 }  // namespace orthoflow::deploy

@@ -16,7 +16,10 @@ namespace orthoflow::deploy {
 inline constexpr const char* ROOT_LABEL = "orthoflow-root";
 inline constexpr const char* DATA_LABEL = "orthoflow-data";
 inline constexpr const char* ESP_LABEL = "ORTHO-EFI";  // FAT: at most 11 upper-case characters
-/// @brief Where the service keeps its state: the mount point of the data partition.
+/// @brief The data partition's mount point; it holds orthoflow/ (the service's state, bound onto
+/// STATE_DIR) and ssh/ (the robot's own SSH host keys, root only).
+inline constexpr const char* DATA_DIR = "/data";
+/// @brief Where the service keeps its state: DATA_DIR/orthoflow, bound here.
 inline constexpr const char* STATE_DIR = "/var/lib/orthoflow";
 
 /// @brief One file of the root file system: a path relative to its root, the text, the mode.
@@ -44,7 +47,8 @@ struct ImageFile {
 [[nodiscard]] std::string kernel_command_line(const RobotConfig& config, Arch arch);
 
 /// @brief The layout scripts/build_image.sh reads: one "key value..." line each (esp_mib,
-/// root_mib, data_mib, ui_port, packages), values checked by check_robot_config.
+/// root_mib, data_mib, ui_port, initramfs, packages: the configured ones, and openssh-server when
+/// admin keys are given), values checked by check_robot_config.
 [[nodiscard]] std::string image_layout(const RobotConfig& config);
 
 /// @brief Path of the UI's token on the robot: /etc/orthoflow/ui-token when the configuration

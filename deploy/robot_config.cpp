@@ -136,6 +136,18 @@ Result<void, std::string> read_network(const YAML::Node& node, NetworkSettings& 
   return {};
 }
 
+Result<void, std::string> read_admin(const YAML::Node& node, AdminSettings& a) {
+  if (!node.IsMap()) return err("admin: a map (ssh_authorized_keys)");
+  for (const auto& kv : node) {
+    const std::string k = kv.first.as<std::string>();
+    if (k == "ssh_authorized_keys")
+      a.ssh_authorized_keys = kv.second.IsNull() ? "" : kv.second.as<std::string>();
+    else
+      return err("admin." + k + ": unknown key (ssh_authorized_keys)");
+  }
+  return {};
+}
+
 Result<void, std::string> read_image(const YAML::Node& node, ImageSettings& im) {
   if (!node.IsMap())
     return err("image: a map (esp_mib, root_mib, data_mib, console, cmdline, packages, initramfs)");
@@ -213,12 +225,14 @@ Result<RobotConfig, std::string> parse_robot_config(const std::string& text,
         ok = read_ui(v, c.ui);
       else if (k == "network")
         ok = read_network(v, c.network);
+      else if (k == "admin")
+        ok = read_admin(v, c.admin);
       else if (k == "image")
         ok = read_image(v, c.image);
       else
         return err(name + ": " + k +
                    ": unknown key (hostname, source, graph, learner, rate_hz, threads, ui, "
-                   "network, image)");
+                   "network, admin, image)");
       if (!ok) return err(name + ": " + ok.error());
     }
   } catch (const YAML::Exception& e) { return err(name + ": " + e.what()); }
@@ -263,6 +277,8 @@ Result<void, std::string> check_robot_config(const RobotConfig& c) {
     if (!c.ui.token_file.empty() && !host_path(c.ui.token_file))
       return err("ui.token_file: a path (letters, digits, / . _ - + @ ~ and spaces)");
   }
+  if (!c.admin.ssh_authorized_keys.empty() && !host_path(c.admin.ssh_authorized_keys))
+    return err("admin.ssh_authorized_keys: a path (letters, digits, / . _ - + @ ~ and spaces)");
   const NetworkSettings& n = c.network;
   if (n.interfaces.empty() || n.interfaces.size() > 16)
     return err("network.interfaces: 1..16 interface names or globs");
@@ -301,6 +317,36 @@ Result<void, std::string> check_robot_config(const RobotConfig& c) {
     if (!made_of(p, 2, 64, "+.-") || !letter_or_digit(p.front()) ||
         p.find_first_of("ABCDEFGHIJKLMNOPQRSTUVWXYZ") != std::string::npos)
       return err("image.packages: '" + p + "' is not a Debian package name");
+  return {};
+}
+
+Result<void, std::string> check_authorized_keys(std::string_view text) {
+  if (text.size() > 65536) return err("larger than 64 KiB");
+  int keys = 0;
+  int line_no = 0;
+  std::size_t start = 0;
+  while (start < text.size()) {
+    std::size_t end = text.find('\n', start);
+    if (end == std::string_view::npos) end = text.size();
+    std::string_view line = text.substr(start, end - start);
+    start = end + 1;
+    ++line_no;
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    if (line.empty() || line.front() == '#') continue;
+    const std::size_t space = line.find(' ');
+    const std::string_view type = line.substr(0, space);
+    const bool known = type == "ssh-ed25519" || type == "ssh-rsa" ||
+                       type.rfind("ecdsa-sha2-", 0) == 0 || type.rfind("sk-", 0) == 0;
+    if (!known || space == std::string_view::npos || space + 1 >= line.size())
+      return err("line " + std::to_string(line_no) +
+                 ": not a public key (ssh-ed25519, ssh-rsa, ecdsa-sha2-*, sk-* followed by the "
+                 "key; no options)");
+    for (const char ch : line)
+      if (static_cast<unsigned char>(ch) < 0x20 || static_cast<unsigned char>(ch) > 0x7e)
+        return err("line " + std::to_string(line_no) + ": a character that is not printable ASCII");
+    ++keys;
+  }
+  if (keys == 0) return err("no public key in it");
   return {};
 }
 

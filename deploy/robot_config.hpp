@@ -38,6 +38,14 @@ struct NetworkSettings {
   std::vector<std::string> dns;                        ///< static resolvers, optional
 };
 
+/// @brief Remote administration: none unless keys are given (the image has no root password).
+struct AdminSettings {
+  /// A file on the build machine with SSH public keys for root (authorized_keys format); empty: no
+  /// SSH server. With it: openssh-server, keys only, host keys made at the first boot on the data
+  /// partition (every robot its own).
+  std::string ssh_authorized_keys;
+};
+
 struct ImageSettings {
   std::uint32_t esp_mib = 64;         ///< the EFI system partition (the boot loader)
   std::uint32_t root_mib = 1536;      ///< the read-only root file system
@@ -64,6 +72,7 @@ struct RobotConfig {
   std::uint32_t threads = 0;         ///< 0: all cores
   UiSettings ui;
   NetworkSettings network;
+  AdminSettings admin;
   ImageSettings image;
 };
 
@@ -77,6 +86,9 @@ struct RobotConfig {
 
 /// @brief The UI's port from `listen` ([ADDR:]PORT), 0 when the UI is off.
 [[nodiscard]] std::uint16_t ui_port(const RobotConfig& config) noexcept;
+/// @brief Checks the text of an authorized_keys file: at most 64 KiB, every line empty, a comment
+/// or a public key of a type OpenSSH takes (ssh-ed25519, ssh-rsa, ecdsa-sha2-*, sk-*), no options.
+[[nodiscard]] Result<void, std::string> check_authorized_keys(std::string_view text);
 /// @brief The kernel console for @p arch: config.image.console or the architecture's default.
 [[nodiscard]] std::string kernel_console(const RobotConfig& config, Arch arch);
 

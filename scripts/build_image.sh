@@ -135,7 +135,10 @@ cp "$here/deploy/60-orthoflow-kinect.rules" "$here/deploy/60-orthoflow-jaco.rule
 gid=$(awk -F: '$1 == "orthoflow" {print $3}' "$rootfs/etc/group")
 [ -n "$gid" ] || die "the service user was not made"
 [ -f "$rootfs/etc/orthoflow/ui-token" ] && chown "0:$gid" "$rootfs/etc/orthoflow/ui-token"
-mkdir -p "$rootfs/var/lib/orthoflow" "$rootfs/boot/efi" "$rootfs/usr/share/orthoflow-image"
+mkdir -p "$rootfs/var/lib/orthoflow" "$rootfs/data" "$rootfs/boot/efi" "$rootfs/usr/share/orthoflow-image"
+# openssh-server made host keys while it was installed: every robot flashed from this image would
+# share them. The first boot makes the robot's own on the data partition instead.
+rm -f "$rootfs"/etc/ssh/ssh_host_*
 # What systemd would make in /var/lib at boot, made now: the root is read-only there.
 mkdir -p "$rootfs/var/lib/systemd/linger" "$rootfs/var/lib/dbus"
 ln -sfn /etc/machine-id "$rootfs/var/lib/dbus/machine-id"
@@ -167,8 +170,11 @@ mmd -i "$work/esp.img" ::/EFI ::/EFI/BOOT
 mcopy -i "$work/esp.img" "$work/$efi_name" "::/EFI/BOOT/$efi_name"
 mkfs.ext4 -q -L orthoflow-root -d "$work/rootfs" "$work/root.img" "${root_mib}M" ||
   die "the root file system does not fit in image.root_mib $root_mib MiB"
-uid=$(awk -F: '$1 == "orthoflow" {print $3 ":" $4}' "$work/rootfs/etc/passwd")
-mkfs.ext4 -q -L orthoflow-data -m 0 -E "root_owner=$uid" "$work/data.img" "${data_mib}M"
+# The data partition: orthoflow/ for the service (bound onto /var/lib/orthoflow), ssh/ for root.
+uid=$(awk -F: '$1 == "orthoflow" {print $3 ":" $4}' "$rootfs/etc/passwd")
+mkdir -p "$work/data/orthoflow" "$work/data/ssh"
+chown "$uid" "$work/data/orthoflow" && chmod 0750 "$work/data/orthoflow" && chmod 0700 "$work/data/ssh"
+mkfs.ext4 -q -L orthoflow-data -m 0 -d "$work/data" "$work/data.img" "${data_mib}M"
 
 # 5. The disk: GPT with the three partitions, 1 MiB aligned.
 img="$out/orthoflow-$arch.img"

@@ -165,9 +165,15 @@ run_image() {
   mkdir -p "$out"
   # The packages come from the aarch64 stage; made here when that stage did not run.
   ls build/release/deb/orthoflow_*_amd64.deb >/dev/null 2>&1 || check_deb build/release amd64
+  # The test configuration with an admin key made now (never committed): boot 2 logs in with it and
+  # updates the package in place.
+  local cfg="$out/config" deb
+  rm -rf "$cfg" && mkdir -p "$cfg" && cp tests/image/robot.yaml tests/image/ui-token "$cfg/"
+  ssh-keygen -q -t ed25519 -N '' -C orthoflow-image-test -f "$cfg/admin_key"
+  printf 'admin:\n  ssh_authorized_keys: admin_key.pub\n' >> "$cfg/robot.yaml"
   for arch in ${IMAGE_ARCHES:-amd64 arm64}; do
     echo "=== image $arch: build"
-    if ! bash scripts/build_image.sh --arch "$arch" --out "$out" --config tests/image/robot.yaml \
+    if ! bash scripts/build_image.sh --arch "$arch" --out "$out" --config "$cfg/robot.yaml" \
         >"$logdir/image_build_$arch.log" 2>&1; then
       tail -n 40 "$logdir/image_build_$arch.log"
       echo "image $arch: build FAILED"
@@ -176,7 +182,8 @@ run_image() {
     fi
     tail -n 7 "$logdir/image_build_$arch.log"
     echo "=== image $arch: boot"
-    if bash scripts/test_image.sh --arch "$arch" --dir "$out" --token tests/image/ui-token \
+    deb=$(ls build/release/deb/orthoflow_*_"$arch".deb build/aarch64/deb/orthoflow_*_"$arch".deb 2>/dev/null | head -n 1)
+    if bash scripts/test_image.sh --arch "$arch" --dir "$out" --token "$cfg/ui-token" --ssh-key "$cfg/admin_key" --deb "$deb" \
         >"$logdir/image_boot_$arch.log" 2>&1; then
       cat "$out/boot-$arch.txt"
       passed=$((passed + 1))

@@ -15,10 +15,12 @@
 # usage: scripts/test_image.sh --arch amd64|arm64 --dir DIR --token FILE [--timeout S] [--keep]
 #   DIR     build_image.sh's output; FILE the web view's token the image was built with
 #   S       seconds each boot may take to reach its goal (default 900)
+#   --ssh-key KEY --deb DEB: the image was built with KEY.pub in admin.ssh_authorized_keys; boot 2 then
+#           also logs in and updates the orthoflow package in place with DEB (docs/DEPLOY.md section 7)
 # Writes DIR/boot-ARCH.txt (timings, memory and CPU of the service) and DIR/console-ARCH-N.log.
 set -euo pipefail
 
-arch="" dir="" token_file="" timeout=900 keep=0
+arch="" dir="" token_file="" timeout=900 keep=0 ssh_key="" deb=""
 die() { echo "test_image: $*" >&2; exit 2; }
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -27,6 +29,8 @@ while [ $# -gt 0 ]; do
     --token) token_file="${2:-}"; shift 2 ;;
     --timeout) timeout="${2:-}"; shift 2 ;;
     --keep) keep=1; shift ;;
+    --ssh-key) ssh_key="${2:-}"; shift 2 ;;
+    --deb) deb="${2:-}"; shift 2 ;;
     *) die "unknown argument '$1'" ;;
   esac
 done
@@ -58,7 +62,9 @@ trap cleanup EXIT
 set -E
 trap 'fail "scripts/test_image.sh line $LINENO: a command failed"' ERR
 cp --sparse=always "$dir/orthoflow-$arch.img" "$scratch/disk.img"
-port=$(python3 -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
+free_port() { python3 -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])'; }
+port=$(free_port)
+ssh_port=$(free_port)
 report="$dir/boot-$arch.txt"
 : > "$report"
 note() { echo "$*" | tee -a "$report"; }
@@ -87,7 +93,7 @@ start_qemu() {
   # shellcheck disable=SC2086
   $qemu $machine $accel -m 1536 -smp 2 -no-reboot -display none -monitor none -serial "file:$console" \
     -drive "file=$scratch/disk.img,format=raw,if=virtio" \
-    -nic "user,model=virtio-net-pci,hostfwd=tcp:127.0.0.1:$port-:8080" "$@" \
+    -nic "user,model=virtio-net-pci,hostfwd=tcp:127.0.0.1:$port-:8080,hostfwd=tcp:127.0.0.1:$ssh_port-:22" "$@" \
     >"$scratch/qemu-$n.log" 2>&1 &
   qpid=$!
   boot_start=$(date +%s)
@@ -152,6 +158,29 @@ printf '%s' "$memory" | grep -q '"label":"image_test_mug"' ||
 sleep 12  # one more health line with the service warm
 note "boot 2: first frame served $second_frame s after power-on; memory intact: $memory"
 note "boot 2: $(last_health)"
+if [ -n "$ssh_key" ]; then
+  # The administrator's way in (keys only) and the package update in place of DEPLOY.md section 7.
+  common_opts=(-i "$ssh_key" -o BatchMode=yes -o StrictHostKeyChecking=no -o UserKnownHostsFile=/dev/null
+               -o ConnectTimeout=10 -o LogLevel=ERROR)
+  ssh_opts=(-p "$ssh_port" "${common_opts[@]}")
+  on_robot() { ssh "${ssh_opts[@]}" root@127.0.0.1 "$@"; }
+  ssh_answers() { on_robot true 2>/dev/null; }
+  wait_for "boot 2: SSH with the admin key" ssh_answers
+  if ssh -p "$ssh_port" -o BatchMode=yes -o StrictHostKeyChecking=no -o UserKnownHostsFile=/dev/null \
+       -o PubkeyAuthentication=no -o ConnectTimeout=10 root@127.0.0.1 true 2>/dev/null; then
+    fail "boot 2: SSH let root in without a key"
+  fi
+  [ "$(on_robot systemctl is-active orthoflow)" = active ] || fail "boot 2: orthoflow not active over SSH"
+  scp -q -P "$ssh_port" "${common_opts[@]}" "$deb" root@127.0.0.1:/tmp/orthoflow-update.deb
+  update_start=$(date +%s)
+  on_robot 'systemctl stop orthoflow && mount -o remount,rw / && dpkg -i /tmp/orthoflow-update.deb >/dev/null &&
+            mount -o remount,ro / && systemctl start orthoflow' || fail "boot 2: the update in place failed"
+  [ "$(on_robot findmnt -no OPTIONS / | cut -d, -f1)" = ro ] || fail "boot 2: the root is not read-only after the update"
+  boot_start=$update_start
+  wait_for "boot 2: frames after the package update" serving_frames
+  state | grep -q '"label":"image_test_mug"' || fail "boot 2: the memory lost the category across the update"
+  note "boot 2: package updated in place over SSH (keys only; password refused) in $(elapsed) s to the next frame; root read-only again; memory intact"
+fi
 power_cut
 
 # --- boot 3: a service that cannot start (no Kinect) is restarted, with its reason; no reboot loop

@@ -69,7 +69,10 @@ TEST(ImageFiles, WithoutTheUiNoTokenNorPort) {
 TEST(ImageFiles, ReadOnlyRootAndTheMemoryOnItsOwnPartition) {
   const std::string fstab = file(root_files(RobotConfig{}, Arch::amd64), "etc/fstab").text;
   EXPECT_TRUE(has(fstab, "LABEL=orthoflow-root  /  ext4  ro,"));
-  EXPECT_TRUE(has(fstab, "LABEL=orthoflow-data  /var/lib/orthoflow  ext4  rw,"));
+  EXPECT_TRUE(has(fstab, "LABEL=orthoflow-data  /data  ext4  rw,"));
+  EXPECT_TRUE(has(fstab,
+                  "/data/orthoflow  /var/lib/orthoflow  none  "
+                  "bind,x-systemd.requires-mounts-for=/data  0 0\n"));
   EXPECT_TRUE(has(fstab, "tmpfs  /tmp  tmpfs"));
 }
 
@@ -102,6 +105,23 @@ TEST(ImageFiles, TheBootLoaderFindsTheRootByLabelOnTheConsole) {
   EXPECT_TRUE(has(grub_config(c, Arch::arm64), "console=ttyAMA0,115200"));
   EXPECT_EQ(kernel_command_line(c, Arch::arm64),
             "root=LABEL=orthoflow-root ro rootwait console=tty0 console=ttyAMA0,115200 quiet");
+}
+
+TEST(ImageFiles, SshOnlyWithKeysAndThenKeysOnlyWithTheRobotsOwnHostKey) {
+  RobotConfig c;
+  for (const auto& f : root_files(c, Arch::amd64))
+    EXPECT_EQ(f.path.find("ssh"), std::string::npos) << f.path;
+  EXPECT_FALSE(has(image_layout(c), "openssh-server"));
+  c.admin.ssh_authorized_keys = "admin.pub";
+  const auto files = root_files(c, Arch::amd64);
+  const std::string sshd = file(files, "etc/ssh/sshd_config.d/orthoflow-image.conf").text;
+  EXPECT_TRUE(has(sshd, "PasswordAuthentication no\n"));
+  EXPECT_TRUE(has(sshd, "PermitRootLogin prohibit-password\n"));
+  EXPECT_TRUE(has(sshd, "HostKey /data/ssh/ssh_host_ed25519_key\n"));
+  EXPECT_TRUE(has(file(files, "etc/systemd/system/ssh.service.d/orthoflow-image.conf").text,
+                  "After=orthoflow-firstboot.service\n"));
+  EXPECT_TRUE(has(file(files, "etc/orthoflow/image.env").text, "ORTHOFLOW_SSH=1\n"));
+  EXPECT_TRUE(has(image_layout(c), "packages openssh-server\n"));
 }
 
 TEST(ImageFiles, TheLayoutHoldsTheSizes) {

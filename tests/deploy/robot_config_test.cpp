@@ -160,6 +160,34 @@ TEST(RobotConfig, StaticNetworkNeedsAnAddressAndDhcpTakesNone) {
   EXPECT_TRUE(parse("network: {dhcp: false, address: 10.0.0.5/24}"));
 }
 
+TEST(RobotConfig, AdminKeys) {
+  auto c = parse("admin: {ssh_authorized_keys: keys/admin.pub}");
+  ASSERT_TRUE(c) << c.error();
+  EXPECT_EQ(c->admin.ssh_authorized_keys, "keys/admin.pub");
+  EXPECT_NE(error_of("admin: {password: x}").find("admin.password: unknown key"),
+            std::string::npos);
+  EXPECT_NE(error_of("admin: {ssh_authorized_keys: \"a;b\"}").find("admin.ssh_authorized_keys"),
+            std::string::npos);
+  EXPECT_TRUE(RobotConfig{}.admin.ssh_authorized_keys.empty());  // no remote shell unless asked
+}
+
+TEST(RobotConfig, AuthorizedKeysAreKeysOnly) {
+  EXPECT_TRUE(check_authorized_keys("ssh-ed25519 AAAAC3NzaC1lZDI1NTE5AAAAIG me@host\n"));
+  EXPECT_TRUE(
+      check_authorized_keys("# admins\n\nssh-rsa AAAAB3Nza x\r\necdsa-sha2-nistp256 AAAAE2 y\n"));
+  EXPECT_TRUE(check_authorized_keys("sk-ssh-ed25519@openssh.com AAAAGnNr z"));
+  EXPECT_FALSE(check_authorized_keys(""));
+  EXPECT_FALSE(check_authorized_keys("# only a comment\n"));
+  EXPECT_NE(
+      check_authorized_keys("command=\"/bin/sh\" ssh-ed25519 AAAA x\n").error().find("line 1"),
+      std::string::npos);
+  EXPECT_NE(check_authorized_keys("ssh-ed25519 AAAA\nssh-dss AAAA\n").error().find("line 2"),
+            std::string::npos);
+  EXPECT_FALSE(check_authorized_keys("ssh-ed25519\n"));
+  EXPECT_FALSE(check_authorized_keys("ssh-ed25519 AAAA \x01\n"));
+  EXPECT_FALSE(check_authorized_keys(std::string(70000, '#')));
+}
+
 TEST(RobotConfig, Architectures) {
   EXPECT_EQ(*parse_arch("amd64"), Arch::amd64);
   EXPECT_EQ(*parse_arch("arm64"), Arch::arm64);

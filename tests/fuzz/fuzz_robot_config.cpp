@@ -35,7 +35,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       if (f.path == "etc/systemd/system/orthoflow.service")
         check(count(f.text, "\nExecStart=") == 1);
       if (f.path == "etc/hostname") check(count(f.text, "\n") == 1);
-      if (f.path == "etc/orthoflow/image.env") check(count(f.text, "\n") == 4);
+      if (f.path == "etc/orthoflow/image.env") check(count(f.text, "\n") == 6);
     }
     const std::string line = d::kernel_command_line(config.value(), arch);
     check(line.find('\n') == std::string::npos && line.find('\'') == std::string::npos &&
