@@ -85,7 +85,7 @@ void render(const ImageArgs& a) {
   const deploy::RobotConfig config = load_or_throw(a.config);
   const fs::path out(a.out);
   const fs::path root = out / "rootfs";
-  for (const auto& f : deploy::root_files(config, *arch)) write_file(root / f.path, f.text, f.mode);
+  for (const auto& f : deploy::root_files(config)) write_file(root / f.path, f.text, f.mode);
   const fs::path here = fs::path(a.config).parent_path();
   copy_file(a.config, root / "etc/orthoflow/robot.yaml", 0644);
   if (config.ui.enabled && !config.ui.token_file.empty())

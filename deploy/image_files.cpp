@@ -140,8 +140,7 @@ std::vector<std::string> service_arguments(const RobotConfig& c) {
   return a;
 }
 
-std::vector<ImageFile> root_files(const RobotConfig& c, Arch arch) {
-  (void)arch;
+std::vector<ImageFile> root_files(const RobotConfig& c) {
   std::vector<ImageFile> files = {
       {"etc/hostname", c.hostname + "\n", 0644},
       {"etc/hosts",
@@ -194,7 +193,8 @@ std::string image_layout(const RobotConfig& c) {
   return "esp_mib " + std::to_string(c.image.esp_mib) + "\nroot_mib " +
          std::to_string(c.image.root_mib) + "\ndata_mib " + std::to_string(c.image.data_mib) +
          "\nui_port " + std::to_string(ui_port(c)) + "\ninitramfs " + c.image.initramfs +
-         "\npackages " + join(packages, " ") + "\n";
+         "\npackages " + join(packages, " ") + "\nroot_label " + ROOT_LABEL + "\ndata_label " +
+         DATA_LABEL + "\nesp_label " + ESP_LABEL + "\n";
 }
 
 }  // namespace orthoflow::deploy

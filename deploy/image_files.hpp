@@ -32,7 +32,7 @@ struct ImageFile {
 /// @brief The configuration's files, relative to the root file system. The configured token file
 /// and graph file (when the configuration names them) are copied by the caller to
 /// etc/orthoflow/ui-token and etc/orthoflow/graph.yaml, where the unit expects them.
-[[nodiscard]] std::vector<ImageFile> root_files(const RobotConfig& config, Arch arch);
+[[nodiscard]] std::vector<ImageFile> root_files(const RobotConfig& config);
 
 /// @brief The `orthoflow run` arguments of the service after the source (the robot-run launcher
 /// picks the source), one per element.
@@ -48,7 +48,8 @@ struct ImageFile {
 
 /// @brief The layout scripts/build_image.sh reads: one "key value..." line each (esp_mib,
 /// root_mib, data_mib, ui_port, initramfs, packages: the configured ones, and openssh-server when
-/// admin keys are given), values checked by check_robot_config.
+/// admin keys are given; root_label, data_label, esp_label: the labels fstab and the boot loader
+/// find the partitions by), values checked by check_robot_config.
 [[nodiscard]] std::string image_layout(const RobotConfig& config);
 
 /// @brief Path of the UI's token on the robot: /etc/orthoflow/ui-token when the configuration

@@ -23,7 +23,7 @@ bool made_of(std::string_view text, std::size_t min, std::size_t max, std::strin
 }
 
 bool digits(std::string_view text, std::size_t max) {
-  return made_of(text, 1, max, "") &&
+  return !text.empty() && text.size() <= max &&
          text.find_first_not_of("0123456789") == std::string_view::npos;
 }
 

@@ -98,6 +98,8 @@ fi
 layout() { sed -n "s/^$1 //p" "$work/render/layout"; }
 esp_mib=$(layout esp_mib) root_mib=$(layout root_mib) data_mib=$(layout data_mib)
 extra=$(layout packages) initramfs=$(layout initramfs)
+# The labels fstab and the boot loader find the partitions by: named once, in deploy/image_files.hpp.
+root_label=$(layout root_label) data_label=$(layout data_label) esp_label=$(layout esp_label)
 initramfs_hooks=()
 if [ "$initramfs" = list ]; then
   # Before the kernel is installed, so that its initramfs is made once, with the list.
@@ -165,16 +167,16 @@ tar -C "$work/rootfs" --numeric-owner --xattrs -cf - . | zstd -q -T0 -9 -o "$out
 grub-mkstandalone -O "$grub_target" -o "$work/$efi_name" \
   --modules="part_gpt part_msdos ext2 fat search search_label linux normal echo test" \
   --locales= --themes= --fonts= "boot/grub/grub.cfg=$work/render/grub.cfg"
-mkfs.vfat -n ORTHO-EFI -C "$work/esp.img" $((esp_mib * 1024)) >/dev/null
+mkfs.vfat -n "$esp_label" -C "$work/esp.img" $((esp_mib * 1024)) >/dev/null
 mmd -i "$work/esp.img" ::/EFI ::/EFI/BOOT
 mcopy -i "$work/esp.img" "$work/$efi_name" "::/EFI/BOOT/$efi_name"
-mkfs.ext4 -q -L orthoflow-root -d "$work/rootfs" "$work/root.img" "${root_mib}M" ||
+mkfs.ext4 -q -L "$root_label" -d "$work/rootfs" "$work/root.img" "${root_mib}M" ||
   die "the root file system does not fit in image.root_mib $root_mib MiB"
 # The data partition: orthoflow/ for the service (bound onto /var/lib/orthoflow), ssh/ for root.
 uid=$(awk -F: '$1 == "orthoflow" {print $3 ":" $4}' "$rootfs/etc/passwd")
 mkdir -p "$work/data/orthoflow" "$work/data/ssh"
 chown "$uid" "$work/data/orthoflow" && chmod 0750 "$work/data/orthoflow" && chmod 0700 "$work/data/ssh"
-mkfs.ext4 -q -L orthoflow-data -m 0 -d "$work/data" "$work/data.img" "${data_mib}M"
+mkfs.ext4 -q -L "$data_label" -m 0 -d "$work/data" "$work/data.img" "${data_mib}M"
 
 # 5. The disk: GPT with the three partitions, 1 MiB aligned.
 img="$out/orthoflow-$arch.img"
@@ -183,8 +185,8 @@ truncate -s $(( (2 + esp_mib + root_mib + data_mib) * 1024 * 1024 )) "$img"
 sfdisk --quiet "$img" <<EOF
 label: gpt
 start=2048, size=$((esp_mib * 2048)), type=C12A7328-F81F-11D2-BA4B-00A0C93EC93B, name="EFI"
-size=$((root_mib * 2048)), type=$root_type, name="orthoflow-root"
-size=$((data_mib * 2048)), type=0FC63DAF-8483-4772-8E79-3D69D8477DE4, name="orthoflow-data"
+size=$((root_mib * 2048)), type=$root_type, name="$root_label"
+size=$((data_mib * 2048)), type=0FC63DAF-8483-4772-8E79-3D69D8477DE4, name="$data_label"
 EOF
 offset=1
 for part in esp:$esp_mib root:$root_mib data:$data_mib; do

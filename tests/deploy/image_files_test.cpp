@@ -28,7 +28,7 @@ TEST(ImageFiles, TheUnitRunsTheConfiguredSourceWithTheMemoryOnTheDataPartition) 
   c.source = "kinect-sim:3";
   c.learner = "bayes";
   c.rate_hz = 15;
-  const auto files = root_files(c, Arch::amd64);
+  const auto files = root_files(c);
   const std::string unit = file(files, "etc/systemd/system/orthoflow.service").text;
   EXPECT_TRUE(has(
       unit,
@@ -47,12 +47,11 @@ TEST(ImageFiles, AGivenTokenAndGraphAreUsedFromEtc) {
   RobotConfig c;
   c.ui.token_file = "token.txt";
   c.graph = "graphs/mine.yaml";
-  const std::string unit =
-      file(root_files(c, Arch::arm64), "etc/systemd/system/orthoflow.service").text;
+  const std::string unit = file(root_files(c), "etc/systemd/system/orthoflow.service").text;
   EXPECT_TRUE(has(unit, "--graph /etc/orthoflow/graph.yaml"));
   EXPECT_TRUE(has(unit, "--ui-token-file /etc/orthoflow/ui-token"));
   EXPECT_EQ(token_path_on_robot(c), "/etc/orthoflow/ui-token");
-  const std::string env = file(root_files(c, Arch::arm64), "etc/orthoflow/image.env").text;
+  const std::string env = file(root_files(c), "etc/orthoflow/image.env").text;
   EXPECT_TRUE(has(env, "ORTHOFLOW_UI_TOKEN=/etc/orthoflow/ui-token\n"));
   EXPECT_TRUE(has(env, "ORTHOFLOW_UI_PORT=8080\n"));
 }
@@ -60,14 +59,14 @@ TEST(ImageFiles, AGivenTokenAndGraphAreUsedFromEtc) {
 TEST(ImageFiles, WithoutTheUiNoTokenNorPort) {
   RobotConfig c;
   c.ui.enabled = false;
-  const auto files = root_files(c, Arch::amd64);
+  const auto files = root_files(c);
   EXPECT_FALSE(has(file(files, "etc/systemd/system/orthoflow.service").text, "--ui"));
   EXPECT_TRUE(has(file(files, "etc/orthoflow/image.env").text,
                   "ORTHOFLOW_UI_PORT=0\nORTHOFLOW_UI_TOKEN=\n"));
 }
 
 TEST(ImageFiles, ReadOnlyRootAndTheMemoryOnItsOwnPartition) {
-  const std::string fstab = file(root_files(RobotConfig{}, Arch::amd64), "etc/fstab").text;
+  const std::string fstab = file(root_files(RobotConfig{}), "etc/fstab").text;
   EXPECT_TRUE(has(fstab, "LABEL=orthoflow-root  /  ext4  ro,"));
   EXPECT_TRUE(has(fstab, "LABEL=orthoflow-data  /data  ext4  rw,"));
   EXPECT_TRUE(has(fstab,
@@ -79,7 +78,7 @@ TEST(ImageFiles, ReadOnlyRootAndTheMemoryOnItsOwnPartition) {
 TEST(ImageFiles, HostNameAndNetwork) {
   RobotConfig c;
   c.hostname = "kitchen-1";
-  auto files = root_files(c, Arch::amd64);
+  auto files = root_files(c);
   EXPECT_EQ(file(files, "etc/hostname").text, "kitchen-1\n");
   EXPECT_TRUE(has(file(files, "etc/hosts").text, "127.0.1.1 kitchen-1\n"));
   EXPECT_TRUE(has(file(files, "etc/systemd/network/80-orthoflow.network").text,
@@ -88,7 +87,7 @@ TEST(ImageFiles, HostNameAndNetwork) {
   c.network.address = "10.0.0.5/24";
   c.network.gateway = "10.0.0.1";
   c.network.dns = {"10.0.0.1"};
-  files = root_files(c, Arch::amd64);
+  files = root_files(c);
   EXPECT_TRUE(has(file(files, "etc/systemd/network/80-orthoflow.network").text,
                   "Address=10.0.0.5/24\nGateway=10.0.0.1\nDNS=10.0.0.1\n"));
 }
@@ -109,11 +108,10 @@ TEST(ImageFiles, TheBootLoaderFindsTheRootByLabelOnTheConsole) {
 
 TEST(ImageFiles, SshOnlyWithKeysAndThenKeysOnlyWithTheRobotsOwnHostKey) {
   RobotConfig c;
-  for (const auto& f : root_files(c, Arch::amd64))
-    EXPECT_EQ(f.path.find("ssh"), std::string::npos) << f.path;
+  for (const auto& f : root_files(c)) EXPECT_EQ(f.path.find("ssh"), std::string::npos) << f.path;
   EXPECT_FALSE(has(image_layout(c), "openssh-server"));
   c.admin.ssh_authorized_keys = "admin.pub";
-  const auto files = root_files(c, Arch::amd64);
+  const auto files = root_files(c);
   const std::string sshd = file(files, "etc/ssh/sshd_config.d/orthoflow-image.conf").text;
   EXPECT_TRUE(has(sshd, "PasswordAuthentication no\n"));
   EXPECT_TRUE(has(sshd, "PermitRootLogin prohibit-password\n"));
@@ -129,7 +127,8 @@ TEST(ImageFiles, TheLayoutHoldsTheSizes) {
   c.image.packages = {"openssh-server", "htop"};
   EXPECT_EQ(image_layout(c),
             "esp_mib 64\nroot_mib 1536\ndata_mib 256\nui_port 8080\ninitramfs list\npackages "
-            "openssh-server htop\n");
+            "openssh-server htop\nroot_label orthoflow-root\ndata_label orthoflow-data\nesp_label "
+            "ORTHO-EFI\n");
 }
 
 }  // namespace

@@ -30,13 +30,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const auto config = d::parse_robot_config(text, "fuzz.yaml");
   if (!config) return 0;
   check(d::check_robot_config(config.value()).has_value());
+  for (const auto& f : d::root_files(config.value())) {
+    if (f.path == "etc/systemd/system/orthoflow.service") check(count(f.text, "\nExecStart=") == 1);
+    if (f.path == "etc/hostname") check(count(f.text, "\n") == 1);
+    if (f.path == "etc/orthoflow/image.env") check(count(f.text, "\n") == 6);
+  }
   for (const d::Arch arch : {d::Arch::amd64, d::Arch::arm64}) {
-    for (const auto& f : d::root_files(config.value(), arch)) {
-      if (f.path == "etc/systemd/system/orthoflow.service")
-        check(count(f.text, "\nExecStart=") == 1);
-      if (f.path == "etc/hostname") check(count(f.text, "\n") == 1);
-      if (f.path == "etc/orthoflow/image.env") check(count(f.text, "\n") == 6);
-    }
     const std::string line = d::kernel_command_line(config.value(), arch);
     check(line.find('\n') == std::string::npos && line.find('\'') == std::string::npos &&
           line.find('"') == std::string::npos && line.find(';') == std::string::npos);
