@@ -53,7 +53,8 @@ Result<void, std::string> parse_objects_params(const engine::ParamMap& params,
                              "max_points",   "pixel_radius",   "min_size",     "max_size",
                              "edge_margin",  "merge_overlap",  "cluster_mode", "crease_angle",
                              "crease_gap",   "normal_offset",  "max_rise",     "depth_change",
-                             "stand_height", "occlusion_rows", "occluder_gap", "occlusion_top"});
+                             "stand_height", "occlusion_rows", "occluder_gap", "occlusion_top",
+                             "neck_cell",    "neck_core",      "neck_ratio",   "neck_round"});
       !ok) {
     return err(ok.error());
   }
@@ -87,6 +88,10 @@ Result<void, std::string> parse_objects_params(const engine::ParamMap& params,
   take(params.integer("occlusion_rows", k.occlusion_rows, 0, 10000), k.occlusion_rows, e);
   take(params.number("occluder_gap", k.occluder_gap, 0.0, 1.0), k.occluder_gap, e);
   take(params.number("occlusion_top", k.occlusion_top, 0.0, 1.0), k.occlusion_top, e);
+  take(params.number("neck_cell", k.neck_cell, 0.0, 0.05), k.neck_cell, e);
+  take(params.number("neck_core", k.neck_core, 0.001, 0.3), k.neck_core, e);
+  take(params.number("neck_ratio", k.neck_ratio, 0.0, 0.95), k.neck_ratio, e);
+  take(params.number("neck_round", k.neck_round, 1.0, 100.0), k.neck_round, e);
   take(params.number("min_size", c.min_size, 0.0, 10.0), c.min_size, e);
   take(params.number("max_size", c.max_size, 0.0, 10.0), c.max_size, e);
   take(params.number("edge_margin", c.edge_margin, -1.0, 1.0), c.edge_margin, e);

@@ -87,9 +87,14 @@ std::size_t ObjectStage::join_occluded(CloudView cloud, std::span<const std::uin
       detail::unite(root, a, b);
     }
   }
-  return detail::relabel(root, new_id_, labels, [&](auto&& f) {
+  const std::size_t after = detail::relabel(root, new_id_, labels, [&](auto&& f) {
     for (const std::uint32_t i : members) f(std::size_t{i});
   });
+  std::fill_n(joined_.begin(), after, std::uint8_t{0});
+  for (std::size_t c = 0; c < clusters; ++c)
+    if (detail::find_root(root, c) != static_cast<std::int32_t>(c))
+      joined_[static_cast<std::size_t>(new_id_[c])] = 1;
+  return after;
 }
 
 }  // namespace orthoflow::kernels

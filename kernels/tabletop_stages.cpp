@@ -277,7 +277,9 @@ ObjectStage::ObjectStage(std::size_t max_points, std::uint32_t min_cluster_size)
       members_(max_points),
       pending_(max_points),
       votes_(MAX_OCCLUSION_PIECES * MAX_OCCLUSION_PIECES),
-      pieces_(MAX_OCCLUSION_PIECES) {}
+      pieces_(MAX_OCCLUSION_PIECES),
+      joined_(root_.size()),
+      neck_(max_points) {}
 
 Result<ObjectClusters, SegmentationError> ObjectStage::run(CloudView cloud,
                                                            const PlaneInput& plane_input,
@@ -317,8 +319,11 @@ Result<ObjectClusters, SegmentationError> ObjectStage::run(CloudView cloud,
     clusters = merge_footprints(target, members, basis, clusters, p.merge_overlap,
                                 crowded ? p.crease.max_rise : -1.0F, p.crease.stand_height,
                                 p.cluster.tolerance);
+  std::fill_n(joined_.begin(), std::min(clusters, joined_.size()), std::uint8_t{0});
   if (crowded && p.crease.occlusion_rows > 0)
     clusters = join_occluded({target, cloud.width, cloud.height}, members, clusters, p.crease);
+  if (crowded)
+    clusters = split_necks(target, members, basis, clusters, p.cluster.min_size, p.crease);
   const auto stats = std::span(stats_).first(clusters);
   if (organized) {
     cluster_stats_listed(target, labels, members, moments_, stats);

@@ -25,6 +25,7 @@
 #include "kernels/cluster_stats.hpp"
 #include "kernels/convex_hull.hpp"
 #include "kernels/crop.hpp"
+#include "kernels/detail/neck_scratch.hpp"
 #include "kernels/euclidean_cluster.hpp"
 #include "kernels/organized_normals.hpp"
 #include "kernels/ransac_plane.hpp"
@@ -67,6 +68,16 @@ struct CreaseParams {
   std::uint32_t occlusion_rows = 8;
   float occluder_gap = 0.02F;
   float occlusion_top = 0.015F;
+  /// Crowded mode, neck split (kernels/neck_split.cpp), last: a piece whose footprint on the table
+  /// is two or more round cores joined by a neck (two cans of one height touching, whose tops
+  /// meet where no crease parts them) is cut at the neck. The footprint is drawn on a grid of
+  /// neck_cell (0: off); a core is at least neck_core in radius, a neck at most neck_ratio of the
+  /// smaller core's radius wide (half-width over radius), and only round parts are cut: each
+  /// part's footprint at most neck_round times the disc of its core's radius. Metres.
+  float neck_cell = 0.005F;
+  float neck_core = 0.015F;
+  float neck_ratio = 0.5F;
+  float neck_round = 1.5F;
 };
 
 /// @brief Chain settings; defaults are the PCL baseline's (specs/BASELINES.md).
@@ -262,6 +273,12 @@ class ObjectStage {
   /// @return the cluster count after. kernels/occlusion_join.cpp.
   std::size_t join_occluded(CloudView cloud, std::span<const std::uint32_t> members,
                             std::size_t clusters, const CreaseParams& p) noexcept;
+  /// Crowded mode: cuts pieces whose footprint is cores joined by necks (CreaseParams::neck_*);
+  /// pieces the occlusion join made are left whole. @return the cluster count after.
+  /// kernels/neck_split.cpp.
+  std::size_t split_necks(PointsView target, std::span<const std::uint32_t> members,
+                          const PlaneBasis& basis, std::size_t clusters, std::uint32_t min_size,
+                          const CreaseParams& p) noexcept;
   /// Crowded mode, organized: clusters of the prism pixels off the creases, then the crease pixels
   /// re-attached; members_ lists every prism pixel. kernels/crease_split.cpp.
   [[nodiscard]] Result<std::size_t, ClusterError> cluster_crowded(
@@ -282,6 +299,8 @@ class ObjectStage {
   std::vector<std::uint32_t> pending_;        // crowded mode: crease pixels not yet attached
   std::vector<std::uint16_t> votes_;          // occlusion join: rows per piece pair
   std::vector<std::array<float, 4>> pieces_;  // occlusion join: top, bottom, first row, last row
+  std::vector<std::uint8_t> joined_;          // occlusion join: the cluster joined pieces
+  detail::NeckScratch neck_;                  // neck split
 };
 
 }  // namespace orthoflow::kernels
