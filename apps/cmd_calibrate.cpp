@@ -20,6 +20,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "apps/calibrate_target.hpp"
 #include "apps/commands.hpp"
 #include "manipulation/hand_eye.hpp"
 #include "manipulation/robot_frames.hpp"
@@ -238,6 +239,8 @@ void add_calibrate_command(CLI::App& app) {
   sim->add_option("--noise-deg", s->noise_deg,
                   "observation rotation noise per axis, standard deviation (default 0.2)");
   sim->callback([s] { run_simulate(*s); });
+
+  add_calibrate_target_commands(cmd);
 }
 
 }  // namespace orthoflow::apps

@@ -48,7 +48,7 @@ void add_ipc_command(CLI::App& app);
 /// 31 unreachable).
 void add_remote_commands(CLI::App& app);
 
-/// @brief `calibrate hand-eye|simulate-samples`: the camera's pose in the arm's base frame
+/// @brief `calibrate hand-eye|simulate-samples|find-target|simulate-frames`: the camera's pose in the arm's base frame
 /// (apps/cmd_calibrate.cpp).
 void add_calibrate_command(CLI::App& app);
 /// @brief `grasp --robot-frames F --objects RUN.jsonl`: grasp plans of a run's objects

@@ -121,6 +121,33 @@ std::string format_robot_frames(const RobotFrames& frames, std::string_view comm
   return out.str();
 }
 
+Result<std::optional<TargetFrameLine>, std::string> parse_target_frame_line(std::string_view line) {
+  const auto first = line.find_first_not_of(" \t\r\n");
+  if (first == std::string_view::npos || line[first] == '#') {
+    return std::optional<TargetFrameLine>{};
+  }
+  if (line.size() > MAX_LINE_BYTES) { return err(std::string("longer than 4096 bytes")); }
+  const nlohmann::json j = nlohmann::json::parse(line, nullptr, false);
+  if (j.is_discarded() || !j.is_object()) { return err(std::string("not a JSON object")); }
+  if (!j.contains("frame") || !j["frame"].is_string() || j["frame"].get<std::string>().empty() ||
+      j["frame"].get<std::string>().find('\0') != std::string::npos) {
+    return err(std::string("'frame' must name a PCD file"));
+  }
+  if (!j.contains("joints") || !j["joints"].is_array() || j["joints"].size() != 6) {
+    return err(std::string("'joints' must be 6 actuator angles in degrees"));
+  }
+  TargetFrameLine out;
+  out.frame = j["frame"].get<std::string>();
+  for (std::size_t k = 0; k < 6; ++k) {
+    const nlohmann::json& v = j["joints"][k];
+    if (!v.is_number() || !std::isfinite(v.get<double>())) {
+      return err("'joints': element " + std::to_string(k) + " is not a finite number");
+    }
+    out.joints[k] = v.get<double>();
+  }
+  return std::optional<TargetFrameLine>{std::move(out)};
+}
+
 Result<std::optional<CalibrationLine>, std::string> parse_calibration_line(
     std::string_view line, const drivers::jaco::ArmGeometry& geometry) {
   const auto first = line.find_first_not_of(" \t\r\n");

@@ -61,6 +61,17 @@ struct CalibrationLine {
 [[nodiscard]] Result<std::optional<CalibrationLine>, std::string> parse_calibration_line(
     std::string_view line, const drivers::jaco::ArmGeometry& geometry);
 
+/// @brief One line of a poses file of `orthoflow calibrate find-target`: a depth frame of the
+/// calibration ball and the arm's joints when it was taken.
+struct TargetFrameLine {
+  std::string frame;                    ///< the frame's PCD file, as written in the line
+  drivers::jaco::JointAngles joints{};  ///< actuator degrees
+};
+/// @brief Parses one poses line ({"frame": "FILE.pcd", "joints": [6 numbers]}); nullopt for a
+/// blank or comment line; the error says what is wrong. @pre none.
+[[nodiscard]] Result<std::optional<TargetFrameLine>, std::string> parse_target_frame_line(
+    std::string_view line);
+
 /// @brief One object of a line of `orthoflow run --json-out` (the fields the planner uses).
 struct PerceivedObject {
   std::uint64_t track = 0;

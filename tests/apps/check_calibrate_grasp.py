@@ -1,5 +1,6 @@
-"""`orthoflow calibrate hand-eye|simulate-samples` and `orthoflow grasp` (issue 21): the camera's pose
-recovered from a simulated rig's samples file within 2 mm and 0.5 degrees, refusals of bad sample
+"""`orthoflow calibrate hand-eye|simulate-samples|simulate-frames|find-target` and `orthoflow grasp`
+(issue 21): the camera's pose recovered from a simulated rig's samples file, and from the ball found
+in its rendered depth frames, within 2 mm and 0.5 degrees, refusals of bad sample
 files with the line, grasp plans of the embedded session's objects in the arm's base frame, and
 `orthoflow demo`'s refusals and pictures."""
 import json
@@ -71,6 +72,35 @@ with tempfile.TemporaryDirectory() as tmp:
     expect("do not determine the camera" in p.stderr, f"degenerate: {p.stderr}")
     p = run(cli, "calibrate", "hand-eye", "--samples", os.path.join(tmp, "none.jsonl"), code=EXIT_BAD_INPUT)
     expect("cannot open" in p.stderr, p.stderr)
+
+    # The ball in the gripper found in rendered depth frames (simulate-frames), then hand-eye.
+    frames_dir = os.path.join(tmp, "frames")
+    truth, samples, out = (os.path.join(tmp, f) for f in ("ball_truth.yaml", "ball.jsonl", "ball.yaml"))
+    run(cli, "calibrate", "simulate-frames", "--out", frames_dir, "--count", "12", "--seed", "3", "--truth", truth)
+    poses = os.path.join(frames_dir, "poses.jsonl")
+    r = json.loads(run(cli, "calibrate", "find-target", "--poses", poses, "--out", samples, "--json").stdout)
+    expect(r["poses"] == 12 and r["found"] >= 8, f"find-target: {r['found']} of {r['poses']}")
+    for row in r["frames"]:
+        expect("centre_m" in row or row["refused"].startswith("no ball"), f"row: {row}")
+    run(cli, "calibrate", "hand-eye", "--samples", samples, "--out", out)
+    (t_est, q_est), (t_true, q_true) = frames_of(out), frames_of(truth)
+    err_mm, err_deg = 1e3 * math.dist(t_est, t_true), angle_between(q_est, q_true)
+    expect(err_mm < 2.0 and err_deg < 0.5, f"ball in depth: {err_mm:.2f} mm, {err_deg:.3f} deg")
+    print(f"ball found in {r['found']} of 12 rendered frames: camera within {err_mm:.2f} mm and {err_deg:.3f} deg")
+    # A ball of a size nothing in view has is not found (the arm's links are 4-5.5 cm capsules:
+    # looking for 4.5 cm balls finds their rounded ends, or refuses two of them); a bad poses file names its line; a missing frame is a
+    # refused row, not a crash.
+    p = run(cli, "calibrate", "find-target", "--poses", poses, "--radius", "0.02", "--out", samples,
+            code=EXIT_FAILURE)
+    expect("not found in any frame" in p.stderr, p.stderr)
+    bad_poses = os.path.join(frames_dir, "bad.jsonl")
+    first = open(poses).read().splitlines()[1]
+    open(bad_poses, "w").write(first + "\n" + '{"frame": "pose_001.pcd", "joints": [1, 2]}\n')
+    p = run(cli, "calibrate", "find-target", "--poses", bad_poses, "--out", samples, code=EXIT_BAD_INPUT)
+    expect("bad.jsonl:2: 'joints' must be 6" in p.stderr, p.stderr)
+    open(bad_poses, "w").write(first + "\n" + first.replace("pose_000", "missing") + "\n")
+    r = json.loads(run(cli, "calibrate", "find-target", "--poses", bad_poses, "--out", samples, "--json").stdout)
+    expect(r["found"] <= 1 and r["frames"][1]["refused"].startswith("cannot read"), f"missing: {r['frames'][1]}")
 
     # Grasps of the embedded session's objects, in the arm's base frame.
     objects = os.path.join(tmp, "run.jsonl")

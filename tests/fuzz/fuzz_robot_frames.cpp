@@ -1,8 +1,8 @@
 // Fuzzes the manipulation folder's text parsers (manipulation/robot_frames.hpp): the first byte
-// picks the parser (robot frames YAML, a calibration samples line, a line of `orthoflow run
-// --json-out`), the rest is its input. No input may crash or hit UB; robot frames that parse are a
-// rigid transform that survives format and parse again; a samples line that parses holds finite,
-// rigid poses.
+// picks the parser (robot frames YAML, a calibration samples line, a poses line of `orthoflow
+// calibrate find-target`, a line of `orthoflow run --json-out`), the rest is its input. No input
+// may crash or hit UB; robot frames that parse are a rigid transform that survives format and parse
+// again; a samples line that parses holds finite, rigid poses.
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -30,7 +30,7 @@ void check(bool ok) {
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size == 0) return 0;
   const std::string_view text(reinterpret_cast<const char*>(data + 1), size - 1);
-  switch (data[0] % 3) {
+  switch (data[0] % 4) {
     case 0: {
       const auto frames = m::parse_robot_frames(text);
       if (frames.has_value()) {
@@ -53,6 +53,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
           const auto& q = std::get<m::PointSample>(line.value()->sample);
           check(rigid(q.base_from_gripper) && q.target_in_camera.allFinite());
         }
+      }
+      break;
+    }
+    case 2: {
+      const auto line = m::parse_target_frame_line(text);
+      if (line.has_value() && line.value()) {
+        check(!line.value()->frame.empty());
+        for (const double q : line.value()->joints) check(std::isfinite(q));
       }
       break;
     }
