@@ -327,7 +327,8 @@ void run(const RunOptions& o) {
   engine::Engine engine(**graph, {o.threads});
   std::unique_ptr<RunUi> ui;
   if (!o.ui.empty()) {
-    ui = start_run_ui(o.ui, o.ui_token_file, **learning, objects, engine.stats(), spec->period_ns);
+    ui = start_run_ui(o.ui, o.ui_token_file, **learning, objects, engine.stats(), spec->period_ns,
+                      spec->name);
   }
   // --ipc-learning: the graph's objects publisher registered this process with RouDi.
   std::unique_ptr<graphs::LearningIpcBridge> bridge;

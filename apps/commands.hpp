@@ -48,8 +48,8 @@ void add_ipc_command(CLI::App& app);
 /// 31 unreachable).
 void add_remote_commands(CLI::App& app);
 
-/// @brief `calibrate hand-eye|simulate-samples|find-target|simulate-frames`: the camera's pose in the arm's base frame
-/// (apps/cmd_calibrate.cpp).
+/// @brief `calibrate hand-eye|simulate-samples|find-target|simulate-frames`: the camera's pose in
+/// the arm's base frame (apps/cmd_calibrate.cpp).
 void add_calibrate_command(CLI::App& app);
 /// @brief `grasp --robot-frames F --objects RUN.jsonl`: grasp plans of a run's objects
 /// (apps/cmd_grasp.cpp).

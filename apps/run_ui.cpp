@@ -15,6 +15,7 @@
 #include "graphs/learning_ipc_bridge.hpp"
 #include "ui/graph_backend.hpp"
 #include "ui/ipc_backend.hpp"
+#include "ui/ipc_task_link.hpp"
 #include "ui/ui_server.hpp"
 
 namespace orthoflow::apps {
@@ -24,13 +25,26 @@ namespace {
 // Members in this order: the server (which calls the backend) goes first.
 class RunningUi final : public RunUi {
  public:
+  std::unique_ptr<ui::IpcTaskLink> tasks;
   std::unique_ptr<ui::GraphBackend> backend;
   std::unique_ptr<ui::UiServer> server;
   ~RunningUi() override {
     server.reset();
     backend.reset();
+    tasks.reset();
   }
 };
+
+// The page's task buttons: over iceoryx to `orthoflow task run`, when this process has the
+// runtime (null, with a line saying why, when the link cannot open).
+std::unique_ptr<ui::IpcTaskLink> open_task_link(const std::string& graph) {
+  auto link = ui::IpcTaskLink::open(graph);
+  if (!link) {
+    std::cout << "ui: no task control (" << link.error() << ")\n";
+    return nullptr;
+  }
+  return std::move(*link);
+}
 
 [[noreturn]] void fail(const std::string& message, int code, const char* who = "run: --ui") {
   std::cerr << who << ": " << message << "\n";
@@ -85,6 +99,8 @@ void run_standalone_ui(const UiOptions& o) {
   }
   auto backend = ui::IpcBackend::open(o.graph);
   if (!backend) fail(backend.error(), EXIT_FAILURE_GENERIC, WHO);
+  std::unique_ptr<ui::IpcTaskLink> tasks = open_task_link(o.graph);
+  (*backend)->set_task_link(tasks.get());
   g_ui_stop.store(false);
   auto previous_int = std::signal(SIGINT, on_ui_signal);
   auto previous_term = std::signal(SIGTERM, on_ui_signal);
@@ -113,6 +129,7 @@ void run_standalone_ui(const UiOptions& o) {
             << " statuses, " << c.acks.load() << " acknowledgements taken, " << c.rejected.load()
             << " payloads rejected\n";
   backend->reset();
+  tasks.reset();
   std::signal(SIGINT, previous_int);
   std::signal(SIGTERM, previous_term);
   if (lost) fail(roudi_lost_text("serving the web view"), EXIT_ROUDI_LOST, WHO);
@@ -128,12 +145,19 @@ std::string check_ui_listen(const std::string& value) {
 
 std::unique_ptr<RunUi> start_run_ui(const std::string& listen, const std::string& token_file,
                                     graphs::LearningService& learning, graphs::ObjectsHub& hub,
-                                    const engine::GraphStats& stats, std::int64_t period_ns) {
+                                    const engine::GraphStats& stats, std::int64_t period_ns,
+                                    const std::string& graph) {
   const double frame_hz = period_ns > 0 ? 1e9 / static_cast<double>(period_ns) : 30.0;
   auto running = std::make_unique<RunningUi>();
   auto backend_result = ui::GraphBackend::open(learning, hub);
   if (!backend_result) fail(backend_result.error(), EXIT_FAILURE_GENERIC);
   running->backend = std::move(*backend_result);
+  // Task commands go over iceoryx: only when the graph publishes (--ipc-learning,
+  // --publish-objects), as `orthoflow task run` needs its objects anyway.
+  if (engine::ipc_runtime_ready()) {
+    running->tasks = open_task_link(graph);
+    running->backend->set_task_link(running->tasks.get());
+  }
   running->backend->set_telemetry(&stats);
   running->server =
       start_server(listen, token_file, std::min(30.0, frame_hz), *running->backend, "run: --ui");

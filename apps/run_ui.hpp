@@ -26,9 +26,14 @@ class RunUi {
 
 /// @brief Starts the server on @p listen (token from @p token_file when not empty) and prints its
 /// URL, and the token when one is needed. The stream rate is capped at the graph's frame rate
-/// (@p period_ns; 0 = unpaced) and at 30 Hz. Throws CLI::RuntimeError when it cannot start.
-[[nodiscard]] std::unique_ptr<RunUi> start_run_ui(
-    const std::string& listen, const std::string& token_file, graphs::LearningService& learning,
-    graphs::ObjectsHub& hub, const engine::GraphStats& stats, std::int64_t period_ns);
+/// (@p period_ns; 0 = unpaced) and at 30 Hz. With an iceoryx runtime in the process (the graph
+/// publishes), the page's task buttons reach `orthoflow task run` for graph @p graph. Throws
+/// CLI::RuntimeError when it cannot start.
+[[nodiscard]] std::unique_ptr<RunUi> start_run_ui(const std::string& listen,
+                                                  const std::string& token_file,
+                                                  graphs::LearningService& learning,
+                                                  graphs::ObjectsHub& hub,
+                                                  const engine::GraphStats& stats,
+                                                  std::int64_t period_ns, const std::string& graph);
 
 }  // namespace orthoflow::apps

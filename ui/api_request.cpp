@@ -35,10 +35,16 @@ struct Route {
   bool post;
 };
 constexpr Route ROUTES[] = {
-    {"/api/state", Kind::STATE, false}, {"/api/events", Kind::EVENTS, false},
-    {"/api/teach", Kind::TEACH, true},  {"/api/correct", Kind::CORRECT, true},
-    {"/api/ask", Kind::ASK, true},      {"/api/forget", Kind::FORGET, true},
-    {"/api/undo", Kind::UNDO, true},    {"/api/camera.png", Kind::CAMERA, false},
+    {"/api/state", Kind::STATE, false},
+    {"/api/events", Kind::EVENTS, false},
+    {"/api/teach", Kind::TEACH, true},
+    {"/api/correct", Kind::CORRECT, true},
+    {"/api/ask", Kind::ASK, true},
+    {"/api/forget", Kind::FORGET, true},
+    {"/api/undo", Kind::UNDO, true},
+    {"/api/camera.png", Kind::CAMERA, false},
+    {"/api/task/start", Kind::TASK_START, true},
+    {"/api/task/stop", Kind::TASK_STOP, true},
 };
 
 // "application/json", optionally followed by parameters ("; charset=utf-8"). Requiring it also
@@ -84,12 +90,51 @@ std::optional<ApiError> only_fields(const Json& body,
   return std::nullopt;
 }
 
+// POST /api/task/start {"task": "clear_table"} or {"task": "serve_a_meal", "bring": [labels]};
+// POST /api/task/stop {}.
+Result<ApiRequest, ApiError> decode_task(Kind kind, const Json& body) {
+  ApiRequest decoded;
+  decoded.kind = kind;
+  if (kind == Kind::TASK_STOP) {
+    if (auto extra = only_fields(body, {})) return err(std::move(*extra));
+    decoded.task.kind = graphs::TaskCommand::Kind::STOP;
+    return decoded;
+  }
+  if (auto extra = only_fields(body, {"task", "bring"})) return err(std::move(*extra));
+  const auto task = body.find("task");
+  if (task == body.end()) return refuse(400, "missing field 'task'");
+  if (!task->is_string() || (*task != "clear_table" && *task != "serve_a_meal"))
+    return refuse(400, "'task' must be \"clear_table\" or \"serve_a_meal\"");
+  decoded.task.kind = graphs::TaskCommand::Kind::START;
+  const bool serve = *task == "serve_a_meal";
+  decoded.task.task =
+      serve ? manipulation::TableTaskKind::SERVE_A_MEAL : manipulation::TableTaskKind::CLEAR_TABLE;
+  const auto bring = body.find("bring");
+  if (!serve) {
+    if (bring != body.end()) return refuse(400, "'bring' is for serve_a_meal only");
+    return decoded;
+  }
+  if (bring == body.end() || !bring->is_array() || bring->empty() ||
+      bring->size() > graphs::TASK_MAX_BRING)
+    return refuse(
+        400, "'bring' must list 1 to " + std::to_string(graphs::TASK_MAX_BRING) + " categories");
+  for (const Json& label : *bring) {
+    if (!label.is_string()) return refuse(400, "'bring' must list category names");
+    const auto& text = label.get_ref<const std::string&>();
+    if (const auto problem = core::check_label(text); problem != core::LabelProblem::NONE)
+      return refuse(400, "'bring': " + std::string(core::to_string(problem)));
+    decoded.task.bring.push_back(text);
+  }
+  return decoded;
+}
+
 Result<ApiRequest, ApiError> decode_action(Kind kind, const RawRequest& request) {
   if (!is_json_type(find_header(request.headers, "Content-Type")))
     return refuse(415, "an action needs Content-Type: application/json");
   const Json body = Json::parse(request.body, nullptr, /*allow_exceptions=*/false);
   if (body.is_discarded()) return refuse(400, "the body is not valid JSON");
   if (!body.is_object()) return refuse(400, "the body must be a JSON object");
+  if (kind == Kind::TASK_START || kind == Kind::TASK_STOP) return decode_task(kind, body);
   ApiRequest decoded;
   decoded.kind = kind;
   const bool needs_track = kind != Kind::FORGET && kind != Kind::UNDO,
@@ -150,6 +195,10 @@ std::string_view to_string(ApiRequest::Kind kind) noexcept {
       return "undo";
     case Kind::CAMERA:
       return "camera";
+    case Kind::TASK_START:
+      return "task_start";
+    case Kind::TASK_STOP:
+      return "task_stop";
     case Kind::ASSET:
       return "asset";
   }

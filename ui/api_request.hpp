@@ -19,6 +19,7 @@
 
 #include "core/fixed_text.hpp"
 #include "core/result.hpp"
+#include "graphs/task_payloads.hpp"
 
 namespace orthoflow::ui {
 
@@ -59,7 +60,9 @@ struct ApiRequest {
     FORGET,
     UNDO,
     ASSET,
-    CAMERA
+    CAMERA,
+    TASK_START,  ///< POST /api/task/start: start a table task (ui/task_link.hpp)
+    TASK_STOP,   ///< POST /api/task/stop
   };
   Kind kind = Kind::STATE;
   std::uint32_t track = 0;        ///< TEACH, CORRECT, ASK: >= 1
@@ -67,6 +70,7 @@ struct ApiRequest {
   double hz = DEFAULT_STREAM_HZ;  ///< EVENTS: requested rate (> 0; the server clamps it)
   bool camera = false;     ///< EVENTS: ?camera=1, the client shows the camera image: keep it coming
   std::string_view asset;  ///< ASSET: the path to look up
+  graphs::TaskCommand task;  ///< TASK_START, TASK_STOP: the command (categories checked as labels)
 };
 
 /// @brief "state", "events", "teach", ...

@@ -4,12 +4,16 @@
 /// state to show, and a way to submit an action and get its acknowledgement. GraphBackend
 /// (ui/graph_backend.hpp) implements it over a running graph; tests may implement it over anything.
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "graphs/learning_channel.hpp"
+#include "graphs/task_payloads.hpp"
 
 namespace orthoflow::ui {
+
+class TaskLink;  // ui/task_link.hpp
 
 /// @brief One object of the latest frame.
 struct ObjectView {
@@ -74,6 +78,11 @@ struct UiSnapshot {
   std::int64_t frame_p99_ns = 0;
   bool durable = false;  ///< acknowledged actions are on disk (--db)
   CameraBoxes camera;    ///< the objects in the last camera image served
+  /// The table tasks (ui/task_link.hpp): whether the server can send task commands, and the task
+  /// process's newest state (none when no task process published one lately).
+  bool task_control = false;
+  std::optional<graphs::TaskStatus> task;
+  std::int64_t task_age_ms = 0;
 };
 
 /// @brief An action for the learning channel.
@@ -112,6 +121,13 @@ class UiBackend {
   /// for its clients that asked for the camera, so that the state says when an image is there
   /// before the page asks for one).
   virtual void want_camera() {}
+  /// @brief The link to the process that runs the table tasks (ui/task_link.hpp), or null: set
+  /// once, before serving; not owned.
+  void set_task_link(TaskLink* link) noexcept { task_link_ = link; }
+  [[nodiscard]] TaskLink* task_link() const noexcept { return task_link_; }
+
+ private:
+  TaskLink* task_link_ = nullptr;
 };
 
 }  // namespace orthoflow::ui

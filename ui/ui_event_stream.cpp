@@ -1,5 +1,7 @@
 #include "ui/ui_event_stream.hpp"
 
+#include "ui/task_link.hpp"
+
 #include <algorithm>
 #include <chrono>
 
@@ -76,7 +78,7 @@ void EventStream::run() {
     }
     guard.unlock();
     if (camera) backend_.want_camera();
-    const std::string document = state_json(backend_.snapshot());
+    const std::string document = state_json(snapshot_with_task(backend_));
     guard.lock();
     const std::int64_t now = now_ns();
     for (Client& c : clients_) {

@@ -92,7 +92,29 @@ Json camera_json(const CameraBoxes& c) {
       {"frame", c.frame_id}, {"width", c.width}, {"height", c.height}, {"boxes", std::move(boxes)}};
 }
 
+Json task_status_json(const graphs::TaskStatus& t, std::int64_t age_ms) {
+  return {{"state", graphs::to_string(t.state)},
+          {"task", manipulation::to_string(t.task)},
+          {"answer", graphs::to_string(t.answer)},
+          {"move", t.move},
+          {"moves", t.moves},
+          {"done", t.done},
+          {"phase", manipulation::to_string(t.phase)},
+          {"message", t.message},
+          {"age_ms", age_ms}};
+}
+
 }  // namespace
+
+std::string task_answer_json(const graphs::TaskCommand& command, const graphs::TaskStatus& answer) {
+  const bool ok =
+      answer.answer == graphs::TaskAnswer::STARTED || answer.answer == graphs::TaskAnswer::STOPPING;
+  Json doc = task_status_json(answer, 0);
+  doc.erase("age_ms");
+  doc["ok"] = ok;
+  doc["action"] = graphs::to_string(command.kind);
+  return doc.dump(-1, ' ', false, Json::error_handler_t::replace);
+}
 
 std::string state_json(const UiSnapshot& s) {
   Json objects = Json::array(), memory = Json::array(), events = Json::array();
@@ -111,7 +133,9 @@ std::string state_json(const UiSnapshot& s) {
                     {"memory", std::move(memory)},
                     {"events", std::move(events)},
                     {"telemetry", telemetry_json(s)},
-                    {"camera", camera_json(s.camera)}};
+                    {"camera", camera_json(s.camera)},
+                    {"tasks", s.task_control},
+                    {"task", s.task ? task_status_json(*s.task, s.task_age_ms) : Json(nullptr)}};
   // Labels are valid UTF-8 by the label rule; replace keeps a bad byte from throwing regardless.
   return doc.dump(-1, ' ', false, Json::error_handler_t::replace);
 }

@@ -12,8 +12,15 @@ namespace orthoflow::ui {
 /// @brief The state document: {"frame", "age_ms", "durable", "objects": [{"track", "label" (null =
 /// Unknown), "score", "centroid", "bbox_min", "bbox_max", "points", "moving", "described"}],
 /// "memory": [{"label", "views", "last_taught_ms"}], "events": [...], "telemetry": {...}}.
-/// A score that is not finite (before any lesson) is null.
+/// A score that is not finite (before any lesson) is null. "tasks": whether task commands can be
+/// sent; "task": the task process's newest state {"state", "task", "answer", "move", "moves",
+/// "done", "phase", "message", "age_ms"}, or null.
 [[nodiscard]] std::string state_json(const UiSnapshot& snapshot);
+
+/// @brief The answer to a task command: {"ok", "action", "state", "task", "answer", "move",
+/// "moves", "done", "phase", "message"}.
+[[nodiscard]] std::string task_answer_json(const graphs::TaskCommand& command,
+                                           const graphs::TaskStatus& answer);
 
 /// @brief The HTTP status of an action's answer: 200 for stored / learned / answered; 404
 /// no_such_track, unknown_label; 400 bad_label; 409 not_described; 422 rejected; 500 write_failed;

@@ -1,5 +1,7 @@
 #include "ui/ui_server.hpp"
 
+#include "ui/task_link.hpp"
+
 #include <civetweb.h>
 
 #include <chrono>
@@ -179,7 +181,7 @@ int UiServer::handle_http(mg_connection* conn) {
 int UiServer::serve(mg_connection* conn, const ApiRequest& request) {
   switch (request.kind) {
     case Kind::STATE:
-      return reply(conn, 200, "application/json", state_json(backend_.snapshot()));
+      return reply(conn, 200, "application/json", state_json(snapshot_with_task(backend_)));
     case Kind::EVENTS:
       return reply_error(conn, {426, "GET /api/events is a WebSocket: send an Upgrade"},
                          "Upgrade: websocket\r\n");
@@ -198,9 +200,36 @@ int UiServer::serve(mg_connection* conn, const ApiRequest& request) {
         return reply(conn, 200, asset->content_type, asset->text(), page ? cookie_.c_str() : "");
       }
       return reply_error(conn, {404, "no such page"});
+    case Kind::TASK_START:
+    case Kind::TASK_STOP:
+      return act_task(conn, request);
     default:
       return act(conn, request);
   }
+}
+
+int UiServer::act_task(mg_connection* conn, const ApiRequest& request) {
+  TaskLink* link = backend_.task_link();
+  if (link == nullptr)
+    return reply_error(conn, {503,
+                              "no task control here: run the graph with --ipc-learning (or "
+                              "`orthoflow ui`) beside `orthoflow task run`"});
+  const TaskReply answered = link->send(request.task, config_.ack_timeout_ms);
+  switch (answered.status) {
+    case TaskReply::Status::NO_TASK_PROCESS:
+      return reply_error(conn, {503, "no `orthoflow task run` takes task commands"});
+    case TaskReply::Status::TIMEOUT:
+      return reply_error(conn, {504, "`orthoflow task run` did not answer"});
+    case TaskReply::Status::INVALID:
+      return reply_error(conn, {400, "a category is not a valid label"});
+    case TaskReply::Status::ANSWERED:
+      break;
+  }
+  const graphs::TaskAnswer a = answered.answer.answer;
+  const int status = a == graphs::TaskAnswer::STARTED || a == graphs::TaskAnswer::STOPPING ? 200
+                     : a == graphs::TaskAnswer::REFUSED                                    ? 409
+                                                                                           : 400;
+  return reply(conn, status, "application/json", task_answer_json(request.task, answered.answer));
 }
 
 int UiServer::act(mg_connection* conn, const ApiRequest& request) {

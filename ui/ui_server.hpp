@@ -51,6 +51,7 @@ class UiServer {
   UiServer(UiServerConfig config, UiBackend& backend);
   int serve(mg_connection* conn, const ApiRequest& request);
   int act(mg_connection* conn, const ApiRequest& request);
+  int act_task(mg_connection* conn, const ApiRequest& request);
 
   UiServerConfig config_;
   UiBackend& backend_;

@@ -9,12 +9,15 @@
 
 #include <chrono>
 #include <cstdio>
+#include <fstream>
+#include <sstream>
 #include <string>
 #include <thread>
 
 #include <nlohmann/json.hpp>
 
 #include "tests/ipc/roudi_sandbox.hpp"
+#include "tests/ui/http_test_client.hpp"
 
 namespace orthoflow::tests {
 namespace {
@@ -182,6 +185,65 @@ TEST(IpcTask, ClearTableAcrossProcessesMovesAnObjectOfTheSimulatedWorld) {
         }
       },
       260s);
+  if (outcome.skipped) GTEST_SKIP() << outcome.reason;
+  EXPECT_EQ(outcome.failures, "");
+}
+
+// The web view's task buttons (ui/task_link.hpp) over the same channel: `orthoflow ui` beside
+// `orthoflow task run --sim` shows the task process's state and forwards POST /api/task/start and
+// /stop; the task process's refusals come back with their reasons (no graph runs, so there are no
+// fresh objects and no task to stop); once the task process is gone, a start is 503.
+TEST(IpcTask, TheWebViewStartsAndStopsTasksThroughTheTaskProcess) {
+  const Outcome outcome = run_isolated(
+      [](Sandbox& box) {
+        if (box.start_roudi() < 0) return;
+        const pid_t task = box.spawn_orthoflow(
+            "task", {"task", "run", "--sim", "--robot-frames", FRAMES, "--seconds", "120"});
+        box.check(
+            box.wait_for_output(task, "task: commands on orthoflow/tabletop/task_commands", 30s),
+            "the task process runs");
+        const pid_t ui = box.spawn_orthoflow(
+            "ui", {"ui", "--listen", "127.0.0.1:0", "--graph", "tabletop", "--seconds", "90"});
+        box.check(box.wait_for_output(ui, "over iceoryx", 30s), "the ui runs");
+        std::ifstream in("/tmp/ui.out");
+        std::stringstream text;
+        text << in.rdbuf();
+        const std::string out = text.str();
+        const std::size_t at = out.find("ui: http://127.0.0.1:");
+        box.check(at != std::string::npos, "the ui prints its URL");
+        if (at == std::string::npos) return;
+        const auto port = static_cast<std::uint16_t>(std::stoi(out.substr(at + 21)));
+        nlohmann::json state;
+        for (int k = 0; k < 100; ++k) {  // the task process publishes its state every cycle
+          state =
+              nlohmann::json::parse(ui::test::http(port, "GET", "/api/state").body, nullptr, false);
+          if (state.is_object() && state["task"].is_object()) break;
+          std::this_thread::sleep_for(100ms);
+        }
+        box.check(state.is_object() && state["tasks"] == true && state["task"].is_object() &&
+                      state["task"]["state"] == "idle",
+                  "the page shows the task process's state: idle");
+        const auto start =
+            ui::test::post_json(port, "/api/task/start", R"({"task": "clear_table"})");
+        box.check(start.status == 409 &&
+                      start.body.find("no fresh objects from the graph") != std::string::npos,
+                  "a start is refused by the task process, with its reason: " + start.body);
+        const auto stop = ui::test::post_json(port, "/api/task/stop", "{}");
+        box.check(stop.status == 409 && stop.body.find("no task is running") != std::string::npos,
+                  "a stop with no task is refused: " + stop.body);
+        ::kill(task, SIGTERM);
+        const ProcResult t = box.wait(task, 60s);
+        box.check(t.exit_code == 0, "the task process exits on SIGTERM", t);
+        int gone = 0;
+        for (int k = 0; k < 100 && gone != 503; ++k) {
+          gone = ui::test::post_json(port, "/api/task/start", R"({"task": "clear_table"})").status;
+          if (gone != 503) std::this_thread::sleep_for(100ms);
+        }
+        box.check(gone == 503, "with no task process a start is 503");
+        ::kill(ui, SIGTERM);
+        box.check(box.wait(ui, 20s).exit_code == 0, "the ui stops on SIGTERM");
+      },
+      180s);
   if (outcome.skipped) GTEST_SKIP() << outcome.reason;
   EXPECT_EQ(outcome.failures, "");
 }

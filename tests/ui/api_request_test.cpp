@@ -180,3 +180,61 @@ TEST(ApiRequest, QueryAndHeaderHelpers) {
 
 }  // namespace
 }  // namespace orthoflow::ui
+
+namespace orthoflow::ui {
+namespace {
+
+TEST(ApiRequest, TaskStartAndStop) {
+  auto clear = decode("POST", "/api/task/start", R"({"task": "clear_table"})");
+  ASSERT_TRUE(clear);
+  EXPECT_EQ(clear->kind, Kind::TASK_START);
+  EXPECT_EQ(clear->task.kind, graphs::TaskCommand::Kind::START);
+  EXPECT_EQ(clear->task.task, manipulation::TableTaskKind::CLEAR_TABLE);
+  EXPECT_TRUE(clear->task.bring.empty());
+  auto serve = decode("POST", "/api/task/start",
+                      R"({"task": "serve_a_meal", "bring": ["mug", "bol à café"]})");
+  ASSERT_TRUE(serve);
+  EXPECT_EQ(serve->task.task, manipulation::TableTaskKind::SERVE_A_MEAL);
+  EXPECT_EQ(serve->task.bring, (std::vector<std::string>{"mug", "bol à café"}));
+  auto stop = decode("POST", "/api/task/stop", "{}");
+  ASSERT_TRUE(stop);
+  EXPECT_EQ(stop->kind, Kind::TASK_STOP);
+  EXPECT_EQ(stop->task.kind, graphs::TaskCommand::Kind::STOP);
+  EXPECT_EQ(to_string(Kind::TASK_START), "task_start");
+}
+
+TEST(ApiRequest, BadTaskCommandsAre400WithTheReason) {
+  const auto reason = [](std::string_view path, std::string_view body) {
+    const auto r = decode("POST", path, body);
+    EXPECT_FALSE(r) << body;
+    return r ? std::string() : std::to_string(r.error().status) + " " + r.error().message;
+  };
+  EXPECT_EQ(reason("/api/task/start", "{}"), "400 missing field 'task'");
+  EXPECT_EQ(reason("/api/task/start", R"({"task": "dance"})"),
+            "400 'task' must be \"clear_table\" or \"serve_a_meal\"");
+  EXPECT_EQ(reason("/api/task/start", R"({"task": 3})"),
+            "400 'task' must be \"clear_table\" or \"serve_a_meal\"");
+  EXPECT_EQ(reason("/api/task/start", R"({"task": "clear_table", "bring": ["mug"]})"),
+            "400 'bring' is for serve_a_meal only");
+  EXPECT_EQ(reason("/api/task/start", R"({"task": "serve_a_meal"})"),
+            "400 'bring' must list 1 to 4 categories");
+  EXPECT_EQ(reason("/api/task/start", R"({"task": "serve_a_meal", "bring": []})"),
+            "400 'bring' must list 1 to 4 categories");
+  EXPECT_EQ(
+      reason("/api/task/start", R"({"task": "serve_a_meal", "bring": ["a","b","c","d","e"]})"),
+      "400 'bring' must list 1 to 4 categories");
+  EXPECT_EQ(reason("/api/task/start", R"({"task": "serve_a_meal", "bring": [1]})"),
+            "400 'bring' must list category names");
+  EXPECT_NE(reason("/api/task/start", R"({"task": "serve_a_meal", "bring": ["a\u0001"]})")
+                .find("400 'bring': "),
+            std::string::npos);
+  EXPECT_EQ(reason("/api/task/start", R"({"task": "clear_table", "speed": 2})"),
+            "400 unknown field 'speed'");
+  EXPECT_EQ(reason("/api/task/stop", R"({"now": true})"), "400 unknown field 'now'");
+  EXPECT_EQ(status_of(decode("GET", "/api/task/start")), 405);
+  EXPECT_EQ(status_of(decode("POST", "/api/task/stop", "{}", "", {})), 415);
+  EXPECT_EQ(status_of(decode("POST", "/api/task")), 404);
+}
+
+}  // namespace
+}  // namespace orthoflow::ui

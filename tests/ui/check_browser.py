@@ -289,6 +289,13 @@ try:
 
     browser.go(f"{url}/?token={TOKEN}")
     browser.wait("the page to go live", lambda: browser.text("#status") == "live")
+    # The task panel: this run publishes nothing over iceoryx, so no task commands can be sent: its
+    # buttons are disabled and it says why (the buttons' way to the task process is tested in
+    # tests/ipc/ipc_task_test.cpp).
+    browser.wait("the task panel to say there is no task control",
+                 lambda: "no task control here" in (browser.text("#task-state") or ""))
+    expect(browser.script("return [...document.querySelectorAll('#task button')].every((b) => b.disabled);"),
+           "task buttons enabled without task control")
     browser.wait(f"track {track} in the objects table",
                  lambda: any(r[0] == str(track) for r in browser.rows("objects")))
     browser.wait("the latency table", lambda: len(browser.rows("latency")) >= 3)

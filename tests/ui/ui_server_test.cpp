@@ -10,6 +10,7 @@
 #include <mutex>
 
 #include "http_test_client.hpp"
+#include "ui/task_link.hpp"
 #include "ui/ui_client.hpp"
 
 namespace orthoflow::ui {
@@ -303,6 +304,82 @@ TEST(UiClient, UrlsAreCheckedAndAnUnreachableServerIsAnError) {
   ::close(fd);
   ASSERT_FALSE(r);
   EXPECT_NE(r.error().find("cannot connect"), std::string::npos) << r.error();
+}
+
+/// A task process stand-in behind the TaskLink interface: answers every command as set and
+/// remembers what it was sent (the real link, over iceoryx, is tested in tests/ipc/ipc_task_test).
+class RecordingTaskLink : public TaskLink {
+ public:
+  std::optional<TaskView> view() const override {
+    std::lock_guard<std::mutex> guard(lock_);
+    return shown;
+  }
+  TaskReply send(const graphs::TaskCommand& command, int /*timeout_ms*/) override {
+    std::lock_guard<std::mutex> guard(lock_);
+    sent.push_back(command);
+    return reply;
+  }
+  mutable std::mutex lock_;
+  std::optional<TaskView> shown;
+  TaskReply reply;
+  std::vector<graphs::TaskCommand> sent;
+};
+
+// POST /api/task/start and /api/task/stop: without a task link 503; with one, the task process's
+// answer (started / stopping 200, refused 409, invalid 400), no task process 503, no answer 504;
+// the state shows whether tasks can be sent and the task's newest state.
+TEST_F(UiServerTest, TaskCommandsReachTheTaskProcessAndItsAnswerComesBack) {
+  start();
+  const std::string clear = R"({"task": "clear_table"})";
+  auto none = post_json(port_, "/api/task/start", clear);
+  EXPECT_EQ(none.status, 503);
+  EXPECT_NE(none.body.find("no task control here"), std::string::npos) << none.body;
+  auto doc = nlohmann::json::parse(http(port_, "GET", "/api/state").body);
+  EXPECT_EQ(doc["tasks"], false);
+  EXPECT_TRUE(doc["task"].is_null());
+
+  RecordingTaskLink link;
+  backend_.set_task_link(&link);
+  graphs::TaskStatus status;
+  status.state = graphs::TaskState::RUNNING;
+  status.answer = graphs::TaskAnswer::STARTED;
+  status.moves = 3;
+  status.move = 1;
+  status.phase = manipulation::Phase::APPROACH;
+  link.reply = {TaskReply::Status::ANSWERED, status};
+  link.shown = TaskView{status, 42};
+  const auto started = post_json(port_, "/api/task/start", clear);
+  ASSERT_EQ(started.status, 200) << started.body;
+  const auto answer = nlohmann::json::parse(started.body);
+  EXPECT_EQ(answer["ok"], true);
+  EXPECT_EQ(answer["answer"], "started");
+  EXPECT_EQ(answer["task"], "clear_table");
+  EXPECT_EQ(answer["moves"], 3);
+  doc = nlohmann::json::parse(http(port_, "GET", "/api/state").body);
+  EXPECT_EQ(doc["tasks"], true);
+  EXPECT_EQ(doc["task"]["state"], "running");
+  EXPECT_EQ(doc["task"]["phase"], "approach");
+  EXPECT_EQ(doc["task"]["age_ms"], 42);
+
+  status.answer = graphs::TaskAnswer::REFUSED;
+  status.message = "a task is running";
+  link.reply = {TaskReply::Status::ANSWERED, status};
+  const auto refused =
+      post_json(port_, "/api/task/start", R"({"task": "serve_a_meal", "bring": ["mug"]})");
+  EXPECT_EQ(refused.status, 409);
+  EXPECT_EQ(nlohmann::json::parse(refused.body)["message"], "a task is running");
+  status.answer = graphs::TaskAnswer::STOPPING;
+  link.reply = {TaskReply::Status::ANSWERED, status};
+  EXPECT_EQ(post_json(port_, "/api/task/stop", "{}").status, 200);
+  link.reply = {TaskReply::Status::NO_TASK_PROCESS, {}};
+  EXPECT_EQ(post_json(port_, "/api/task/stop", "{}").status, 503);
+  link.reply = {TaskReply::Status::TIMEOUT, {}};
+  EXPECT_EQ(post_json(port_, "/api/task/stop", "{}").status, 504);
+  EXPECT_EQ(post_json(port_, "/api/task/start", R"({"task": "fly"})").status, 400);  // not sent
+  ASSERT_EQ(link.sent.size(), 5U);
+  EXPECT_EQ(link.sent[1].bring, std::vector<std::string>{"mug"});
+  EXPECT_EQ(link.sent[2].kind, graphs::TaskCommand::Kind::STOP);
+  backend_.set_task_link(nullptr);
 }
 
 }  // namespace

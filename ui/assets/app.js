@@ -1,5 +1,6 @@
 // The orthoflow live view: reads the state over the WebSocket /api/events (JSON documents, see
-// ui/ui_json.hpp), draws it, and sends teach / correct / ask / forget / undo to the JSON API.
+// ui/ui_json.hpp), draws it, and sends teach / correct / ask / forget / undo to the JSON API, and
+// starts and stops the table tasks (POST /api/task/start, /api/task/stop).
 'use strict';
 
 const params = new URLSearchParams(location.search);
@@ -162,8 +163,51 @@ $('camera').addEventListener('click', (event) => {
   if (best !== null) select(best);
 });
 
+function renderTask(s) {
+  const t = s.task;
+  for (const b of document.querySelectorAll('#task button')) b.disabled = !s.tasks;
+  if (!s.tasks) {
+    $('task-state').textContent = 'no task control here (the graph needs --ipc-learning)';
+  } else if (t === null) {
+    $('task-state').textContent = 'no `orthoflow task run` answering';
+  } else {
+    let text = `${t.task}: ${t.state}`;
+    if (t.state === 'running') text += `, move ${t.move} of ${t.moves} (${t.phase}), ${t.done} done`;
+    if (t.state === 'finished') text += `, ${t.done} of ${t.moves} moves done`;
+    if (t.message) text += ` (${t.message})`;
+    $('task-state').textContent = text;
+  }
+}
+
+async function task(which) {
+  const headers = {'Content-Type': 'application/json'};
+  if (token) headers.Authorization = `Bearer ${token}`;
+  let path = '/api/task/start', body = {task: which};
+  if (which === 'stop') { path = '/api/task/stop'; body = {}; }
+  if (which === 'serve_a_meal') {
+    body.bring = $('bring').value.split(',').map((c) => c.trim()).filter((c) => c.length > 0);
+    if (body.bring.length === 0) { $('task-answer').textContent = 'name the categories to bring'; return; }
+  }
+  $('task-answer').textContent = `${which}...`;
+  try {
+    const response = await fetch(path, {method: 'POST', headers, body: JSON.stringify(body)});
+    const answer = await response.json();
+    $('task-answer').textContent = answer.error ? `${which}: ${answer.error}`
+      : `${which}: ${answer.answer}${answer.message ? ` (${answer.message})` : ''}`;
+    $('task-answer').className = answer.ok ? 'good' : 'bad';
+  } catch (e) {
+    $('task-answer').textContent = `${which} failed: ${e}`;
+    $('task-answer').className = 'bad';
+  }
+}
+
+for (const button of document.querySelectorAll('#task button')) {
+  button.addEventListener('click', () => task(button.dataset.task));
+}
+
 function render(s) {
   state = s;
+  renderTask(s);
   refreshCamera(s);
   $('frame').textContent = `frame ${s.frame} (${fmt(s.age_ms, 1)} ms old)`;
   renderObjects(s);
