@@ -179,26 +179,34 @@ function renderTask(s) {
   }
 }
 
-async function task(which) {
+// POSTs @p body as JSON (with the bearer token when the page has one) and returns the answer
+// document; shows "WHAT..." in @p line meanwhile, and WHAT failed: ... there when no answer came.
+async function postJson(path, body, line, what) {
   const headers = {'Content-Type': 'application/json'};
   if (token) headers.Authorization = `Bearer ${token}`;
+  $(line).textContent = `${what}...`;
+  try {
+    const response = await fetch(path, {method: 'POST', headers, body: JSON.stringify(body)});
+    return await response.json();
+  } catch (e) {
+    $(line).textContent = `${what} failed: ${e}`;
+    $(line).className = 'bad';
+    return null;
+  }
+}
+
+async function task(which) {
   let path = '/api/task/start', body = {task: which};
   if (which === 'stop') { path = '/api/task/stop'; body = {}; }
   if (which === 'serve_a_meal') {
     body.bring = $('bring').value.split(',').map((c) => c.trim()).filter((c) => c.length > 0);
     if (body.bring.length === 0) { $('task-answer').textContent = 'name the categories to bring'; return; }
   }
-  $('task-answer').textContent = `${which}...`;
-  try {
-    const response = await fetch(path, {method: 'POST', headers, body: JSON.stringify(body)});
-    const answer = await response.json();
-    $('task-answer').textContent = answer.error ? `${which}: ${answer.error}`
-      : `${which}: ${answer.answer}${answer.message ? ` (${answer.message})` : ''}`;
-    $('task-answer').className = answer.ok ? 'good' : 'bad';
-  } catch (e) {
-    $('task-answer').textContent = `${which} failed: ${e}`;
-    $('task-answer').className = 'bad';
-  }
+  const answer = await postJson(path, body, 'task-answer', which);
+  if (answer === null) return;
+  $('task-answer').textContent = answer.error ? `${which}: ${answer.error}`
+    : `${which}: ${answer.answer}${answer.message ? ` (${answer.message})` : ''}`;
+  $('task-answer').className = answer.ok ? 'good' : 'bad';
 }
 
 for (const button of document.querySelectorAll('#task button')) {
@@ -249,27 +257,19 @@ async function act(action) {
   const body = action === 'forget' ? {label} : action === 'undo' ? {}
     : action === 'ask' ? {track: selected} : {track: selected, label};
   if (action !== 'forget' && action !== 'undo' && selected === null) { $('answer').textContent = 'click an object first'; return; }
-  const headers = {'Content-Type': 'application/json'};
-  if (token) headers.Authorization = `Bearer ${token}`;
-  $('answer').textContent = `${action}...`;
-  try {
-    const response = await fetch(`/api/${action}`, {method: 'POST', headers, body: JSON.stringify(body)});
-    const answer = await response.json();
-    let text = `${action}: ${answer.outcome || answer.error}`;
-    if (action === 'ask' && answer.ok) {
-      text += ` -> ${answer.answer === null ? 'Unknown' : answer.answer}`;
-      const near = answer.nearest.map((n) => n.score === null ? n.label : `${n.label} ${fmt(n.score, 3)}`);
-      if (near.length > 0) text += `; nearest: ${near.join(', ')}`;
-    }
-    if (action === 'undo' && answer.ok) text += `: ${answer.views} view(s) of "${answer.label}" taken back`;
-    if (!answer.ok && answer.error && answer.outcome) text += ` (${answer.error})`;  // else shown above
-    if (answer.ok && answer.outcome === 'stored') text += ' (on disk)';
-    $('answer').textContent = text;
-    $('answer').className = answer.ok ? 'good' : 'bad';
-  } catch (e) {
-    $('answer').textContent = `${action} failed: ${e}`;
-    $('answer').className = 'bad';
+  const answer = await postJson(`/api/${action}`, body, 'answer', action);
+  if (answer === null) return;
+  let text = `${action}: ${answer.outcome || answer.error}`;
+  if (action === 'ask' && answer.ok) {
+    text += ` -> ${answer.answer === null ? 'Unknown' : answer.answer}`;
+    const near = answer.nearest.map((n) => n.score === null ? n.label : `${n.label} ${fmt(n.score, 3)}`);
+    if (near.length > 0) text += `; nearest: ${near.join(', ')}`;
   }
+  if (action === 'undo' && answer.ok) text += `: ${answer.views} view(s) of "${answer.label}" taken back`;
+  if (!answer.ok && answer.error && answer.outcome) text += ` (${answer.error})`;  // else shown above
+  if (answer.ok && answer.outcome === 'stored') text += ' (on disk)';
+  $('answer').textContent = text;
+  $('answer').className = answer.ok ? 'good' : 'bad';
 }
 
 for (const button of document.querySelectorAll('#action button')) {
