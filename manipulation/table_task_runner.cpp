@@ -136,13 +136,11 @@ std::size_t TableTaskRunner::fill_obstacles(const SeenObject* target, const Vect
 
 const SeenObject* TableTaskRunner::find_seen(std::uint32_t track, const Vector3d& near,
                                              const std::string& label, double same_label_m,
-                                             double any_m,
-                                             std::span<const std::uint32_t> not_these) const {
+                                             double any_m) const {
   const SeenObject* best = nullptr;
   double best_d = 0.0;
   for (const SeenObject& o : seen_) {
     if (o.track == track) return &o;
-    if (std::find(not_these.begin(), not_these.end(), o.track) != not_these.end()) continue;
     const double d = (o.centre - near).norm();
     if ((d < any_m || (d < same_label_m && o.label == label)) && (best == nullptr || d < best_d)) {
       best = &o;
@@ -154,11 +152,8 @@ const SeenObject* TableTaskRunner::find_seen(std::uint32_t track, const Vector3d
 
 const SeenObject* TableTaskRunner::current_target() const {
   // Its track; else (renumbered, or moved by someone) the nearest object of its label within 15 cm
-  // of where it was planned, or anything within 3 cm; never an object that had a track of its own
-  // when the move started (two cans side by side: once the hand lifts one out of view, the other is
-  // not it, and "it did not rise" would be wrong).
-  return find_seen(target_track_, target_centre_, target_label_, 0.15, 0.03,
-                   std::span(bystanders_).first(bystander_count_));
+  // of where it was planned, or anything within 3 cm.
+  return find_seen(target_track_, target_centre_, target_label_, 0.15, 0.03);
 }
 
 bool TableTaskRunner::is_target(const SeenObject& o, const SeenObject* t) const {
@@ -251,10 +246,6 @@ void TableTaskRunner::start_move(std::int64_t now_ns, const jaco::ArmSnapshot& a
   target_track_ = s->track;
   target_centre_ = s->centre;
   target_label_ = r.label;
-  bystander_count_ = 0;
-  for (const SeenObject& o : seen_)
-    if (o.track != target_track_ && bystander_count_ < bystanders_.size())
-      bystanders_[bystander_count_++] = o.track;
   const SeenObject* target = current_target();
   const Vector3d tool = jaco::forward_kinematics(options_.job.initial).translation();
   const auto obstacles =

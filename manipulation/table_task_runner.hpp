@@ -176,8 +176,7 @@ class TableTaskRunner {
   std::size_t add_spheres(const SeenObject& o, std::size_t used);
   [[nodiscard]] const SeenObject* find_seen(std::uint32_t track, const Eigen::Vector3d& near,
                                             const std::string& label, double same_label_m,
-                                            double any_m,
-                                            std::span<const std::uint32_t> not_these = {}) const;
+                                            double any_m) const;
   [[nodiscard]] const SeenObject* current_target() const;
   [[nodiscard]] bool is_target(const SeenObject& o, const SeenObject* t) const;
   [[nodiscard]] bool placing() const noexcept;
@@ -189,10 +188,6 @@ class TableTaskRunner {
   std::vector<SeenObject> seen_;
   std::int64_t seen_stamp_ns_ = 0;
   std::vector<Obstacle> others_;
-  /// The other objects' tracks when the running move started: never taken for its target (a
-  /// twin of the target beside it, when the hand lifts the target out of view).
-  std::array<std::uint32_t, MAX_TASK_OBJECTS> bystanders_{};
-  std::size_t bystander_count_ = 0;
   ExecutionManager manager_{};
   std::vector<MoveRecord> moves_;
   std::vector<StayRecord> stays_;
