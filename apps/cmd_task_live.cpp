@@ -36,6 +36,7 @@
 #include "graphs/table_task_session.hpp"
 #include "graphs/task_payloads.hpp"
 #include "manipulation/robot_frames.hpp"
+#include "ui/ui_json.hpp"
 
 namespace orthoflow::apps {
 namespace {
@@ -122,17 +123,6 @@ std::uint64_t drain(engine::IpcSubscriber& in, const Use& use) {
 template <class Payload>
 void publish_pod(engine::IpcPublisher& out, const Payload& p) {
   (void)out.publish_copy({reinterpret_cast<const std::byte*>(&p), sizeof p});
-}
-
-nlohmann::json status_json(const graphs::TaskStatus& s) {
-  return {{"state", graphs::to_string(s.state)},
-          {"task", manipulation::to_string(s.task)},
-          {"answer", graphs::to_string(s.answer)},
-          {"message", s.message},
-          {"move", s.move},
-          {"moves", s.moves},
-          {"done", s.done},
-          {"phase", manipulation::to_string(s.phase)}};
 }
 
 nlohmann::json report_json(const manipulation::TableTaskRunner& r) {
@@ -321,7 +311,7 @@ void run_live(const LiveArgs& a) {
                         {"object_lists", lists},
                         {"commands", commands},
                         {"rejected", rejected},
-                        {"status", status_json(task.status(now_ns()))}};
+                        {"status", ui::task_status_json(task.status(now_ns()))}};
   if (task.runner() != nullptr) out["report"] = report_json(*task.runner());
   if (a.json) {
     std::cout << out.dump() << '\n';
@@ -374,7 +364,7 @@ void send_command(const LiveArgs& a, const std::optional<graphs::TaskCommand>& c
     if (s && s->has_value()) {
       auto st = graphs::decode_task_status((*s)->bytes());
       if (st && (!command || (st->client == client && st->request == request))) {
-        const nlohmann::json j = status_json(*st);
+        const nlohmann::json j = ui::task_status_json(*st);
         if (a.json)
           std::cout << j.dump() << '\n';
         else

@@ -92,7 +92,9 @@ Json camera_json(const CameraBoxes& c) {
       {"frame", c.frame_id}, {"width", c.width}, {"height", c.height}, {"boxes", std::move(boxes)}};
 }
 
-Json task_status_json(const graphs::TaskStatus& t, std::int64_t age_ms) {
+}  // namespace
+
+nlohmann::json task_status_json(const graphs::TaskStatus& t) {
   return {{"state", graphs::to_string(t.state)},
           {"task", manipulation::to_string(t.task)},
           {"answer", graphs::to_string(t.answer)},
@@ -100,21 +102,28 @@ Json task_status_json(const graphs::TaskStatus& t, std::int64_t age_ms) {
           {"moves", t.moves},
           {"done", t.done},
           {"phase", manipulation::to_string(t.phase)},
-          {"message", t.message},
-          {"age_ms", age_ms}};
+          {"message", t.message}};
 }
-
-}  // namespace
 
 std::string task_answer_json(const graphs::TaskCommand& command, const graphs::TaskStatus& answer) {
   const bool ok =
       answer.answer == graphs::TaskAnswer::STARTED || answer.answer == graphs::TaskAnswer::STOPPING;
-  Json doc = task_status_json(answer, 0);
-  doc.erase("age_ms");
+  Json doc = task_status_json(answer);
   doc["ok"] = ok;
   doc["action"] = graphs::to_string(command.kind);
   return doc.dump(-1, ' ', false, Json::error_handler_t::replace);
 }
+
+namespace {
+
+Json task_view_json(const UiSnapshot& s) {
+  if (!s.task) return nullptr;
+  Json doc = task_status_json(*s.task);
+  doc["age_ms"] = s.task_age_ms;
+  return doc;
+}
+
+}  // namespace
 
 std::string state_json(const UiSnapshot& s) {
   Json objects = Json::array(), memory = Json::array(), events = Json::array();
@@ -135,7 +144,7 @@ std::string state_json(const UiSnapshot& s) {
                     {"telemetry", telemetry_json(s)},
                     {"camera", camera_json(s.camera)},
                     {"tasks", s.task_control},
-                    {"task", s.task ? task_status_json(*s.task, s.task_age_ms) : Json(nullptr)}};
+                    {"task", task_view_json(s)}};
   // Labels are valid UTF-8 by the label rule; replace keeps a bad byte from throwing regardless.
   return doc.dump(-1, ' ', false, Json::error_handler_t::replace);
 }

@@ -4,6 +4,8 @@
 /// action's answer and an error, and the HTTP status each learning outcome maps to.
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "ui/api_request.hpp"
 #include "ui/ui_backend.hpp"
 
@@ -16,6 +18,10 @@ namespace orthoflow::ui {
 /// sent; "task": the task process's newest state {"state", "task", "answer", "move", "moves",
 /// "done", "phase", "message", "age_ms"}, or null.
 [[nodiscard]] std::string state_json(const UiSnapshot& snapshot);
+
+/// @brief A task process's state: {"state", "task", "answer", "move", "moves", "done", "phase",
+/// "message"} (what `orthoflow task status --json` prints too).
+[[nodiscard]] nlohmann::json task_status_json(const graphs::TaskStatus& status);
 
 /// @brief The answer to a task command: {"ok", "action", "state", "task", "answer", "move",
 /// "moves", "done", "phase", "message"}.
