@@ -121,14 +121,28 @@ std::string format_robot_frames(const RobotFrames& frames, std::string_view comm
   return out.str();
 }
 
-Result<std::optional<TargetFrameLine>, std::string> parse_target_frame_line(std::string_view line) {
+namespace {
+
+/// One line of a JSON-lines file: nullopt for a blank or comment line, the object otherwise; the
+/// error for a line too long or not a JSON object.
+Result<std::optional<nlohmann::json>, std::string> json_line(std::string_view line) {
   const auto first = line.find_first_not_of(" \t\r\n");
   if (first == std::string_view::npos || line[first] == '#') {
-    return std::optional<TargetFrameLine>{};
+    return std::optional<nlohmann::json>{};
   }
   if (line.size() > MAX_LINE_BYTES) { return err(std::string("longer than 4096 bytes")); }
-  const nlohmann::json j = nlohmann::json::parse(line, nullptr, false);
+  nlohmann::json j = nlohmann::json::parse(line, nullptr, false);
   if (j.is_discarded() || !j.is_object()) { return err(std::string("not a JSON object")); }
+  return std::optional<nlohmann::json>{std::move(j)};
+}
+
+}  // namespace
+
+Result<std::optional<TargetFrameLine>, std::string> parse_target_frame_line(std::string_view line) {
+  auto object = json_line(line);
+  if (!object) return err(object.error());
+  if (!*object) return std::optional<TargetFrameLine>{};
+  const nlohmann::json& j = **object;
   if (!j.contains("frame") || !j["frame"].is_string() || j["frame"].get<std::string>().empty() ||
       j["frame"].get<std::string>().find('\0') != std::string::npos) {
     return err(std::string("'frame' must name a PCD file"));
@@ -150,13 +164,10 @@ Result<std::optional<TargetFrameLine>, std::string> parse_target_frame_line(std:
 
 Result<std::optional<CalibrationLine>, std::string> parse_calibration_line(
     std::string_view line, const drivers::jaco::ArmGeometry& geometry) {
-  const auto first = line.find_first_not_of(" \t\r\n");
-  if (first == std::string_view::npos || line[first] == '#') {
-    return std::optional<CalibrationLine>{};
-  }
-  if (line.size() > MAX_LINE_BYTES) { return err(std::string("longer than 4096 bytes")); }
-  const nlohmann::json j = nlohmann::json::parse(line, nullptr, false);
-  if (j.is_discarded() || !j.is_object()) { return err(std::string("not a JSON object")); }
+  auto object = json_line(line);
+  if (!object) return err(object.error());
+  if (!*object) return std::optional<CalibrationLine>{};
+  const nlohmann::json& j = **object;
   Eigen::Isometry3d base_from_gripper;
   if (j.contains("joints") == j.contains("gripper")) {
     return err(std::string("give exactly one of \"joints\" and \"gripper\""));

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstring>
+#include <random>
 
 namespace orthoflow::ui {
 
@@ -41,6 +42,13 @@ std::string outcome_text(const UiAnswer& a) {
 }
 
 }  // namespace
+
+std::uint64_t random_client_id() {
+  std::random_device device;
+  std::uint64_t id = 0;
+  while (id == 0) id = (std::uint64_t{device()} << 32U) ^ device();
+  return id;
+}
 
 std::vector<ObjectView> object_views(const engine::ObjectListPayload& list) {
   std::vector<ObjectView> objects;

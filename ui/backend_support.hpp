@@ -17,6 +17,10 @@ namespace orthoflow::ui {
 /// @brief Recent events kept for the page.
 inline constexpr std::size_t MAX_UI_EVENTS = 32;
 
+/// @brief A sender id for a command channel (answers go to every sender: each keeps its own):
+/// random, never 0.
+[[nodiscard]] std::uint64_t random_client_id();
+
 /// @brief The objects of @p list (at most OBJECT_LIST_CAPACITY, whatever its count says).
 [[nodiscard]] std::vector<ObjectView> object_views(const engine::ObjectListPayload& list);
 

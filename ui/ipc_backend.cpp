@@ -3,7 +3,6 @@
 #include <chrono>
 #include <cstring>
 #include <optional>
-#include <random>
 
 #include "engine/ipc_pubsub.hpp"
 #include "engine/ipc_runtime.hpp"
@@ -37,13 +36,6 @@ std::optional<engine::IpcSample> next_sample(engine::IpcSubscriber& in,
     return std::nullopt;
   }
   return std::move(*taken);
-}
-
-// A client id no other sender is likely to have (acks go to every sender of the graph).
-std::uint64_t random_client_id() {
-  std::random_device device;
-  const std::uint64_t id = (static_cast<std::uint64_t>(device()) << 32U) ^ device();
-  return id == 0 ? 1 : id;
 }
 
 }  // namespace

@@ -1,10 +1,10 @@
 #include "ui/ipc_task_link.hpp"
 
 #include <chrono>
-#include <random>
 
 #include "engine/ipc_pubsub.hpp"
 #include "engine/ipc_runtime.hpp"
+#include "ui/backend_support.hpp"
 #include "ui/background_thread.hpp"
 #include "ui/ipc_backend.hpp"
 
@@ -41,9 +41,9 @@ Result<std::unique_ptr<IpcTaskLink>, std::string> IpcTaskLink::open(const std::s
 
 IpcTaskLink::IpcTaskLink(std::unique_ptr<engine::IpcSubscriber> status,
                          std::unique_ptr<engine::IpcPublisher> commands)
-    : status_in_(std::move(status)), commands_out_(std::move(commands)) {
-  std::random_device device;
-  client_id_ = ((static_cast<std::uint64_t>(device()) << 32U) ^ device()) | 1U;
+    : status_in_(std::move(status)),
+      commands_out_(std::move(commands)),
+      client_id_(random_client_id()) {
   poller_ = std::thread([this] { poll(); });
 }
 
