@@ -18,7 +18,7 @@ PACKAGES=(
   libfreenect-dev libfreenect-bin  # test-only: libfreenect against the simulated Kinect (tests/support/sim_libusb)
   chromium chromium-driver  # test-only: the web view in a real, headless browser (tests/ui/check_browser.py)
   # The robot image (scripts/build_image.sh, issue 24): Debian's tools to build it, qemu to boot it.
-  mmdebstrap arch-test qemu-user-static e2fsprogs dosfstools mtools fdisk zstd grub-efi-amd64-bin grub-efi-arm64-bin
+  mmdebstrap arch-test qemu-user-static e2fsprogs dosfstools mtools fdisk zstd grub-efi-amd64-bin grub-efi-arm64-bin:arm64
   qemu-system-x86 qemu-system-arm ovmf qemu-efi-aarch64 curl  # test-only: booting the images (scripts/test_image.sh)
 )
 
@@ -32,6 +32,12 @@ else
   SUDO=""
   [ "$(id -u)" -eq 0 ] || SUDO="sudo"
   echo "install_deps: installing ${missing[*]}"
+  # grub-efi-arm64-bin exists only as an arm64 package: dpkg must know the architecture first (on a
+  # fresh Debian 12 machine it does not; install_arm64_deps.sh below needs it too).
+  if ! dpkg --print-foreign-architectures | grep -qx arm64; then
+    echo "install_deps: adding the arm64 architecture to dpkg"
+    $SUDO dpkg --add-architecture arm64
+  fi
   $SUDO apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
