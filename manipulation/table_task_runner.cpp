@@ -136,13 +136,22 @@ std::size_t TableTaskRunner::fill_obstacles(const SeenObject* target, const Vect
 
 const SeenObject* TableTaskRunner::find_seen(std::uint32_t track, const Vector3d& near,
                                              const std::string& label, double same_label_m,
-                                             double any_m) const {
+                                             double any_m, bool not_bystanders) const {
   const SeenObject* best = nullptr;
   double best_d = 0.0;
+  bool by_track = false;
   for (const SeenObject& o : seen_) {
-    if (o.track == track) return &o;
+    if (not_bystanders && a_bystander(o.centre)) continue;
     const double d = (o.centre - near).norm();
-    if ((d < any_m || (d < same_label_m && o.label == label)) && (best == nullptr || d < best_d)) {
+    // By its track first (of the pieces with it, the nearest); else by distance.
+    if (o.track == track) {
+      if (!by_track || d < best_d) {
+        best = &o;
+        best_d = d;
+      }
+      by_track = true;
+    } else if (!by_track && (d < any_m || (d < same_label_m && o.label == label)) &&
+               (best == nullptr || d < best_d)) {
       best = &o;
       best_d = d;
     }
@@ -150,10 +159,23 @@ const SeenObject* TableTaskRunner::find_seen(std::uint32_t track, const Vector3d
   return best;
 }
 
+bool TableTaskRunner::a_bystander(const Vector3d& centre) const noexcept {
+  // Standing (not risen with the hand) and nearer to where another object stood when the move
+  // started than to where the target stood: that other object, whatever its track or label.
+  const Vector3d& up = options_.job.grasp.table.normal;
+  if ((centre - target_centre_).dot(up) > options_.limits.target_moved_m) return false;
+  const double to_target = (centre - target_centre_).norm();
+  for (std::size_t k = 0; k < bystander_count_; ++k) {
+    if ((centre - bystanders_[k]).norm() < to_target) return true;
+  }
+  return false;
+}
+
 const SeenObject* TableTaskRunner::current_target() const {
   // Its track; else (renumbered, or moved by someone) the nearest object of its label within 15 cm
-  // of where it was planned, or anything within 3 cm.
-  return find_seen(target_track_, target_centre_, target_label_, 0.15, 0.03);
+  // of where it was planned, or anything within 3 cm; never one of the move's bystanders (two cans
+  // side by side: when the hand has lifted one out of view, the other one is not it).
+  return find_seen(target_track_, target_centre_, target_label_, 0.15, 0.03, true);
 }
 
 bool TableTaskRunner::is_target(const SeenObject& o, const SeenObject* t) const {
@@ -246,6 +268,12 @@ void TableTaskRunner::start_move(std::int64_t now_ns, const jaco::ArmSnapshot& a
   target_track_ = s->track;
   target_centre_ = s->centre;
   target_label_ = r.label;
+  bystander_count_ = 0;
+  for (const SeenObject& o : seen_) {
+    if (o.track != target_track_ && (o.centre - s->centre).norm() > 0.03 &&
+        bystander_count_ < bystanders_.size())
+      bystanders_[bystander_count_++] = o.centre;
+  }
   const SeenObject* target = current_target();
   const Vector3d tool = jaco::forward_kinematics(options_.job.initial).translation();
   const auto obstacles =
@@ -426,7 +454,7 @@ void TableTaskRunner::check_left_behind(std::size_t move) {
   for (const SeenObject& o : seen_) {
     if ((o.centre.head<2>() - r.to).norm() < PLACED_NEAR_M) at_spot = true;
     if ((o.label == r.label || o.track == r.track) &&
-        along_table(o.centre - from) < LEFT_BEHIND_M &&
+        along_table(o.centre - from) < LEFT_BEHIND_M && !a_bystander(o.centre) &&
         !arm_hides(o.centre, 0.5 * o.box.extents.head<2>().norm()))
       left = true;
   }

@@ -176,7 +176,10 @@ class TableTaskRunner {
   std::size_t add_spheres(const SeenObject& o, std::size_t used);
   [[nodiscard]] const SeenObject* find_seen(std::uint32_t track, const Eigen::Vector3d& near,
                                             const std::string& label, double same_label_m,
-                                            double any_m) const;
+                                            double any_m, bool not_bystanders = false) const;
+  /// True if an object at @p centre, standing, is nearer to where another object stood when the
+  /// running move started than to where its target stood.
+  [[nodiscard]] bool a_bystander(const Eigen::Vector3d& centre) const noexcept;
   [[nodiscard]] const SeenObject* current_target() const;
   [[nodiscard]] bool is_target(const SeenObject& o, const SeenObject* t) const;
   [[nodiscard]] bool placing() const noexcept;
@@ -188,6 +191,9 @@ class TableTaskRunner {
   std::vector<SeenObject> seen_;
   std::int64_t seen_stamp_ns_ = 0;
   std::vector<Obstacle> others_;
+  /// Where the other objects stood when the running move started (base frame).
+  std::array<Eigen::Vector3d, MAX_TASK_OBJECTS> bystanders_{};
+  std::size_t bystander_count_ = 0;
   ExecutionManager manager_{};
   std::vector<MoveRecord> moves_;
   std::vector<StayRecord> stays_;
