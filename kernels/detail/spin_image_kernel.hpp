@@ -1,0 +1,95 @@
+#pragma once
+// The spin-image rule both twins share (kernels/spin_image.hpp): the float neighbour test and the
+// double binning, and the declaration of the SIMD functor that finds neighbours a batch at a time
+// (body in spin_image.inl, one TU per arch; every unit compiled with -ffp-contract=off).
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+
+#include "kernels/point_cloud.hpp"
+#include "kernels/simd_arch.hpp"
+#include "kernels/spin_image.hpp"
+
+namespace orthoflow::kernels::detail {
+
+/// One call's constants.
+struct SpinSetup {
+  std::uint32_t width = 0;  // W
+  double bin = 0.0;         // s = R / W / sqrt(2)
+  double limit = 0.0;       // W * s: the cylinder's radius and half height
+  float radius2 = 0.0F;     // R^2 rounded to float, as PCL's radius search compares
+  double angle_cos = 0.0;   // 0: no support-angle test
+  std::size_t columns = 0;  // 2W + 1
+};
+
+/// One keypoint: its position, normal and index.
+struct SpinKey {
+  float x, y, z;
+  float nx, ny, nz;
+};
+
+/// Adds neighbour @p p (|d| = @p norm, d . n = @p dot, both float) to @p acc; PCL's rule.
+inline void spin_bin(const SpinSetup& s, const SpinKey& k, PointsView normals, std::size_t p,
+                     float norm, float dot, double* acc) noexcept {
+  if (s.angle_cos > 0.0) {
+    const float nn = k.nx * normals.x[p] + k.ny * normals.y[p] + k.nz * normals.z[p];
+    double c = static_cast<double>(nn);
+    c = std::max(-1.0, std::min(1.0, c));  // NaN becomes 1, as in PCL
+    if (std::abs(c) < s.angle_cos) return;
+  }
+  const auto dn = static_cast<double>(norm);
+  if (std::abs(dn) < 10 * std::numeric_limits<double>::epsilon()) return;  // the keypoint itself
+  double c = static_cast<double>(dot) / dn;
+  c = std::max(-1.0, std::min(1.0, c));
+  double beta = dn * c;
+  double alpha = dn * std::sqrt(1.0 - c * c);
+  if (std::abs(beta) >= s.limit || alpha >= s.limit) return;  // outside the cylinder
+  const auto w = static_cast<int>(s.width);
+  int beta_bin = static_cast<int>(std::floor(beta / s.bin)) + w;
+  int alpha_bin = static_cast<int>(std::floor(alpha / s.bin));
+  if (alpha_bin == w) {  // on the border: the last cell, a just below 1
+    --alpha_bin;
+    alpha = s.bin * (alpha_bin + 1) - std::numeric_limits<double>::epsilon();
+  }
+  if (beta_bin == 2 * w) {
+    --beta_bin;
+    beta = s.bin * (beta_bin - w + 1) - std::numeric_limits<double>::epsilon();
+  }
+  if (alpha_bin < 0 || beta_bin < 0) return;  // unreachable for finite input; never write outside
+  const double a = alpha / s.bin - static_cast<double>(alpha_bin);
+  const double b = beta / s.bin - static_cast<double>(beta_bin - w);
+  double* row = acc + static_cast<std::size_t>(alpha_bin) * s.columns;
+  const auto j = static_cast<std::size_t>(beta_bin);
+  row[j] += (1 - a) * (1 - b);
+  row[s.columns + j] += a * (1 - b);
+  row[j + 1] += (1 - a) * b;
+  row[s.columns + j + 1] += a * b;
+}
+
+/// The scalar neighbour test for points [begin, end): the operation order the SIMD body uses.
+/// @return the neighbours found (within R, the keypoint included).
+inline std::size_t spin_range(const SpinSetup& s, const SpinKey& k, PointsView points,
+                              PointsView normals, std::size_t begin, std::size_t end,
+                              double* acc) noexcept {
+  std::size_t found = 0;
+  for (std::size_t p = begin; p < end; ++p) {
+    const float dx = points.x[p] - k.x;
+    const float dy = points.y[p] - k.y;
+    const float dz = points.z[p] - k.z;
+    const float d2 = dx * dx + dy * dy + dz * dz;
+    if (!(d2 < s.radius2)) continue;  // NaN is never a neighbour
+    ++found;
+    const float dot = dx * k.nx + dy * k.ny + dz * k.nz;
+    spin_bin(s, k, normals, p, std::sqrt(d2), dot, acc);
+  }
+  return found;
+}
+
+struct SpinNeighboursKernel {
+  template <class Arch>
+  std::size_t operator()(Arch arch, const SpinSetup& s, const SpinKey& k, PointsView points,
+                         PointsView normals, double* acc) const noexcept;
+};
+
+}  // namespace orthoflow::kernels::detail
