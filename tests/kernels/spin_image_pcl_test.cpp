@@ -15,41 +15,18 @@
 #include <pcl/search/kdtree.h>
 #include <pcl/features/impl/spin_image.hpp>
 
+#include "bench/vs_pcl/mug_view.hpp"
 #include "kernels/spin_image.hpp"
 
 namespace ok = orthoflow::kernels;
 
 namespace {
 
-// A mug-like view: the near half of a cylinder wall (radius 4 cm, height 10 cm), its rim and a
-// handle-like lump, with 1 mm noise; seeded.
-pcl::PointCloud<pcl::PointXYZ>::Ptr object_view(std::uint32_t seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<float> u(0.0F, 1.0F);
-  std::normal_distribution<float> noise(0.0F, 0.001F);
-  auto cloud = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
-  for (int i = 0; i < 2500; ++i) {
-    const float a = 3.14159F * u(rng), h = 0.1F * u(rng);
-    cloud->push_back(
-        {0.04F * std::cos(a) + noise(rng), -0.04F * std::sin(a) + noise(rng), h + noise(rng)});
-  }
-  for (int i = 0; i < 400; ++i) {
-    const float a = 6.2832F * u(rng);
-    const float r = 0.035F + 0.005F * u(rng);
-    cloud->push_back({r * std::cos(a), r * std::sin(a), 0.1F + noise(rng)});
-  }
-  for (int i = 0; i < 300; ++i) {
-    const float a = 3.14159F * u(rng);
-    cloud->push_back({0.05F + 0.02F * std::sin(a) + noise(rng), noise(rng) + 0.004F * u(rng),
-                      0.05F + 0.03F * std::cos(a)});
-  }
-  return cloud;
-}
-
 template <int N>
 void compare_with_pcl(std::uint32_t width, float support, float angle_cos) {
   ASSERT_EQ(static_cast<std::size_t>(N), ok::spin_image_bins(width));
-  const auto cloud = object_view(width * 31 + static_cast<std::uint32_t>(support * 1000));
+  const auto cloud =
+      orthoflow::bench::mug_view(width * 31 + static_cast<std::uint32_t>(support * 1000));
   auto normals = std::make_shared<pcl::PointCloud<pcl::Normal>>();
   pcl::NormalEstimation<pcl::PointXYZ, pcl::Normal> ne;
   ne.setInputCloud(cloud);
