@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "kernels/set_distance.hpp"
+#include "kernels/simd_arch.hpp"
 
 namespace ok = orthoflow::kernels;
 
@@ -27,6 +28,7 @@ void BM_SetDistance(benchmark::State& state) {
                                   : ok::set_distance_scalar(u, stored, scratch));
   }
   state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(n * n));
+  if (SIMD) state.SetLabel(ok::simd_arch_name());
 }
 
 }  // namespace

@@ -16,6 +16,7 @@
 #include <pcl/features/impl/spin_image.hpp>
 
 #include "bench/vs_pcl/mug_view.hpp"
+#include "kernels/simd_arch.hpp"
 #include "kernels/spin_image.hpp"
 
 namespace ok = orthoflow::kernels;
@@ -80,6 +81,7 @@ void BM_SpinImages(benchmark::State& state) {
   }
   state.counters["keypoints"] = static_cast<double>(v.our_keys.size());
   state.counters["points"] = static_cast<double>(v.x.size());
+  if (SIMD) state.SetLabel(ok::simd_arch_name());
 }
 
 template <int N>
