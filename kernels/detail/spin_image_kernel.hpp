@@ -29,15 +29,30 @@ struct SpinKey {
   float nx, ny, nz;
 };
 
-/// Adds neighbour @p p (|d| = @p norm, d . n = @p dot, both float) to @p acc; PCL's rule.
-inline void spin_bin(const SpinSetup& s, const SpinKey& k, PointsView normals, std::size_t p,
-                     float norm, float dot, double* acc) noexcept {
-  if (s.angle_cos > 0.0) {
-    const float nn = k.nx * normals.x[p] + k.ny * normals.y[p] + k.nz * normals.z[p];
-    double c = static_cast<double>(nn);
-    c = std::max(-1.0, std::min(1.0, c));  // NaN becomes 1, as in PCL
-    if (std::abs(c) < s.angle_cos) return;
-  }
+/// Adds the four bilinear weights of cell (@p alpha_bin, @p beta_bin) to @p acc.
+inline void spin_scatter(const SpinSetup& s, double* acc, int alpha_bin, int beta_bin, double w00,
+                         double w10, double w01, double w11) noexcept {
+  double* row = acc + static_cast<std::size_t>(alpha_bin) * s.columns;
+  const auto j = static_cast<std::size_t>(beta_bin);
+  row[j] += w00;
+  row[s.columns + j] += w10;
+  row[j + 1] += w01;
+  row[s.columns + j + 1] += w11;
+}
+
+/// False when neighbour @p p's normal is too far from the keypoint's (the support angle; PCL's
+/// rule: |cos| below angle_cos, a NaN cosine taken as 1).
+inline bool spin_angle_ok(const SpinSetup& s, const SpinKey& k, PointsView normals,
+                          std::size_t p) noexcept {
+  if (s.angle_cos <= 0.0) return true;
+  const float nn = k.nx * normals.x[p] + k.ny * normals.y[p] + k.nz * normals.z[p];
+  double c = static_cast<double>(nn);
+  c = std::max(-1.0, std::min(1.0, c));  // NaN becomes 1, as in PCL
+  return !(std::abs(c) < s.angle_cos);
+}
+
+/// Adds a neighbour at |d| = @p norm with d . n = @p dot (both float) to @p acc: PCL's rule.
+inline void spin_bin(const SpinSetup& s, float norm, float dot, double* acc) noexcept {
   const auto dn = static_cast<double>(norm);
   if (std::abs(dn) < 10 * std::numeric_limits<double>::epsilon()) return;  // the keypoint itself
   double c = static_cast<double>(dot) / dn;
@@ -59,12 +74,7 @@ inline void spin_bin(const SpinSetup& s, const SpinKey& k, PointsView normals, s
   if (alpha_bin < 0 || beta_bin < 0) return;  // unreachable for finite input; never write outside
   const double a = alpha / s.bin - static_cast<double>(alpha_bin);
   const double b = beta / s.bin - static_cast<double>(beta_bin - w);
-  double* row = acc + static_cast<std::size_t>(alpha_bin) * s.columns;
-  const auto j = static_cast<std::size_t>(beta_bin);
-  row[j] += (1 - a) * (1 - b);
-  row[s.columns + j] += a * (1 - b);
-  row[j + 1] += (1 - a) * b;
-  row[s.columns + j + 1] += a * b;
+  spin_scatter(s, acc, alpha_bin, beta_bin, (1 - a) * (1 - b), a * (1 - b), (1 - a) * b, a * b);
 }
 
 /// The scalar neighbour test for points [begin, end): the operation order the SIMD body uses.
@@ -80,8 +90,9 @@ inline std::size_t spin_range(const SpinSetup& s, const SpinKey& k, PointsView p
     const float d2 = dx * dx + dy * dy + dz * dz;
     if (!(d2 < s.radius2)) continue;  // NaN is never a neighbour
     ++found;
+    if (!spin_angle_ok(s, k, normals, p)) continue;
     const float dot = dx * k.nx + dy * k.ny + dz * k.nz;
-    spin_bin(s, k, normals, p, std::sqrt(d2), dot, acc);
+    spin_bin(s, std::sqrt(d2), dot, acc);
   }
   return found;
 }
