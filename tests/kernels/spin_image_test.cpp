@@ -210,7 +210,8 @@ TEST_P(SpinImageTwins, EverySimdVariantEqualsTheScalarTwinBitForBit) {
       auto b = ok::spin_images(c.points(), c.normals(), keys, p, simd);
       ASSERT_TRUE(a.has_value() && b.has_value());
       EXPECT_EQ(a.value(), b.value());
-      EXPECT_EQ(std::memcmp(twin.data(), simd.data(), twin.size() * sizeof(float)), 0)
+      EXPECT_TRUE(twin.empty() ||
+                  std::memcmp(twin.data(), simd.data(), twin.size() * sizeof(float)) == 0)
           << "n " << n << " width " << k.width;
       if (kind == Kind::RANDOM && n >= 16) { EXPECT_GT(a.value(), 0U); }
       // Each compiled variant's neighbour search, keypoint by keypoint, against the twin's.
