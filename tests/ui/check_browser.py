@@ -95,15 +95,23 @@ class Browser:
         self.base = driver_url
         # No background networking, updates, sync or first-run work: the machines this runs on have
         # no network beyond loopback, and Chromium's own attempts to reach it only slow it down.
-        options = {"binary": chromium,
-                   "args": ["--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
-                            "--disable-quic", "--no-first-run", "--no-default-browser-check",
-                            "--disable-background-networking", "--disable-component-update",
-                            "--disable-sync", "--disable-extensions",
-                            "--window-size=1280,1100", f"--user-data-dir={work / 'profile'}"]}
-        caps = {"capabilities": {"alwaysMatch": {"browserName": "chrome", "goog:chromeOptions": options,
-                                                 "goog:loggingPrefs": {"browser": "ALL"}}}}
-        status, reply = http("POST", f"{self.base}/session", caps, timeout=60)
+        # A browser that fails to start (seen once on a loaded 2-core machine: the session was
+        # refused within seconds) is started again, with a profile of its own, twice at most; each
+        # refusal is printed.
+        for attempt in range(3):
+            options = {"binary": chromium,
+                       "args": ["--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
+                                "--disable-quic", "--no-first-run", "--no-default-browser-check",
+                                "--disable-background-networking", "--disable-component-update",
+                                "--disable-sync", "--disable-extensions",
+                                "--window-size=1280,1100", f"--user-data-dir={work / f'profile{attempt}'}"]}
+            caps = {"capabilities": {"alwaysMatch": {"browserName": "chrome", "goog:chromeOptions": options,
+                                                     "goog:loggingPrefs": {"browser": "ALL"}}}}
+            status, reply = http("POST", f"{self.base}/session", caps, timeout=60)
+            if status == 200:
+                break
+            step(f"the browser did not start (attempt {attempt + 1}): {str(reply)[:300]}")
+            time.sleep(2)
         expect(status == 200, f"no browser session: {reply}")
         self.session = f"{self.base}/session/{reply['value']['sessionId']}"
 
