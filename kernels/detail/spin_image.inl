@@ -1,12 +1,14 @@
 #pragma once
 // SIMD body of spin_images(), in two passes per chunk of neighbours (compiled with
 // -ffp-contract=off, so every operation rounds as the scalar twin's does):
-// 1. float batches of points: the neighbour test, |d| and d . n, in the twin's operation order; the
-//    neighbours that pass the support angle (scalar, per neighbour) are collected in order;
+// 1. float batches of points: the neighbour test and d . n in the twin's operation order; for the
+//    neighbours that pass the support angle (scalar, per neighbour), |d| by std::sqrt, collected in
+//    order;
 // 2. double batches of those neighbours: PCL's binning (cosine, alpha, beta, the cylinder, cells,
 //    the border rule, the four bilinear weights) in the twin's operations, then the weights are
 //    added to the image one neighbour at a time, in order. The image equals the twin's bit for bit.
 #include <array>
+#include <cmath>
 
 #include "kernels/detail/spin_image_kernel.hpp"
 
@@ -84,7 +86,6 @@ std::size_t SpinNeighboursKernel::operator()(Arch /*arch*/, const SpinSetup& s, 
   const batch kx(k.x), ky(k.y), kz(k.z), nx(k.nx), ny(k.ny), nz(k.nz), r2(s.radius2);
   std::size_t found = 0;
   std::size_t i = 0;
-  alignas(64) float norm[LANES];
   alignas(64) float dot[LANES];
   alignas(64) float dist2[LANES];
   SpinChunk chunk;
@@ -95,13 +96,14 @@ std::size_t SpinNeighboursKernel::operator()(Arch /*arch*/, const SpinSetup& s, 
     const batch d2 = dx * dx + dy * dy + dz * dz;
     if (!xsimd::any(d2 < r2)) continue;
     d2.store_aligned(dist2);
-    xsimd::sqrt(d2).store_aligned(norm);
     (dx * nx + dy * ny + dz * nz).store_aligned(dot);
     for (std::size_t l = 0; l < LANES; ++l) {
       if (!(dist2[l] < s.radius2)) continue;
       ++found;
       if (!spin_angle_ok(s, k, normals, i + l)) continue;
-      chunk.norm[chunk.size] = static_cast<double>(norm[l]);
+      // |d| by std::sqrt, one neighbour at a time: xsimd 8.1's float sqrt on neon64 is an
+      // estimate refined by Newton steps, not the correctly rounded root the twin takes.
+      chunk.norm[chunk.size] = static_cast<double>(std::sqrt(dist2[l]));
       chunk.dot[chunk.size] = static_cast<double>(dot[l]);
       if (++chunk.size == SPIN_CHUNK) {
         bin_chunk<Arch>(s, chunk, acc);

@@ -29,6 +29,11 @@ struct SpinKey {
   float nx, ny, nz;
 };
 
+// The shared rule has internal linkage: every unit (the scalar twin's, each architecture's, a
+// test's) keeps the copy compiled with its own flags, never another unit's (an inline function's
+// one definition could otherwise be the AVX-512 unit's, or one with fused multiply-adds).
+namespace {
+
 /// Adds the four bilinear weights of cell (@p alpha_bin, @p beta_bin) to @p acc.
 inline void spin_scatter(const SpinSetup& s, double* acc, int alpha_bin, int beta_bin, double w00,
                          double w10, double w01, double w11) noexcept {
@@ -96,6 +101,8 @@ inline std::size_t spin_range(const SpinSetup& s, const SpinKey& k, PointsView p
   }
   return found;
 }
+
+}  // namespace
 
 struct SpinNeighboursKernel {
   template <class Arch>
