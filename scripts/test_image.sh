@@ -81,7 +81,8 @@ boot() {
     sleep 8
     if ! kill -0 "$qpid" 2>/dev/null || grep -q 'KVM internal error\|emulation failure' "$scratch/qemu-$n.log"; then
       note "boot $n: KVM cannot run the guest here ($(head -n 1 "$scratch/qemu-$n.log")): emulation from now on"
-      kill -9 "$qpid" 2>/dev/null; wait "$qpid" 2>/dev/null || true
+      kill -9 "$qpid" 2>/dev/null || true  # qemu may have exited already (it aborts on some hosts)
+      wait "$qpid" 2>/dev/null || true
       accel="-accel tcg,thread=multi -cpu $cpu_tcg" accel_name=tcg
       start_qemu "$n" "$@"
     fi
