@@ -63,14 +63,7 @@ Result<std::size_t, SpinImageError> run(PointsView points, PointsView normals,
     return err(
         SpinImageError{Code::OUTPUT_TOO_SMALL, static_cast<double>(keypoints.size() * bins)});
 
-  detail::SpinSetup s;
-  s.width = w;
-  const double radius = params.support_length;
-  s.bin = radius / w / std::sqrt(2.0);
-  s.limit = s.bin * w;
-  s.radius2 = static_cast<float>(radius * radius);
-  s.angle_cos = params.support_angle_cos;
-  s.columns = 2 * static_cast<std::size_t>(w) + 1;
+  const detail::SpinSetup s = detail::make_spin_setup(params);
   std::array<double, spin_image_bins(MAX_SPIN_IMAGE_WIDTH)> acc{};
   std::size_t described = 0;
   for (std::size_t j = 0; j < keypoints.size(); ++j) {

@@ -23,7 +23,20 @@ struct SpinSetup {
   std::size_t columns = 0;  // 2W + 1
 };
 
-/// One keypoint: its position, normal and index.
+/// The constants of a call with @p p (validated by the caller).
+inline SpinSetup make_spin_setup(const SpinImageParams& p) noexcept {
+  SpinSetup s;
+  s.width = p.image_width;
+  const double radius = p.support_length;
+  s.bin = radius / p.image_width / std::sqrt(2.0);
+  s.limit = s.bin * p.image_width;
+  s.radius2 = static_cast<float>(radius * radius);
+  s.angle_cos = p.support_angle_cos;
+  s.columns = 2 * static_cast<std::size_t>(p.image_width) + 1;
+  return s;
+}
+
+/// One keypoint: its position and normal.
 struct SpinKey {
   float x, y, z;
   float nx, ny, nz;

@@ -215,13 +215,7 @@ TEST_P(SpinImageTwins, EverySimdVariantEqualsTheScalarTwinBitForBit) {
           << "n " << n << " width " << k.width;
       if (kind == Kind::RANDOM && n >= 16) { EXPECT_GT(a.value(), 0U); }
       // Each compiled variant's neighbour search, keypoint by keypoint, against the twin's.
-      ok::detail::SpinSetup s;
-      s.width = k.width;
-      s.bin = static_cast<double>(k.support) / k.width / std::sqrt(2.0);
-      s.limit = s.bin * k.width;
-      s.radius2 = static_cast<float>(static_cast<double>(k.support) * k.support);
-      s.angle_cos = k.angle_cos;
-      s.columns = 2 * k.width + 1;
+      const ok::detail::SpinSetup s = ok::detail::make_spin_setup(p);
       for (std::size_t i = 0; i < n; ++i) {
         const ok::detail::SpinKey key{c.x[i], c.y[i], c.z[i], c.nx[i], c.ny[i], c.nz[i]};
         std::vector<double> want(bins, 0.0);
