@@ -1,9 +1,10 @@
 // `orthoflow evaluate --dataset DIR --protocol cv10|teacher|teacher-context|noise|downsample
-// [--learner instance,bayes] [--approach nn,1,2] [--good-mode invariant,reference] [--bins 5,15]
-// [--runs R]
+// [--learner instance,bayes] [--approach nn,1,2] [--representation good,bow --dictionary FILE]
+// [--good-mode invariant,reference] [--bins 5,15] [--runs R]
 // [--seed S] [--folds K] [--levels MM,...] [--tau T] [--breakpoint N] [--threads N] [--out DIR]
 // [--cache DIR | --no-cache]`: the thesis's evaluations (evaluation/, docs/EVALUATION.md). Comma
 // lists give every combination as one variant, all evaluated on the same folds, orders and views.
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
@@ -14,6 +15,7 @@
 #include "apps/commands.hpp"
 #include "evaluation/progress.hpp"
 #include "evaluation/report.hpp"
+#include "learning/dictionary.hpp"
 
 namespace orthoflow::apps {
 namespace {
@@ -25,6 +27,8 @@ struct EvaluateOptions {
   std::vector<std::string> approaches{"nn"};
   std::vector<std::string> modes{"invariant"};
   std::vector<std::size_t> bins{15};
+  std::vector<std::string> representations{"good"};
+  std::string dictionary;
   std::vector<double> levels_mm;
   std::size_t runs = 10;
   std::uint64_t seed = 1;
@@ -51,14 +55,29 @@ evaluation::Protocol protocol_of(const std::string& p) {
   return evaluation::Protocol::CV10;
 }
 
-/// Every combination of the listed learners, rules, modes and bins (rules apply to instance only).
-std::vector<evaluation::Variant> variants_of(const EvaluateOptions& o) {
+/// Every combination of the listed learners, rules, representations, modes and bins (rules apply
+/// to instance only; modes and bins to GOOD only).
+std::vector<evaluation::Variant> variants_of(
+    const EvaluateOptions& o, const std::shared_ptr<const kernels::VisualDictionary>& dictionary) {
   std::vector<evaluation::Variant> out;
   for (const std::string& l : o.learners) {
     const bool bayes = l == "bayes";
     const std::vector<std::string> rules = bayes ? std::vector<std::string>{"nn"} : o.approaches;
     for (const std::string& a : rules) {
-      for (const std::string& m : o.modes) {
+      for (const std::string& r : o.representations) {
+        if (r != "bow") continue;
+        evaluation::Variant v;
+        v.learner = bayes ? evaluation::LearnerKind::BAYES : evaluation::LearnerKind::INSTANCE;
+        v.rule = a == "1"   ? evaluation::InstanceRule::APPROACH_1
+                 : a == "2" ? evaluation::InstanceRule::APPROACH_2
+                            : evaluation::InstanceRule::NEAREST;
+        v.representation = kernels::DescriptorKind::BOW;
+        v.dictionary = dictionary;
+        out.push_back(v);
+      }
+      const bool good = std::find(o.representations.begin(), o.representations.end(), "good") !=
+                        o.representations.end();
+      for (const std::string& m : good ? o.modes : std::vector<std::string>{}) {
         for (const std::size_t b : o.bins) {
           evaluation::Variant v;
           v.learner = bayes ? evaluation::LearnerKind::BAYES : evaluation::LearnerKind::INSTANCE;
@@ -100,9 +119,20 @@ int exit_code_of(const evaluation::EvalError& e) {
 void run_evaluate(const EvaluateOptions& o) {
   auto dataset = evaluation::scan_dataset(o.dataset);
   if (!dataset) { fail(dataset.error().to_string(), EXIT_BAD_INPUT); }
+  std::shared_ptr<const kernels::VisualDictionary> dictionary;
+  const bool bow = std::find(o.representations.begin(), o.representations.end(), "bow") !=
+                   o.representations.end();
+  if (bow && o.dictionary.empty()) {
+    fail("--representation bow needs --dictionary FILE (orthoflow dictionary build)", EXIT_USAGE);
+  }
+  if (bow) {
+    auto d = learning::load_dictionary(o.dictionary);
+    if (!d) { fail(d.error(), EXIT_BAD_INPUT); }
+    dictionary = std::make_shared<const kernels::VisualDictionary>(std::move(d.value()));
+  }
   evaluation::EvalOptions eo;
   eo.protocol = protocol_of(o.protocol);
-  eo.variants = variants_of(o);
+  eo.variants = variants_of(o, dictionary);
   eo.runs = o.runs;
   eo.seed = o.seed;
   eo.folds = o.folds;
@@ -155,6 +185,12 @@ void add_evaluate_command(CLI::App& app) {
                   "instance rule(s): nn (nearest neighbour), 1, 2 (thesis NOCD approaches)")
       ->delimiter(',')
       ->check(CLI::IsMember({"nn", "1", "2"}));
+  cmd->add_option("--representation", o->representations,
+                  "good and/or bow (comma list; bow: a bag of words over --dictionary's words)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"good", "bow"}));
+  cmd->add_option("--dictionary", o->dictionary,
+                  "bow: the visual words (a file from `orthoflow dictionary build`)");
   cmd->add_option("--good-mode", o->modes, "invariant and/or reference (comma list)")
       ->delimiter(',')
       ->check(CLI::IsMember({"invariant", "reference"}));

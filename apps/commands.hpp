@@ -75,6 +75,8 @@ void add_ui_command(CLI::App& app);
 /// @brief `evaluate --dataset DIR --protocol ...`: cross-validation, simulated teacher, context
 /// change, robustness.
 void add_evaluate_command(CLI::App& app);
+/// @brief `orthoflow dictionary build|show`: the bag of words' visual words (cmd_dictionary.cpp).
+void add_dictionary_command(CLI::App& app);
 /// @brief `derive-views FILE... --out DIR`: partial views of single object views, as a dataset
 /// (registered by add_evaluate_command).
 void add_derive_views_command(CLI::App& app);

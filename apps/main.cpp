@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
   orthoflow::apps::add_ui_command(app);
   orthoflow::apps::add_remote_commands(app);
   orthoflow::apps::add_evaluate_command(app);
+  orthoflow::apps::add_dictionary_command(app);
   orthoflow::apps::add_evaluate_segmentation_command(app);
   orthoflow::apps::add_bench_command(app);
   orthoflow::apps::add_kinect_command(app);

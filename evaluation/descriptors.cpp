@@ -70,6 +70,9 @@ Result<void, EvalError> check_spec(const ViewDescription& spec) {
                          "bins must be in 1.." + std::to_string(kernels::GOOD_MAX_BINS) + ", got " +
                              std::to_string(spec.descriptor.good.bins)});
   }
+  if (auto valid = spec.descriptor.validate(); !valid) {
+    return err(EvalError{EvalError::Code::BAD_CONFIG, valid.error()});
+  }
   if (!std::isfinite(spec.amount_m) || spec.amount_m < 0.0 ||
       (spec.perturbation == Perturbation::DOWNSAMPLE && spec.amount_m <= 0.0)) {
     return err(EvalError{EvalError::Code::BAD_CONFIG,
@@ -117,10 +120,16 @@ std::vector<std::uint8_t> fill_from_cache(const Dataset& ds, const DescriptorCac
 std::string ViewDescription::key() const {
   // "good-invariant-15-none": the same key as before the specification existed, so caches stay
   // valid.
+  // "bow-<dictionary id>-none": a dictionary's words and parameters are all in its id.
   const kernels::GoodConfig& good = descriptor.good;
-  std::string k = std::string(kernels::to_string(descriptor.kind)) + "-" +
-                  (good.mode == kernels::GoodMode::INVARIANT ? "invariant" : "reference") + "-" +
-                  std::to_string(good.bins) + "-" + perturbation_name(perturbation);
+  std::string k = std::string(kernels::to_string(descriptor.kind)) + "-";
+  if (descriptor.kind == kernels::DescriptorKind::BOW && descriptor.dictionary) {
+    k += kernels::dictionary_id_hex(descriptor.dictionary->id) + "-" +
+         perturbation_name(perturbation);
+  } else {
+    k += std::string(good.mode == kernels::GoodMode::INVARIANT ? "invariant" : "reference") + "-" +
+         std::to_string(good.bins) + "-" + perturbation_name(perturbation);
+  }
   if (perturbation != Perturbation::NONE) {
     k += "-" + std::to_string(std::llround(amount_m * 1e6)) + "um";
   }

@@ -13,16 +13,26 @@ std::string Variant::name() const {
          : rule == InstanceRule::APPROACH_1 ? "-nocd1"
                                             : "-nocd2";
   }
+  if (representation == kernels::DescriptorKind::BOW) {
+    return n + "/bow/" + std::to_string(dictionary ? dictionary->words : 0);
+  }
   n += mode == kernels::GoodMode::INVARIANT ? "/invariant/" : "/reference/";
   return n + std::to_string(bins);
 }
 
+kernels::DescriptorSpec Variant::spec() const {
+  if (representation == kernels::DescriptorKind::BOW) {
+    return kernels::DescriptorSpec::make_bow(dictionary);
+  }
+  return kernels::DescriptorSpec::make_good(bins, mode);
+}
+
 ViewDescription Variant::descriptor(Perturbation p, double amount_m, std::uint64_t seed) const {
-  return ViewDescription{kernels::DescriptorSpec::make_good(bins, mode), p, amount_m, seed};
+  return ViewDescription{spec(), p, amount_m, seed};
 }
 
 std::unique_ptr<learning::Learner> Variant::make_learner() const {
-  const std::size_t length = kernels::DescriptorSpec::make_good(bins, mode).length();
+  const std::size_t length = spec().length();
   if (learner == LearnerKind::BAYES) {
     learning::BayesConfig cfg;
     cfg.descriptor_length = length;

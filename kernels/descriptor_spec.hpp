@@ -3,45 +3,58 @@
 /// @brief One descriptor specification: the representation's kind, its parameters and its length
 /// travel together as one value (STYLE rule 18). The describe node, the learners, the perceptual
 /// memory, the evaluation and the CLI ask the specification for the length instead of computing one
-/// of their own, and a store records the specification it was written with. GOOD is the one kind
-/// today; the local-feature representations (spin-image sets, bag of words, topic models) are added
-/// as kinds here.
+/// of their own, and a store records the specification it was written with. Kinds: GOOD, and the
+/// bag of words over spin images (BOW, with its dictionary); the topic models are to come.
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "core/result.hpp"
 #include "kernels/good.hpp"
+#include "kernels/spin_features.hpp"
+#include "kernels/visual_words.hpp"
 
 namespace orthoflow::kernels {
 
 /// @brief The representation a descriptor is.
 enum class DescriptorKind : std::uint8_t {
   GOOD,  ///< the Global Orthographic Object Descriptor: 3 n^2 normalised histogram values
+  BOW,   ///< bag of words: the shares of a view's spin images nearest each word of a dictionary
 };
-/// @brief "good".
+/// @brief "good" or "bow".
 [[nodiscard]] std::string_view to_string(DescriptorKind kind) noexcept;
 
 /// @brief Kind, parameters and length of a descriptor. A plain value; compare with ==.
 struct DescriptorSpec {
   DescriptorKind kind = DescriptorKind::GOOD;
-  GoodConfig good{};  ///< kind GOOD: bins, frame rule and sign threshold (thesis: 15 bins)
+  /// Kind GOOD: bins, frame rule and sign threshold (thesis: 15 bins). Kind BOW: the object frame
+  /// and box a view reports (the grasp planner's) still come from GOOD with these parameters.
+  GoodConfig good{};
+  /// Kind BOW: the dictionary, which carries the spin images' parameters (shared, read-only).
+  std::shared_ptr<const VisualDictionary> dictionary;
 
   /// @brief A GOOD specification.
   [[nodiscard]] static DescriptorSpec make_good(std::size_t bins,
                                                 GoodMode mode = GoodMode::INVARIANT) noexcept;
-  /// @brief Values per descriptor (GOOD: 3 n^2).
+  /// @brief A bag-of-words specification over @p dictionary.
+  [[nodiscard]] static DescriptorSpec make_bow(
+      std::shared_ptr<const VisualDictionary> dictionary) noexcept;
+  /// @brief Values per descriptor (GOOD: 3 n^2; BOW: the dictionary's words).
   [[nodiscard]] std::size_t length() const noexcept;
   /// @brief Every value is a non-negative histogram share (what a naive Bayes learner needs).
   [[nodiscard]] bool histogram() const noexcept;
-  /// @brief Checks the parameters (bins in 1..GOOD_MAX_BINS, a finite non-negative threshold).
+  /// @brief Checks the parameters (bins in 1..GOOD_MAX_BINS, a finite non-negative threshold; BOW:
+  /// a dictionary with words whose length fits its spin images, finite positive leaf and radius).
   [[nodiscard]] Result<void, std::string> validate() const;
-  /// @brief "good bins=15 mode=invariant threshold=0.015": what a mismatch error names.
+  /// @brief "good bins=15 mode=invariant threshold=0.015", "bow words=70 iw=4 sl=0.05 vs=0.01
+  /// nr=0.02 dictionary=3f2a9c0d11e4b7a0": what a mismatch error names.
   [[nodiscard]] std::string describe() const;
   /// @brief Same kind and parameters (GOOD: the effective threshold, so unset equals the mode's
-  /// default).
+  /// default; BOW: the same dictionary id and GOOD parameters).
   [[nodiscard]] bool operator==(const DescriptorSpec& other) const noexcept;
 };
 
@@ -61,13 +74,24 @@ class Describer {
   explicit Describer(const DescriptorSpec& spec);
   [[nodiscard]] const DescriptorSpec& spec() const noexcept { return spec_; }
   /// @brief Writes the descriptor of @p points to the front of @p out. @pre out.size() >=
-  /// spec().length(). Allocation-free. Deterministic (SIMD tolerance as compute_good()).
+  /// spec().length(). GOOD: allocation-free. BOW: allocation-free once a view of as many points
+  /// has been described (its scratch grows to the largest view). Deterministic (SIMD tolerance as
+  /// compute_good(); the words are exact, kernels/visual_words.hpp).
   [[nodiscard]] Result<DescriptorInfo, GoodError> describe(PointsView points,
                                                            std::span<float> out) noexcept;
+  /// @brief BOW: the spin images counted in the last describe() (0 for GOOD).
+  [[nodiscard]] std::size_t features() const noexcept { return features_; }
 
  private:
+  /// BOW: the view's spin features, then their words.
+  [[nodiscard]] Result<void, GoodError> describe_bow(PointsView points, std::span<float> out);
+
   DescriptorSpec spec_;
   GoodScratch good_scratch_;
+  std::vector<float> good_values_;  ///< BOW: GOOD's values, for its frame and box only
+  SpinFeatures features_scratch_;
+  std::vector<float> word_scratch_;
+  std::size_t features_ = 0;
 };
 
 }  // namespace orthoflow::kernels

@@ -188,6 +188,11 @@ const char* to_string(GoodError error) noexcept {
       return "compute_good: the GoodScratch was made for fewer bins than requested";
     case GoodError::OUT_OF_MEMORY:
       return "compute_good: out of memory for a copy of the view without its far points";
+    case GoodError::KEYPOINTS_FAILED:
+      return "bag of words: the keypoints' voxel grid refused the view (too wide for its leaf)";
+    case GoodError::NO_FEATURES:
+      return "bag of words: no spin image of the view has weight (too few points within the "
+             "support length)";
   }
   return "compute_good: unknown error";
 }

@@ -85,6 +85,9 @@ enum class GoodError : std::uint8_t {
   OUTPUT_TOO_SMALL,   ///< descriptor_out holds fewer than 3 n^2 values
   SCRATCH_TOO_SMALL,  ///< the scratch was made for fewer bins than requested
   OUT_OF_MEMORY,      ///< the scratch could not grow to hold a view without its far points
+  /// Describer, bag of words: the keypoints' voxel grid refused the view (too wide for its leaf).
+  KEYPOINTS_FAILED,
+  NO_FEATURES,  ///< Describer, bag of words: no spin image has weight (a view too small or sparse)
 };
 /// @brief What the error means, as a sentence naming compute_good and the offending value's role.
 [[nodiscard]] const char* to_string(GoodError error) noexcept;

@@ -1,0 +1,176 @@
+// `orthoflow dictionary build --from DIR... --out FILE [--words 70] [--image-width 4]
+// [--support-length 0.05] [--keypoint-leaf 0.01] [--normal-radius 0.02] [--seed 1]
+// [--iterations 100] [--threads N]` and `orthoflow dictionary show FILE [--json]`: the dictionary
+// of visual words of the bag-of-words representation (learning/dictionary.hpp,
+// docs/SPIN_IMAGES.md). `build` is the thesis's exploration stage: every object view (*.pcd) under
+// the directories, labelled or not, is described by its spin images at its keypoints, and k-means
+// makes the pool into words. The same files, parameters and seed give the same file, whatever the
+// threads.
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "apps/commands.hpp"
+#include "formats/pcd_io.hpp"
+#include "kernels/spin_features.hpp"
+#include "learning/dictionary.hpp"
+
+namespace orthoflow::apps {
+namespace {
+
+struct DictionaryOptions {
+  std::vector<std::string> from;
+  std::string out;
+  std::size_t words = 70;
+  std::uint32_t image_width = 4;
+  float support_length = 0.05F;
+  float keypoint_leaf = 0.01F;
+  float normal_radius = 0.02F;
+  std::uint64_t seed = 1;
+  std::uint32_t iterations = 100;
+  std::size_t threads = 0;
+  std::string file;
+  bool json = false;
+};
+
+[[noreturn]] void fail(const std::string& message, int code) {
+  std::cerr << "orthoflow dictionary: " << message << '\n';
+  throw CLI::RuntimeError(code);
+}
+
+/// Every *.pcd under the directories (or the files named), sorted: the pool's order.
+std::vector<std::filesystem::path> views_under(const std::vector<std::string>& roots) {
+  std::vector<std::filesystem::path> out;
+  for (const std::string& root : roots) {
+    std::error_code ec;
+    if (std::filesystem::is_regular_file(root, ec)) {
+      out.emplace_back(root);
+      continue;
+    }
+    if (!std::filesystem::is_directory(root, ec))
+      fail(root + " is not a directory", EXIT_BAD_INPUT);
+    for (auto it = std::filesystem::recursive_directory_iterator(root, ec);
+         !ec && it != std::filesystem::recursive_directory_iterator(); it.increment(ec)) {
+      if (it->is_regular_file() && it->path().extension() == ".pcd") out.push_back(it->path());
+    }
+    if (ec) fail("cannot list " + root + ": " + ec.message(), EXIT_BAD_INPUT);
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+void run_build(const DictionaryOptions& o) {
+  const auto files = views_under(o.from);
+  if (files.empty()) fail("no *.pcd object view under the given directories", EXIT_BAD_INPUT);
+  kernels::SpinFeatureParams params;
+  params.spin.image_width = o.image_width;
+  params.spin.support_length = o.support_length;
+  params.keypoint_leaf = o.keypoint_leaf;
+  params.normal_radius = o.normal_radius;
+  std::optional<tbb::global_control> threads;
+  if (o.threads > 0) threads.emplace(tbb::global_control::max_allowed_parallelism, o.threads);
+  // Each view's images in its own slot, then joined in file order: the pool does not depend on
+  // the threads.
+  std::vector<std::vector<float>> images(files.size());
+  std::vector<std::string> errors(files.size());
+  tbb::enumerable_thread_specific<kernels::SpinFeatures> scratch;
+  tbb::parallel_for(std::size_t{0}, files.size(), [&](std::size_t i) {
+    auto cloud = formats::read_pcd(files[i]);
+    if (!cloud) {
+      errors[i] = files[i].string() + ": " + cloud.error().to_string();
+      return;
+    }
+    kernels::SpinFeatures& features = scratch.local();
+    auto k = features.compute(cloud->points(), params);
+    if (!k) {
+      errors[i] = files[i].string() + ": " + kernels::to_string(k.error());
+      return;
+    }
+    images[i].assign(features.images().begin(), features.images().end());
+  });
+  for (const std::string& e : errors)
+    if (!e.empty()) fail(e, EXIT_BAD_INPUT);
+  std::vector<float> pool;
+  for (const auto& v : images) pool.insert(pool.end(), v.begin(), v.end());
+  learning::KMeansParams km;
+  km.k = o.words;
+  km.seed = o.seed;
+  km.max_iterations = o.iterations;
+  std::string provenance = std::to_string(files.size()) + " views under";
+  for (const std::string& root : o.from) provenance += " " + root;
+  auto d = learning::build_dictionary(pool, params, km, provenance);
+  if (!d) fail(d.error(), EXIT_USAGE);
+  if (const std::string why = learning::save_dictionary(*d, o.out); !why.empty())
+    fail(why, EXIT_FAILURE_GENERIC);
+  std::cout << "dictionary " << kernels::dictionary_id_hex(d->id) << ": " << d->words
+            << " words of " << d->dims << " values; " << d->provenance << "\nwrote " << o.out
+            << '\n';
+}
+
+void run_show(const DictionaryOptions& o) {
+  auto d = learning::load_dictionary(o.file);
+  if (!d) fail(d.error(), EXIT_BAD_INPUT);
+  if (o.json) {
+    const nlohmann::json j{{"id", kernels::dictionary_id_hex(d->id)},
+                           {"words", d->words},
+                           {"dims", d->dims},
+                           {"image_width", d->spin.image_width},
+                           {"support_length_m", d->spin.support_length},
+                           {"support_angle_cos", d->spin.support_angle_cos},
+                           {"keypoint_leaf_m", d->keypoint_leaf},
+                           {"normal_radius_m", d->normal_radius},
+                           {"provenance", d->provenance}};
+    std::cout << j.dump() << '\n';
+    return;
+  }
+  std::cout << "dictionary " << kernels::dictionary_id_hex(d->id) << "\n  words " << d->words
+            << " of " << d->dims << " values\n  spin images: IW " << d->spin.image_width << ", SL "
+            << d->spin.support_length << " m, support angle cos " << d->spin.support_angle_cos
+            << "\n  keypoints: VS " << d->keypoint_leaf << " m; normals: radius "
+            << d->normal_radius << " m\n  provenance: " << d->provenance << '\n';
+}
+
+}  // namespace
+
+void add_dictionary_command(CLI::App& app) {
+  auto o = std::make_shared<DictionaryOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "dictionary", "the visual words of the bag-of-words representation (docs/SPIN_IMAGES.md)");
+  cmd->require_subcommand(1);
+  CLI::App* build = cmd->add_subcommand(
+      "build", "k-means over the spin images of every object view (*.pcd) under DIR...");
+  build->add_option("--from", o->from, "directories (or files) of object views")->required();
+  build->add_option("--out", o->out, "the dictionary file to write")->required();
+  build->add_option("--words", o->words, "dictionary size DS (thesis: 70)")
+      ->check(CLI::Range(1, 65536));
+  build->add_option("--image-width", o->image_width, "spin image width IW (thesis: 4)")
+      ->check(CLI::Range(1, 16));
+  build->add_option("--support-length", o->support_length, "spin image support SL, m (0.05)")
+      ->check(CLI::Range(0.001, 1.0));
+  build->add_option("--keypoint-leaf", o->keypoint_leaf, "keypoints' voxel size VS, m (0.01)")
+      ->check(CLI::Range(0.001, 1.0));
+  build->add_option("--normal-radius", o->normal_radius, "normals' radius, m (0.02)")
+      ->check(CLI::Range(0.001, 1.0));
+  build->add_option("--seed", o->seed, "k-means++ seed");
+  build->add_option("--iterations", o->iterations, "k-means iterations at most")
+      ->check(CLI::Range(1, 100000));
+  build->add_option("--threads", o->threads,
+                    "worker threads (0: all); the words do not depend on it");
+  build->callback([o] { run_build(*o); });
+  CLI::App* show = cmd->add_subcommand("show", "a dictionary's words, parameters and provenance");
+  show->add_option("file", o->file, "dictionary file")->required();
+  show->add_flag("--json", o->json, "one JSON object");
+  show->callback([o] { run_show(*o); });
+}
+
+}  // namespace orthoflow::apps

@@ -1,0 +1,142 @@
+// The dictionary's file (learning/dictionary.hpp): encode, parse (fuzzed), save durably, load.
+#include "learning/dictionary.hpp"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <bit>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+namespace orthoflow::learning {
+
+namespace {
+
+static_assert(std::endian::native == std::endian::little, "the dictionary format is little-endian");
+
+constexpr char MAGIC[4] = {'O', 'F', 'W', 'D'};
+constexpr std::uint32_t VERSION = 1;
+constexpr std::uint64_t MAX_WORDS = 1U << 16;
+constexpr std::uint64_t MAX_PROVENANCE = 1U << 16;
+
+template <class T>
+void put(std::string& out, const T& v) {
+  out.append(reinterpret_cast<const char*>(&v), sizeof(T));
+}
+
+template <class T>
+bool get(std::span<const char>& in, T& v) noexcept {
+  if (in.size() < sizeof(T)) return false;
+  std::memcpy(&v, in.data(), sizeof(T));
+  in = in.subspan(sizeof(T));
+  return true;
+}
+
+}  // namespace
+
+std::string encode_dictionary(const kernels::VisualDictionary& d) {
+  std::string out(MAGIC, sizeof MAGIC);
+  put(out, VERSION);
+  put(out, static_cast<std::uint64_t>(d.words));
+  put(out, static_cast<std::uint64_t>(d.dims));
+  put(out, d.spin.image_width);
+  put(out, d.spin.support_length);
+  put(out, d.spin.support_angle_cos);
+  put(out, d.keypoint_leaf);
+  put(out, d.normal_radius);
+  put(out, d.id);
+  put(out, static_cast<std::uint64_t>(d.provenance.size()));
+  out += d.provenance;
+  out.append(reinterpret_cast<const char*>(d.data.data()), d.data.size() * sizeof(float));
+  return out;
+}
+
+Result<kernels::VisualDictionary, std::string> parse_dictionary(std::span<const char> bytes) {
+  if (bytes.size() < sizeof MAGIC || std::memcmp(bytes.data(), MAGIC, sizeof MAGIC) != 0)
+    return err(std::string("not a dictionary file (no OFWD magic)"));
+  bytes = bytes.subspan(sizeof MAGIC);
+  std::uint32_t version = 0;
+  std::uint64_t words = 0, dims = 0, provenance = 0;
+  kernels::VisualDictionary d;
+  if (!get(bytes, version)) return err(std::string("dictionary file truncated in its header"));
+  if (version != VERSION)
+    return err("dictionary file version " + std::to_string(version) + ", this build reads " +
+               std::to_string(VERSION));
+  if (!get(bytes, words) || !get(bytes, dims) || !get(bytes, d.spin.image_width) ||
+      !get(bytes, d.spin.support_length) || !get(bytes, d.spin.support_angle_cos) ||
+      !get(bytes, d.keypoint_leaf) || !get(bytes, d.normal_radius) || !get(bytes, d.id) ||
+      !get(bytes, provenance))
+    return err(std::string("dictionary file truncated in its header"));
+  if (d.spin.image_width == 0 || d.spin.image_width > kernels::MAX_SPIN_IMAGE_WIDTH ||
+      dims != kernels::spin_image_bins(d.spin.image_width) || words == 0 || words > MAX_WORDS ||
+      provenance > MAX_PROVENANCE)
+    return err("dictionary file header is inconsistent (" + std::to_string(words) + " words of " +
+               std::to_string(dims) + " values, image width " + std::to_string(d.spin.image_width) +
+               ")");
+  if (bytes.size() != provenance + words * dims * sizeof(float))
+    return err("dictionary file holds " + std::to_string(bytes.size()) +
+               " bytes after its header, " +
+               std::to_string(provenance + words * dims * sizeof(float)) + " expected");
+  d.words = words;
+  d.dims = dims;
+  d.provenance.assign(bytes.data(), provenance);
+  bytes = bytes.subspan(provenance);
+  d.data.resize(words * dims);
+  std::memcpy(d.data.data(), bytes.data(), d.data.size() * sizeof(float));
+  if (!std::all_of(d.data.begin(), d.data.end(), [](float v) { return std::isfinite(v); }))
+    return err(std::string("dictionary file has a word value that is not finite"));
+  const std::uint64_t id = kernels::dictionary_id(d);
+  if (id != d.id)
+    return err("dictionary file is corrupt: its words hash to " + kernels::dictionary_id_hex(id) +
+               ", its header says " + kernels::dictionary_id_hex(d.id));
+  return d;
+}
+
+std::string save_dictionary(const kernels::VisualDictionary& d, const std::filesystem::path& path) {
+  const std::string bytes = encode_dictionary(d);
+  const std::filesystem::path tmp = path.string() + ".tmp" + std::to_string(::getpid());
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) return "cannot create " + tmp.string() + ": " + std::strerror(errno);
+  std::size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t w = ::write(fd, bytes.data() + done, bytes.size() - done);
+    if (w < 0 && errno == EINTR) continue;
+    if (w <= 0) {
+      const std::string why = std::strerror(errno);
+      ::close(fd);
+      std::filesystem::remove(tmp);
+      return "cannot write " + tmp.string() + ": " + why;
+    }
+    done += static_cast<std::size_t>(w);
+  }
+  const bool synced = ::fsync(fd) == 0;
+  ::close(fd);
+  std::error_code ec;
+  if (!synced) {
+    std::filesystem::remove(tmp, ec);
+    return "cannot sync " + tmp.string();
+  }
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) {
+    std::filesystem::remove(tmp, ec);
+    return "cannot rename the dictionary into " + path.string() + ": " + ec.message();
+  }
+  return {};
+}
+
+Result<kernels::VisualDictionary, std::string> load_dictionary(const std::filesystem::path& path) {
+  std::ifstream f(path, std::ios::binary);
+  if (!f) return err("cannot open the dictionary " + path.string());
+  std::ostringstream s;
+  s << f.rdbuf();
+  const std::string bytes = s.str();
+  auto d = parse_dictionary(bytes);
+  if (!d) return err(path.string() + ": " + d.error());
+  return d;
+}
+
+}  // namespace orthoflow::learning
