@@ -2,7 +2,8 @@
 // the perceptual memory (learning/perceptual_memory.hpp, docs/LEARNING.md) from the command line.
 // Actions: teach LABEL FILE.pcd..., ask FILE.pcd [--json], correct LABEL FILE.pcd, list, stats,
 // forget LABEL, export FILE, import FILE, calibrate. Descriptors are the store's specification
-// (kernels::Describer; GOOD) of each PCD.
+// (kernels::Describer; GOOD, or a bag of words with --representation bow / --dictionary FILE) of
+// each PCD.
 #include <cmath>
 #include <iostream>
 #include <memory>
@@ -15,6 +16,7 @@
 #include "formats/pcd_io.hpp"
 #include "kernels/descriptor_spec.hpp"
 #include "learning/calibration.hpp"
+#include "learning/dictionary.hpp"
 #include "learning/perceptual_memory.hpp"
 
 namespace orthoflow::apps {
@@ -26,6 +28,8 @@ struct MemoryOptions {
   std::size_t bins = 15;
   std::string mode = "invariant";
   std::optional<float> ct;
+  std::string representation = "good";
+  std::string dictionary;
   std::string label;
   std::vector<std::string> files;
   std::string file;
@@ -41,6 +45,19 @@ learning::MemoryConfig config_of(const MemoryOptions& o) {
   learning::MemoryConfig cfg;
   cfg.descriptor = kernels::DescriptorSpec::make_good(
       o.bins, o.mode == "reference" ? kernels::GoodMode::REFERENCE : kernels::GoodMode::INVARIANT);
+  // A bag-of-words store: with --dictionary, those words (a new store takes them; an existing one
+  // must have them); without, the store's own.
+  if (o.representation == "bow" || !o.dictionary.empty()) {
+    std::shared_ptr<const kernels::VisualDictionary> words;
+    if (!o.dictionary.empty()) {
+      auto d = learning::load_dictionary(o.dictionary);
+      if (!d) { fail(d.error(), EXIT_BAD_INPUT); }
+      words = std::make_shared<const kernels::VisualDictionary>(std::move(d.value()));
+    }
+    const kernels::GoodConfig good = cfg.descriptor.good;
+    cfg.descriptor = kernels::DescriptorSpec::make_bow(std::move(words));
+    cfg.descriptor.good = good;
+  }
   cfg.learner =
       o.learner == "bayes" ? learning::LearnerKind::BAYES : learning::LearnerKind::INSTANCE;
   if (o.ct) { cfg.instance.classification_threshold = *o.ct; }
@@ -199,6 +216,12 @@ void add_memory_command(CLI::App& app) {
       ->check(CLI::IsMember({"instance", "bayes"}));
   cmd->add_option("--bins", o->bins, "GOOD bins per side; must match the store (default 15)")
       ->check(CLI::Range(std::size_t{1}, kernels::GOOD_MAX_BINS));
+  cmd->add_option("--representation", o->representation,
+                  "good, or bow (a bag of words; a new store needs --dictionary, an existing one "
+                  "uses its own)")
+      ->check(CLI::IsMember({"good", "bow"}));
+  cmd->add_option("--dictionary", o->dictionary,
+                  "bow: the visual words (`orthoflow dictionary build`); implies bow");
   cmd->add_option("--mode", o->mode, "GOOD frame mode; must match the store")
       ->check(CLI::IsMember({"invariant", "reference"}));
   cmd->add_option("--ct", o->ct,

@@ -86,14 +86,68 @@ std::optional<CategoryId> key_category(std::string_view key) noexcept {
 }
 
 std::string encode_schema(const kernels::DescriptorSpec& spec) {
-  const nlohmann::json j{
+  nlohmann::json j{
       {"schema", MEMORY_SCHEMA_VERSION},
       {"descriptor", std::string(kernels::to_string(spec.kind))},
       {"bins", spec.good.bins},
       {"mode", spec.good.mode == kernels::GoodMode::INVARIANT ? "invariant" : "reference"},
       {"threshold", spec.good.effective_threshold()}};
+  if (spec.kind == kernels::DescriptorKind::BOW && spec.dictionary) {
+    const kernels::VisualDictionary& d = *spec.dictionary;
+    j["dictionary"] = kernels::dictionary_id_hex(d.id);
+    j["words"] = d.words;
+    j["image_width"] = d.spin.image_width;
+    j["support_length"] = d.spin.support_length;
+    j["support_angle_cos"] = d.spin.support_angle_cos;
+    j["keypoint_leaf"] = d.keypoint_leaf;
+    j["normal_radius"] = d.normal_radius;
+  }
   return j.dump();
 }
+
+namespace {
+
+/// The dictionary a "bow" schema names (no words), or nullopt with @p why.
+std::optional<kernels::VisualDictionary> schema_dictionary(const nlohmann::json& j,
+                                                           std::string& why) {
+  const auto id = j.find("dictionary");
+  const auto words = j.find("words");
+  const auto width = j.find("image_width");
+  const char* const numbers[] = {"support_length", "support_angle_cos", "keypoint_leaf",
+                                 "normal_radius"};
+  bool ok = id != j.end() && id->is_string() && id->get<std::string>().size() == 16 &&
+            words != j.end() && words->is_number_unsigned() && width != j.end() &&
+            width->is_number_unsigned();
+  for (const char* n : numbers) ok = ok && j.contains(n) && j[n].is_number();
+  std::uint64_t value = 0;
+  if (ok) {
+    const std::string hex = id->get<std::string>();
+    for (const char c : hex) {
+      const int digit = c >= '0' && c <= '9' ? c - '0' : c >= 'a' && c <= 'f' ? c - 'a' + 10 : -1;
+      if (digit < 0) ok = false;
+      value = (value << 4U) | static_cast<std::uint64_t>(digit < 0 ? 0 : digit);
+    }
+  }
+  if (!ok) {
+    why =
+        "a \"bow\" schema needs \"dictionary\" (16 hex digits), unsigned \"words\" and "
+        "\"image_width\", and numbers \"support_length\", \"support_angle_cos\", "
+        "\"keypoint_leaf\", \"normal_radius\"";
+    return std::nullopt;
+  }
+  kernels::VisualDictionary d;
+  d.id = value;
+  d.words = words->get<std::size_t>();
+  d.spin.image_width = width->get<std::uint32_t>();
+  d.dims = kernels::spin_image_bins(d.spin.image_width);
+  d.spin.support_length = j["support_length"].get<float>();
+  d.spin.support_angle_cos = j["support_angle_cos"].get<float>();
+  d.keypoint_leaf = j["keypoint_leaf"].get<float>();
+  d.normal_radius = j["normal_radius"].get<float>();
+  return d;
+}
+
+}  // namespace
 
 std::optional<kernels::DescriptorSpec> decode_schema(std::string_view json, std::uint32_t& version,
                                                      std::string& why) {
@@ -115,11 +169,15 @@ std::optional<kernels::DescriptorSpec> decode_schema(std::string_view json, std:
         "string \"descriptor\")";
     return std::nullopt;
   }
-  if (kind != j.end() &&
+  const bool bow = kind != j.end() &&
+                   kind->get<std::string>() == kernels::to_string(kernels::DescriptorKind::BOW);
+  if (kind != j.end() && !bow &&
       kind->get<std::string>() != kernels::to_string(kernels::DescriptorKind::GOOD)) {
-    why = "descriptor \"" + kind->get<std::string>() + "\" is not one this build knows (good)";
+    why = "descriptor \"" + kind->get<std::string>() + "\" is not one this build knows (good, bow)";
     return std::nullopt;
   }
+  std::optional<kernels::VisualDictionary> dictionary;
+  if (bow && !(dictionary = schema_dictionary(j, why))) return std::nullopt;
   const std::string m = mode->get<std::string>();
   if (m != "invariant" && m != "reference") {
     why = "mode must be \"invariant\" or \"reference\", not \"" + m + "\"";
@@ -130,6 +188,10 @@ std::optional<kernels::DescriptorSpec> decode_schema(std::string_view json, std:
       bins->get<std::size_t>(),
       m == "invariant" ? kernels::GoodMode::INVARIANT : kernels::GoodMode::REFERENCE);
   spec.good.threshold = threshold->get<float>();
+  if (dictionary) {
+    spec.kind = kernels::DescriptorKind::BOW;
+    spec.dictionary = std::make_shared<const kernels::VisualDictionary>(std::move(*dictionary));
+  }
   return spec;
 }
 
@@ -199,8 +261,11 @@ std::optional<ViewRecord> decode_view(std::string_view bytes,
     why = "view record truncated in its header";
     return std::nullopt;
   }
-  auto got = kernels::DescriptorSpec::make_good(
-      bins, mode == 0 ? kernels::GoodMode::INVARIANT : kernels::GoodMode::REFERENCE);
+  // The record names its GOOD parameters (a bag-of-words store's frame and box); the rest of the
+  // specification (the dictionary) is the store's, checked when it was opened.
+  kernels::DescriptorSpec got = expected;
+  got.good.bins = bins;
+  got.good.mode = mode == 0 ? kernels::GoodMode::INVARIANT : kernels::GoodMode::REFERENCE;
   got.good.threshold = threshold;
   if (mode > 1 || !(got == expected) || n != expected.length() || r.left() != n * sizeof(float)) {
     why = "view record has " + got.describe() + " and " + std::to_string(n) +

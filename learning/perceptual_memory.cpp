@@ -7,6 +7,7 @@
 #include "learning/detail/log_tail.hpp"
 #include "learning/detail/memory_state.hpp"
 #include "learning/detail/store_dir.hpp"
+#include "learning/dictionary.hpp"
 
 namespace orthoflow::learning {
 namespace {
@@ -32,11 +33,19 @@ Result<void, MemoryError> check_schema(PerceptualMemory::State& s, bool created)
                      "a LevelDB database without orthoflow's schema key: not a perceptual memory; "
                      "nothing was changed"));
   }
+  const bool bow = s.cfg.descriptor.kind == kernels::DescriptorKind::BOW;
   if (st.IsNotFound()) {
+    if (auto valid = s.cfg.descriptor.validate(); !valid) {
+      return err(
+          memory_error(Code::PARAMS_MISMATCH, s.dir,
+                       "a new store needs a whole descriptor specification: " + valid.error()));
+    }
     leveldb::WriteOptions sync;
     sync.sync = true;
     leveldb::WriteBatch batch;
     batch.Put(std::string(KEY_SCHEMA), encode_schema(s.cfg.descriptor));
+    if (bow)
+      batch.Put(std::string(KEY_DICTIONARY), encode_dictionary(*s.cfg.descriptor.dictionary));
     batch.Put(std::string(KEY_NEXT_ID), encode_u32(0));
     if (!s.db->Write(sync, &batch).ok()) {
       return err(memory_error(Code::WRITE_FAILED, s.dir, "cannot write the schema key"));
@@ -46,11 +55,32 @@ Result<void, MemoryError> check_schema(PerceptualMemory::State& s, bool created)
   if (!st.ok()) { return err(memory_error(Code::CORRUPT, s.dir, "schema key: " + st.ToString())); }
   std::uint32_t version = 0;
   std::string why;
-  const auto stored = decode_schema(value, version, why);
+  auto stored = decode_schema(value, version, why);
   if (!stored || version != MEMORY_SCHEMA_VERSION) {
     return err(
         memory_error(Code::CORRUPT, s.dir,
                      "schema key: " + (stored ? "version " + std::to_string(version) : why)));
+  }
+  if (stored->kind == kernels::DescriptorKind::BOW) {
+    // The store's own dictionary: its words are in the "d" record, which must be the one the
+    // schema names.
+    std::string bytes;
+    if (!s.db->Get(leveldb::ReadOptions(), std::string(KEY_DICTIONARY), &bytes).ok()) {
+      return err(memory_error(Code::CORRUPT, s.dir, "a bag-of-words store without its dictionary"));
+    }
+    auto own = parse_dictionary(bytes);
+    if (!own || own->id != stored->dictionary->id) {
+      return err(memory_error(
+          Code::CORRUPT, s.dir,
+          "the stored dictionary " + (own ? kernels::dictionary_id_hex(own->id) + " is not the one "
+                                                                                  "its schema names"
+                                          : own.error())));
+    }
+    stored->dictionary = std::make_shared<const kernels::VisualDictionary>(std::move(own.value()));
+    if (bow && !s.cfg.descriptor.dictionary) {  // opened as "bow" without words: the store's own
+      s.cfg.descriptor = *stored;
+      s.learner = make_learner(s.cfg);
+    }
   }
   if (!(*stored == s.cfg.descriptor)) {
     return err(memory_error(Code::PARAMS_MISMATCH, s.dir,
@@ -220,12 +250,15 @@ Result<bool, MemoryError> prepare(PerceptualMemory::State& s, OpenMode mode) {
 Result<PerceptualMemory, MemoryError> PerceptualMemory::open(const std::filesystem::path& dir,
                                                              const MemoryConfig& cfg,
                                                              OpenMode mode) {
-  if (auto valid = cfg.descriptor.validate(); !valid)
+  // A bag of words without its dictionary opens a store with the store's own (check_schema).
+  const bool adopt =
+      cfg.descriptor.kind == kernels::DescriptorKind::BOW && !cfg.descriptor.dictionary;
+  if (auto valid = cfg.descriptor.validate(); !valid && !adopt)
     return err(memory_error(Code::OPEN_FAILED, dir, valid.error()));
   auto s = std::make_unique<State>();
   s->dir = dir;
   s->cfg = cfg;
-  s->learner = make_learner(s->cfg);
+  if (!adopt) s->learner = make_learner(s->cfg);  // else made once the store's words are known
   auto create = prepare(*s, mode);
   if (!create) return err(create.error());
   std::error_code ignored;  // LevelDB creates only the last path component; Open reports failures

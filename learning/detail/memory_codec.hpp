@@ -23,6 +23,9 @@ namespace orthoflow::learning {
 
 inline constexpr std::string_view KEY_SCHEMA = "s";
 inline constexpr std::string_view KEY_NEXT_ID = "n";
+/// A bag-of-words store's dictionary (learning/dictionary.hpp's file bytes), written with its
+/// schema.
+inline constexpr std::string_view KEY_DICTIONARY = "d";
 inline constexpr char KIND_CATEGORY = 'c';
 inline constexpr char KIND_MODEL = 'm';
 inline constexpr char KIND_VIEW = 'v';
@@ -36,11 +39,14 @@ inline constexpr char KIND_VIEW = 'v';
 [[nodiscard]] std::optional<CategoryId> key_category(std::string_view key) noexcept;
 
 /// @brief The schema JSON of a store written with @p spec:
-/// {"schema":1,"descriptor":"good","bins":n, "mode":...,"threshold":t}.
+/// {"schema":1,"descriptor":"good","bins":n, "mode":...,"threshold":t}; a bag-of-words store adds
+/// "dictionary" (its id, 16 hex digits), "words", "image_width", "support_length",
+/// "support_angle_cos", "keypoint_leaf" and "normal_radius".
 [[nodiscard]] std::string encode_schema(const kernels::DescriptorSpec& spec);
 /// @brief Parses a schema JSON (also the export header); nullopt with @p why set when malformed. A
 /// header without "descriptor" (written before the descriptor specification existed) is a GOOD
-/// store.
+/// store. A "bow" schema gives a dictionary with its parameters, id and word count but no words
+/// (the store's "d" record, or the dictionary file, holds them): enough to compare and describe.
 [[nodiscard]] std::optional<kernels::DescriptorSpec> decode_schema(std::string_view json,
                                                                    std::uint32_t& version,
                                                                    std::string& why);

@@ -1,6 +1,7 @@
 // Helper of memory_crash_test: opens the store given as argv[1], then teaches one view at a time
 // and prints the stamp of every acknowledged teach on its own line, until it is killed (or argv[2]
-// teaches).
+// teaches). argv[3] "bow": the store is a bag-of-words store (test::bow_config, its dictionary
+// stored with it).
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -12,7 +13,9 @@ int main(int argc, char** argv) {
   using namespace orthoflow::learning;
   if (argc < 2) { return 2; }
   const long limit = argc > 2 ? std::strtol(argv[2], nullptr, 10) : 1000000L;
-  auto memory_result = PerceptualMemory::open(argv[1], test::small_config());
+  const bool bow = argc > 3 && std::string(argv[3]) == "bow";
+  auto memory_result =
+      PerceptualMemory::open(argv[1], bow ? test::bow_config() : test::small_config());
   if (!memory_result) {
     std::fprintf(stderr, "%s\n", memory_result.error().to_string().c_str());
     return 1;

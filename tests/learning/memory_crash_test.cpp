@@ -34,7 +34,8 @@ void take_lines(std::string& text, std::set<std::int64_t>& out) {
 
 // Runs the child on @p dir and kills it after @p delay; lines already in the pipe were
 // acknowledged.
-ChildRun run_and_kill(const std::filesystem::path& dir, std::chrono::milliseconds delay) {
+ChildRun run_and_kill(const std::filesystem::path& dir, std::chrono::milliseconds delay,
+                      const char* kind) {
   int fds[2];
   EXPECT_EQ(pipe(fds), 0);
   const pid_t pid = fork();
@@ -42,7 +43,8 @@ ChildRun run_and_kill(const std::filesystem::path& dir, std::chrono::millisecond
     dup2(fds[1], STDOUT_FILENO);
     close(fds[0]);
     close(fds[1]);
-    execl(LEARNING_CRASH_CHILD, LEARNING_CRASH_CHILD, dir.c_str(), static_cast<char*>(nullptr));
+    execl(LEARNING_CRASH_CHILD, LEARNING_CRASH_CHILD, dir.c_str(), "1000000", kind,
+          static_cast<char*>(nullptr));
     _exit(127);
   }
   close(fds[1]);
@@ -78,18 +80,20 @@ ChildRun run_and_kill(const std::filesystem::path& dir, std::chrono::millisecond
   return run;
 }
 
-TEST(PerceptualMemoryCrash, EveryAcknowledgedTeachSurvivesSigkill) {
-  const auto dir = test::fresh_dir();
+// Kills the child @p rounds times while it teaches a store of @p kind; after each kill the store
+// opens with every acknowledged view; @p dir is the store's directory.
+void kill_while_teaching(const char* kind, const MemoryConfig& config, int rounds,
+                         const std::filesystem::path& dir) {
   std::mt19937 rng(20260611U);
   std::uniform_int_distribution<int> delay_ms(5, 60);
   std::set<std::int64_t> acknowledged;
   std::size_t unacknowledged_but_stored = 0;
-  for (int round = 0; round < 50; ++round) {
-    const ChildRun run = run_and_kill(dir, std::chrono::milliseconds(delay_ms(rng)));
+  for (int round = 0; round < rounds; ++round) {
+    const ChildRun run = run_and_kill(dir, std::chrono::milliseconds(delay_ms(rng)), kind);
     ASSERT_TRUE(WIFSIGNALED(run.status) && WTERMSIG(run.status) == SIGKILL)
         << "round " << round << " child exited early";
     acknowledged.insert(run.acknowledged.begin(), run.acknowledged.end());
-    auto memory_result = PerceptualMemory::open(dir, test::small_config());
+    auto memory_result = PerceptualMemory::open(dir, config);
     ASSERT_TRUE(memory_result) << "round " << round << ": " << memory_result.error().to_string();
     std::set<std::int64_t> stored;
     for (const CategoryEntry& c : memory_result->list()) {
@@ -116,9 +120,43 @@ TEST(PerceptualMemoryCrash, EveryAcknowledgedTeachSurvivesSigkill) {
       acknowledged.insert(*stored.rbegin());  // it is durable now: later rounds must keep it too
     }
   }
-  EXPECT_GT(acknowledged.size(), 50U);  // the kills landed while teaching, not only during start-up
-  RecordProperty("views", static_cast<int>(acknowledged.size()));
-  RecordProperty("in_flight_stored", static_cast<int>(unacknowledged_but_stored));
+  EXPECT_GT(acknowledged.size(),
+            static_cast<std::size_t>(
+                rounds));  // the kills landed while teaching, not only during start-up
+  ::testing::Test::RecordProperty(std::string(kind) + "_views",
+                                  static_cast<int>(acknowledged.size()));
+  ::testing::Test::RecordProperty(std::string(kind) + "_in_flight_stored",
+                                  static_cast<int>(unacknowledged_but_stored));
+}
+
+TEST(PerceptualMemoryCrash, EveryAcknowledgedTeachSurvivesSigkill) {
+  kill_while_teaching("good", test::small_config(), 50, test::fresh_dir());
+}
+
+// A bag-of-words store keeps its dictionary with its schema: it survives the kills too, opens with
+// its own words (no dictionary given), and refuses other words, naming both.
+TEST(PerceptualMemoryCrash, ABagOfWordsStoreSurvivesSigkillWithItsDictionary) {
+  const auto dir = test::fresh_dir();
+  kill_while_teaching("bow", test::bow_config(), 25, dir);
+  if (HasFatalFailure()) return;
+  {
+    MemoryConfig own = test::bow_config();
+    own.descriptor.dictionary = nullptr;
+    auto reopened = PerceptualMemory::open(dir, own);
+    ASSERT_TRUE(reopened) << reopened.error().to_string();
+    EXPECT_EQ(reopened->config().descriptor, test::bow_config().descriptor);
+    EXPECT_GT(reopened->stats().views, 25U);
+  }  // closed: LevelDB's lock is released
+  auto other = PerceptualMemory::open(dir, test::bow_config(LearnerKind::INSTANCE, 2));
+  ASSERT_FALSE(other);
+  EXPECT_EQ(other.error().code, MemoryError::Code::PARAMS_MISMATCH);
+  const std::string why = other.error().to_string();
+  EXPECT_NE(why.find(kernels::dictionary_id_hex(test::test_dictionary(75, 1)->id)),
+            std::string::npos)
+      << why;
+  EXPECT_NE(why.find(kernels::dictionary_id_hex(test::test_dictionary(75, 2)->id)),
+            std::string::npos)
+      << why;
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -27,6 +28,28 @@ inline MemoryConfig small_config(LearnerKind kind = LearnerKind::INSTANCE) {
   MemoryConfig cfg;
   cfg.descriptor.good.bins = 5;
   cfg.learner = kind;
+  return cfg;
+}
+
+/// A bag-of-words dictionary of @p words seeded words (spin images of width 4: 45 values).
+inline std::shared_ptr<const kernels::VisualDictionary> test_dictionary(std::size_t words = 75,
+                                                                        std::uint64_t seed = 1) {
+  auto d = std::make_shared<kernels::VisualDictionary>();
+  d->words = words;
+  d->dims = kernels::spin_image_bins(4);
+  d->data.resize(d->words * d->dims);
+  for (std::size_t i = 0; i < d->data.size(); ++i)
+    d->data[i] = static_cast<float>((i * 2654435761ULL + seed * 97ULL) % 1000ULL) / 1000.0F;
+  d->id = kernels::dictionary_id(*d);
+  d->provenance = "memory tests";
+  return d;
+}
+
+/// small_config() as a bag of words over test_dictionary(): descriptors of 75 values too.
+inline MemoryConfig bow_config(LearnerKind kind = LearnerKind::INSTANCE, std::uint64_t seed = 1) {
+  MemoryConfig cfg = small_config(kind);
+  cfg.descriptor = kernels::DescriptorSpec::make_bow(test_dictionary(75, seed));
+  cfg.descriptor.good.bins = 5;
   return cfg;
 }
 
