@@ -1,0 +1,111 @@
+// The bag of words (docs/SPIN_IMAGES.md): one real object view (../shared/data/objects) described
+// by GOOD and by the bag of words in the same run (keypoints, normals, spin images, words); the
+// words of one view's spin images, exact SIMD vs the scalar twin; and k-means over a pool of spin
+// images, seeding alone and seeding plus iterations (per iteration = the difference).
+#include <benchmark/benchmark.h>
+
+#include <memory>
+#include <vector>
+
+#include "core/rng.hpp"
+#include "formats/pcd_io.hpp"
+#include "kernels/descriptor_spec.hpp"
+#include "kernels/simd_arch.hpp"
+#include "kernels/spin_features.hpp"
+#include "learning/dictionary.hpp"
+
+namespace ok = orthoflow::kernels;
+namespace ol = orthoflow::learning;
+
+namespace {
+
+ok::PointCloud view(const char* name) {
+  auto cloud = orthoflow::formats::read_pcd(std::string(ORTHOFLOW_SHARED_DIR) + "/data/objects/" +
+                                            name + ".pcd");
+  if (!cloud) std::abort();
+  return std::move(cloud.value());
+}
+
+std::vector<float> random_pool(std::size_t rows, std::size_t dims) {
+  orthoflow::core::Rng rng(3);
+  std::vector<float> pool(rows * dims);
+  for (float& v : pool) v = static_cast<float>(rng.uniform() * rng.uniform() * 0.2);
+  return pool;
+}
+
+/// A dictionary of @p words drawn from the view's own spin images (every few images).
+std::shared_ptr<const ok::VisualDictionary> words_of(const ok::PointCloud& cloud,
+                                                     std::size_t words) {
+  ok::SpinFeatures f;
+  if (!f.compute(cloud.points(), {})) std::abort();
+  const auto images = f.images();
+  const std::size_t dims = ok::spin_image_bins(4), n = images.size() / dims;
+  auto d = std::make_shared<ok::VisualDictionary>();
+  d->words = words;
+  d->dims = dims;
+  d->data.resize(words * dims);
+  for (std::size_t j = 0; j < words; ++j)
+    for (std::size_t v = 0; v < dims; ++v)
+      d->data[v * words + j] = images[(j * n / words) * dims + v];
+  d->id = ok::dictionary_id(*d);
+  return d;
+}
+
+void BM_Describe(benchmark::State& state, const char* name, bool bow) {
+  const ok::PointCloud cloud = view(name);
+  const ok::DescriptorSpec spec =
+      bow ? ok::DescriptorSpec::make_bow(words_of(cloud, 70)) : ok::DescriptorSpec::make_good(15);
+  ok::Describer describer(spec);
+  std::vector<float> out(spec.length());
+  for (auto _ : state) benchmark::DoNotOptimize(describer.describe(cloud.points(), out));
+  state.counters["points"] = static_cast<double>(cloud.size());
+  if (bow) state.counters["spin_images"] = static_cast<double>(describer.features());
+}
+
+template <bool SIMD>
+void BM_WordsOfAView(benchmark::State& state) {
+  const auto features = static_cast<std::size_t>(state.range(0));
+  const auto words = static_cast<std::size_t>(state.range(1));
+  const std::size_t dims = ok::spin_image_bins(4);
+  const auto pool = random_pool(features, dims);
+  const auto w = random_pool(words, dims);
+  const ok::DescriptorMatrixView view{w, dims, words, words};
+  std::vector<float> scratch(words);
+  for (auto _ : state) {
+    std::size_t sum = 0;
+    for (std::size_t i = 0; i < features; ++i) {
+      const std::span<const float> f(pool.data() + i * dims, dims);
+      sum += SIMD ? ok::nearest_word(f, view, scratch) : ok::nearest_word_scalar(f, view);
+    }
+    benchmark::DoNotOptimize(sum);
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(features));
+  if (SIMD) state.SetLabel(ok::simd_arch_name());
+}
+
+void BM_KMeans(benchmark::State& state) {
+  const auto rows = static_cast<std::size_t>(state.range(0));
+  const auto pool = random_pool(rows, ok::spin_image_bins(4));
+  ol::KMeansParams params;
+  params.k = 70;
+  params.max_iterations = static_cast<std::uint32_t>(state.range(1));
+  for (auto _ : state) benchmark::DoNotOptimize(ol::kmeans(pool, ok::spin_image_bins(4), params));
+}
+
+}  // namespace
+
+BENCHMARK_CAPTURE(BM_Describe, good_bowl, "bowl", false)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Describe, bow_bowl, "bowl", true)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Describe, good_bottle, "bottle", false)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Describe, bow_bottle, "bottle", true)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_WordsOfAView<false>)
+    ->Name("BM_WordsOfAView/scalar")
+    ->Args({271, 70})
+    ->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_WordsOfAView<true>)
+    ->Name("BM_WordsOfAView/simd")
+    ->Args({271, 70})
+    ->Unit(benchmark::kMicrosecond);
+// 32,000 spin images: the thesis's pool (194 objects); 0 iterations = k-means++ seeding alone.
+BENCHMARK(BM_KMeans)->Args({32000, 0})->Args({32000, 5})->Unit(benchmark::kMillisecond);
+BENCHMARK_MAIN();
