@@ -2,15 +2,19 @@
 
 #include "graphs/frame_block.hpp"
 #include "graphs/node_support.hpp"
+#include "learning/dictionary.hpp"
 
 namespace orthoflow::graphs {
 
 Result<kernels::DescriptorSpec, std::string> parse_describe_params(const engine::ParamMap& params) {
-  if (auto ok = params.only({"descriptor", "bins", "mode", "threshold"}); !ok)
+  if (auto ok = params.only(
+          {"descriptor", "bins", "mode", "threshold", "dictionary", "max_object_points"});
+      !ok)
     return err(ok.error());
   kernels::DescriptorSpec spec;  // thesis: GOOD, 15 bins; invariant frame by default (docs/GOOD.md)
-  std::string e, kind = "good", mode = "invariant";
-  take(params.choice("descriptor", "good", {"good"}), kind, e);
+  std::string e, kind = "good", mode = "invariant", dictionary;
+  take(params.choice("descriptor", "good", {"good", "bow"}), kind, e);
+  if (kind == "bow") take(params.text("dictionary", ""), dictionary, e);
   take(params.integer("bins", 15, 1, MAX_GOOD_BINS), spec.good.bins, e);
   take(params.choice("mode", "invariant", {"invariant", "reference"}), mode, e);
   if (params.has("threshold")) {
@@ -20,9 +24,26 @@ Result<kernels::DescriptorSpec, std::string> parse_describe_params(const engine:
   if (!e.empty()) return err(e);
   spec.good.mode =
       mode == "invariant" ? kernels::GoodMode::INVARIANT : kernels::GoodMode::REFERENCE;
+  if (kind == "bow") {  // the bag of words over a dictionary file (docs/SPIN_IMAGES.md)
+    if (dictionary.empty())
+      return err(std::string("describe: descriptor bow needs a dictionary file (dictionary: ...)"));
+    auto words = learning::load_dictionary(dictionary);
+    if (!words) return err("describe: " + words.error());
+    spec.kind = kernels::DescriptorKind::BOW;
+    spec.dictionary = std::make_shared<const kernels::VisualDictionary>(std::move(words.value()));
+    if (auto valid = spec.validate(); !valid) return err("describe: " + valid.error());
+  }
   if (spec.length() > MAX_DESCRIPTOR)
     return err("describe: " + spec.describe() + " does not fit the frame block");
   return spec;
+}
+
+Result<std::size_t, std::string> parse_max_object_points(const engine::ParamMap& params) {
+  std::size_t n = 20000;
+  std::string e;
+  take(params.integer("max_object_points", 20000, 100, 1000000), n, e);
+  if (!e.empty()) return err(e);
+  return n;
 }
 
 Result<kernels::DescriptorSpec, std::string> descriptor_of_graph(const engine::GraphSpec& spec) {

@@ -12,9 +12,16 @@
 
 namespace orthoflow::graphs {
 
-/// @brief describe: descriptor (good), bins (1..MAX_GOOD_BINS), mode (invariant|reference),
-/// threshold (m). Thesis defaults: GOOD with 15 bins; the invariant frame (docs/GOOD.md).
+/// @brief describe: descriptor (good|bow), bins (1..MAX_GOOD_BINS), mode (invariant|reference),
+/// threshold (m); bow: dictionary (a file of `orthoflow dictionary build`, loaded here) and
+/// max_object_points (the describe node's scratch, parse_max_object_points). Thesis defaults: GOOD
+/// with 15 bins; the invariant frame (docs/GOOD.md).
 [[nodiscard]] Result<kernels::DescriptorSpec, std::string> parse_describe_params(
+    const engine::ParamMap& params);
+
+/// @brief describe's max_object_points (bow: the largest object view it describes; larger ones are
+/// left undescribed and counted): default 20000.
+[[nodiscard]] Result<std::size_t, std::string> parse_max_object_points(
     const engine::ParamMap& params);
 
 /// @brief The specification of the graph's describe node (the default when it has none). Errors

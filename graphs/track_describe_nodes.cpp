@@ -1,5 +1,9 @@
 #include "graphs/track_describe_nodes.hpp"
 
+#include <algorithm>
+#include <atomic>
+#include <memory>
+#include <thread>
 #include <vector>
 
 #include "graphs/descriptor_params.hpp"
@@ -64,10 +68,45 @@ class Track final : public engine::Node {
   std::vector<TrackOutput> outputs_;
 };
 
+/// The bag of words' spin-feature scratches: one per call that can run at once (the arena's
+/// threads), each reserved once for max_object_points, taken and given back lock-free.
+class FeaturePool {
+ public:
+  FeaturePool(std::size_t count, std::size_t max_points, std::uint32_t image_width)
+      : scratch_(count), busy_(count) {
+    for (auto& s : scratch_) s.reserve(max_points, image_width);
+    for (auto& b : busy_) b.store(false);
+  }
+  /// @brief A free scratch, or nullptr when every one is taken (one pass: bounded).
+  kernels::SpinFeatures* take() noexcept {
+    for (std::size_t i = 0; i < busy_.size(); ++i) {
+      bool expected = false;
+      if (busy_[i].compare_exchange_strong(expected, true, std::memory_order_acquire))
+        return &scratch_[i];
+    }
+    return nullptr;
+  }
+  void give(kernels::SpinFeatures* s) noexcept {
+    busy_[static_cast<std::size_t>(s - scratch_.data())].store(false, std::memory_order_release);
+  }
+
+ private:
+  std::vector<kernels::SpinFeatures> scratch_;
+  std::vector<std::atomic<bool>> busy_;
+};
+
 class Describe final : public engine::Node {
  public:
-  Describe(std::size_t capacity, const kernels::DescriptorSpec& spec, std::size_t slots)
-      : capacity_(capacity), describers_(slots * MAX_OBJECTS, kernels::Describer(spec)) {}
+  Describe(std::size_t capacity, const kernels::DescriptorSpec& spec, std::size_t slots,
+           std::size_t max_object_points)
+      : capacity_(capacity), describers_(slots * MAX_OBJECTS, kernels::Describer(spec)) {
+    if (spec.kind == kernels::DescriptorKind::BOW) {
+      // More scratches than the arena can run at once: hardware threads, and never fewer than 4.
+      const std::size_t workers = std::max<std::size_t>(4, std::thread::hardware_concurrency());
+      pool_ = std::make_unique<FeaturePool>(workers + 1, max_object_points,
+                                            spec.dictionary->spin.image_width);
+    }
+  }
   std::span<const engine::PortSpec> inputs() const noexcept override { return {DESCRIBE_PORTS, 1}; }
   std::span<const engine::PortSpec> outputs() const noexcept override {
     return {DESCRIBE_PORTS + 1, 1};
@@ -75,14 +114,21 @@ class Describe final : public engine::Node {
   bool stateful() const noexcept override { return false; }
 
   // Runs concurrently for different objects: each (slot, object) has its own describer and its own
-  // record and descriptor region in the block, so no two calls touch the same memory.
+  // record and descriptor region in the block, so no two calls touch the same memory; a bag of
+  // words takes a spin-feature scratch of the pool for the call.
   void process(const Message& in, Emitter& out) noexcept override {
     if (in.object_count > 0 && in.object_index < MAX_OBJECTS) {
       const FrameBlock block = block_of(in, capacity_);
       ObjectRecord& o = block.state().objects[in.object_index];
       kernels::Describer& describer = describers_[in.slot * MAX_OBJECTS + in.object_index];
+      const auto view = block.object_view(in.object_index);
+      const auto room = block.descriptor(in.object_index);
+      kernels::SpinFeatures* features = pool_ ? pool_->take() : nullptr;
+      // GOOD, or (more calls at once than hardware threads, e.g. --threads above the cores) the
+      // describer's own scratch, which grows: correct, but it may allocate.
       auto described =
-          describer.describe(block.object_view(in.object_index), block.descriptor(in.object_index));
+          features ? describer.describe(view, room, *features) : describer.describe(view, room);
+      if (features) pool_->give(features);
       o.described = described.has_value();
       if (described) {
         o.descriptor_length = static_cast<std::uint32_t>(described->length);
@@ -97,6 +143,7 @@ class Describe final : public engine::Node {
  private:
   std::size_t capacity_;
   std::vector<kernels::Describer> describers_;
+  std::unique_ptr<FeaturePool> pool_;  ///< bag of words only
 };
 
 NodeResult make_track(const ParamMap& params, const engine::NodeContext& context) {
@@ -124,7 +171,10 @@ NodeResult make_describe(const ParamMap& params, const engine::NodeContext& cont
   if (!capacity) return err(capacity.error());
   auto spec = parse_describe_params(params);
   if (!spec) return err(spec.error());
-  return std::unique_ptr<engine::Node>(new Describe(*capacity, *spec, context.max_in_flight));
+  auto max_points = parse_max_object_points(params);
+  if (!max_points) return err(max_points.error());
+  return std::unique_ptr<engine::Node>(
+      new Describe(*capacity, *spec, context.max_in_flight, *max_points));
 }
 
 }  // namespace

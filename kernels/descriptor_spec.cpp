@@ -101,21 +101,33 @@ Describer::Describer(const DescriptorSpec& spec) : spec_(spec), good_scratch_(sp
   }
 }
 
-Result<void, GoodError> Describer::describe_bow(PointsView points, std::span<float> out) {
+Result<void, GoodError> Describer::describe_bow(PointsView points, std::span<float> out,
+                                                SpinFeatures& features) {
   const VisualDictionary& d = *spec_.dictionary;
   const SpinFeatureParams params{d.spin, d.keypoint_leaf, d.normal_radius};
-  auto computed = features_scratch_.compute(points, params);
+  auto computed = features.compute(points, params);
   if (!computed) {
-    return err(computed.error() == SpinFeatureError::OUT_OF_MEMORY ? GoodError::OUT_OF_MEMORY
-                                                                   : GoodError::KEYPOINTS_FAILED);
+    switch (computed.error()) {
+      case SpinFeatureError::OUT_OF_MEMORY:
+        return err(GoodError::OUT_OF_MEMORY);
+      case SpinFeatureError::TOO_MANY_POINTS:
+        return err(GoodError::TOO_MANY_POINTS);
+      default:
+        return err(GoodError::KEYPOINTS_FAILED);
+    }
   }
-  features_ = bag_of_words(features_scratch_.images(), d.view(), word_scratch_, out);
+  features_ = bag_of_words(features.images(), d.view(), word_scratch_, out);
   if (features_ == 0) return err(GoodError::NO_FEATURES);
   return {};
 }
 
 Result<DescriptorInfo, GoodError> Describer::describe(PointsView points,
                                                       std::span<float> out) noexcept {
+  return describe(points, out, features_scratch_);
+}
+
+Result<DescriptorInfo, GoodError> Describer::describe(PointsView points, std::span<float> out,
+                                                      SpinFeatures& features) noexcept {
   features_ = 0;
   if (spec_.kind == DescriptorKind::GOOD) {
     auto good = compute_good(points, spec_.good, good_scratch_, out);
@@ -126,7 +138,7 @@ Result<DescriptorInfo, GoodError> Describer::describe(PointsView points,
   // The frame and box come from GOOD (the grasp planner needs them whatever the representation).
   auto good = compute_good(points, spec_.good, good_scratch_, good_values_);
   if (!good) return err(good.error());
-  auto bow = describe_bow(points, out);
+  auto bow = describe_bow(points, out, features);
   if (!bow) return err(bow.error());
   return DescriptorInfo{spec_.length(), good->frame, good->bbox, good->flags};
 }

@@ -79,12 +79,18 @@ class Describer {
   /// compute_good(); the words are exact, kernels/visual_words.hpp).
   [[nodiscard]] Result<DescriptorInfo, GoodError> describe(PointsView points,
                                                            std::span<float> out) noexcept;
+  /// @brief describe() with the spin features' scratch given by the caller (BOW; GOOD ignores
+  /// it): describers that never run at once may share one (the graph keeps one per worker, each
+  /// reserved once, so that describing allocates nothing).
+  [[nodiscard]] Result<DescriptorInfo, GoodError> describe(PointsView points, std::span<float> out,
+                                                           SpinFeatures& features) noexcept;
   /// @brief BOW: the spin images counted in the last describe() (0 for GOOD).
   [[nodiscard]] std::size_t features() const noexcept { return features_; }
 
  private:
   /// BOW: the view's spin features, then their words.
-  [[nodiscard]] Result<void, GoodError> describe_bow(PointsView points, std::span<float> out);
+  [[nodiscard]] Result<void, GoodError> describe_bow(PointsView points, std::span<float> out,
+                                                     SpinFeatures& features);
 
   DescriptorSpec spec_;
   GoodScratch good_scratch_;

@@ -193,6 +193,8 @@ const char* to_string(GoodError error) noexcept {
     case GoodError::NO_FEATURES:
       return "bag of words: no spin image of the view has weight (too few points within the "
              "support length)";
+    case GoodError::TOO_MANY_POINTS:
+      return "bag of words: the view has more points than the describer's scratch was reserved for";
   }
   return "compute_good: unknown error";
 }

@@ -88,6 +88,7 @@ enum class GoodError : std::uint8_t {
   /// Describer, bag of words: the keypoints' voxel grid refused the view (too wide for its leaf).
   KEYPOINTS_FAILED,
   NO_FEATURES,  ///< Describer, bag of words: no spin image has weight (a view too small or sparse)
+  TOO_MANY_POINTS,  ///< Describer, bag of words: a view larger than its fixed scratch holds
 };
 /// @brief What the error means, as a sentence naming compute_good and the offending value's role.
 [[nodiscard]] const char* to_string(GoodError error) noexcept;

@@ -14,8 +14,20 @@ const char* to_string(SpinFeatureError error) noexcept {
       return "spin features: the normals' radius or the spin images' parameters were refused";
     case SpinFeatureError::OUT_OF_MEMORY:
       return "spin features: out of memory for the view's scratch";
+    case SpinFeatureError::TOO_MANY_POINTS:
+      return "spin features: the view has more points than the scratch was reserved for";
   }
   return "spin features: unknown error";
+}
+
+void SpinFeatures::reserve(std::size_t max_points, std::uint32_t image_width) {
+  voxel_scratch_ = VoxelGridScratch(max_points);
+  centroids_.assign(3 * max_points, 0.0F);
+  keypoints_.assign(max_points, 0);
+  normals_.assign(3 * max_points, 0.0F);
+  images_.assign(max_points * spin_image_bins(image_width), 0.0F);
+  capacity_ = max_points;
+  fixed_ = true;
 }
 
 Result<std::size_t, SpinFeatureError> SpinFeatures::compute(PointsView points,
@@ -23,12 +35,15 @@ Result<std::size_t, SpinFeatureError> SpinFeatures::compute(PointsView points,
   used_ = described_ = 0;
   const std::size_t n = points.size();
   const std::size_t bins = spin_image_bins(params.spin.image_width);
+  if (fixed_ && (n > capacity_ || n * bins > images_.size()))
+    return err(SpinFeatureError::TOO_MANY_POINTS);
   try {
-    if (voxel_scratch_.capacity() < n) {
+    if (capacity_ < n) {
       voxel_scratch_ = VoxelGridScratch(n);
       centroids_.resize(3 * n);
       keypoints_.resize(n);
       normals_.resize(3 * n);
+      capacity_ = n;
     }
   } catch (const std::bad_alloc&) { return err(SpinFeatureError::OUT_OF_MEMORY); }
   const std::span<float> c(centroids_.data(), 3 * n);

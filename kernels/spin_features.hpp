@@ -28,13 +28,21 @@ enum class SpinFeatureError : std::uint8_t {
   KEYPOINTS_FAILED,  ///< the voxel grid refused the view (a view too wide for its leaf)
   BAD_PARAMS,        ///< the normals' radius or the spin images' parameters were refused
   OUT_OF_MEMORY,     ///< the scratch could not grow to the view
+  TOO_MANY_POINTS,   ///< a fixed-capacity scratch (reserve()) got a larger view: nothing computed
 };
 [[nodiscard]] const char* to_string(SpinFeatureError error) noexcept;
 
 /// @brief Scratch and result of one view's features. Grows to the largest view it has seen (then
-/// allocation-free). @note Not thread-safe: one per thread.
+/// allocation-free), or, after reserve(), holds a fixed capacity and never allocates again (a
+/// larger view is refused: TOO_MANY_POINTS). @note Not thread-safe: one per thread.
 class SpinFeatures {
  public:
+  SpinFeatures() = default;
+  /// @brief Sizes the scratch for views of up to @p max_points points (every point may be a
+  /// keypoint) and fixes it there: compute() allocates nothing from now on.
+  void reserve(std::size_t max_points, std::uint32_t image_width);
+  /// @brief The fixed capacity in points, or 0 while the scratch grows.
+  [[nodiscard]] std::size_t fixed_capacity() const noexcept { return fixed_ ? capacity_ : 0; }
   /// @brief Computes the features of @p points. @return the keypoints (images() has one image of
   /// spin_image_bins(IW) values per keypoint; an image without weight is all zeros).
   [[nodiscard]] Result<std::size_t, SpinFeatureError> compute(PointsView points,
@@ -54,6 +62,8 @@ class SpinFeatures {
   std::vector<float> images_;
   std::size_t used_ = 0;
   std::size_t described_ = 0;
+  std::size_t capacity_ = 0;  ///< points the arrays hold
+  bool fixed_ = false;
 };
 
 }  // namespace orthoflow::kernels

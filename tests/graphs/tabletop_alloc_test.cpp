@@ -15,11 +15,14 @@
 
 #include <unistd.h>
 
+#include "core/rng.hpp"
 #include "drivers/jaco_kinematics.hpp"
 #include "formats/pcd_io.hpp"
 #include "graphs/body_filter_node.hpp"
+#include "graphs/descriptor_params.hpp"
 #include "graphs/labels_writer.hpp"
 #include "kernels/frame_labels.hpp"
+#include "learning/dictionary.hpp"
 #include "tabletop_run.hpp"
 
 #include "tests/support/counting_new.hpp"  // the one TU of this binary that replaces operator new
@@ -168,6 +171,55 @@ TEST(TabletopAllocations, WithTheRobotBodyFilterNothingIsAllocatedPerFrame) {
   arm.join();
   EXPECT_EQ(log.summary().frames, 60U);
   EXPECT_EQ(log.summary().frames_with_table, 60U) << "every frame filtered, none dropped";
+  EXPECT_EQ(g_allocations.load(), 0U);
+}
+
+// The same graph describing objects by the bag of words (describe: descriptor bow, a dictionary
+// file): the spin-feature scratch of the describe node's pool is reserved once, so keypoints,
+// normals, spin images and words allocate nothing per frame either; the learner asks in words.
+TEST(TabletopAllocations, WithTheBagOfWordsNothingIsAllocatedPerFrame) {
+  core::Rng rng(4);
+  std::vector<float> pool(2000 * 45);
+  for (float& v : pool) v = static_cast<float>(rng.uniform() * rng.uniform() * 0.2);
+  learning::KMeansParams km;
+  km.k = 20;
+  auto words = learning::build_dictionary(pool, {}, km, "alloc test");
+  ASSERT_TRUE(words) << words.error();
+  const std::string file = std::string(ORTHOFLOW_BINARY_DIR) + "/tabletop_alloc_test_words.ofwd";
+  ASSERT_EQ(learning::save_dictionary(*words, file), "");
+  auto spec = test::tabletop_spec({{"source", {{"objects", "5"}, {"frames", "60"}}},
+                                   {"recognise", {{"instructor", "0"}}},
+                                   {"describe", {{"descriptor", "bow"}, {"dictionary", file}}}});
+  auto descriptor = descriptor_of_graph(spec);
+  ASSERT_TRUE(descriptor) << descriptor.error();
+  ASSERT_EQ(descriptor->length(), 20U);
+  LearningSettings settings;
+  settings.memory.descriptor = *descriptor;
+  auto learning = LearningService::open(settings);
+  ASSERT_TRUE(learning) << learning.error();
+  std::vector<float> views(2 * 20, 0.05F);
+  ASSERT_TRUE((*learning)->teach("thing", std::span<const float>(views).first(20), 0, 0, {}).ok());
+  ASSERT_TRUE((*learning)->teach("other", std::span<const float>(views).last(20), 0, 0, {}).ok());
+  auto json = LineWriter::open("/dev/null");
+  ASSERT_TRUE(json);
+  SessionLog log(std::move(*json));
+  const auto registry = make_tabletop_registry(**learning, log);
+  auto graph = engine::build_graph(spec, registry);
+  ASSERT_TRUE(graph) << engine::to_string(graph.error());
+  engine::Engine engine(**graph, {2});
+  std::atomic<bool> stop{false};
+  std::thread arm([&] {
+    while (log.summary().frames < 20 && !stop.load())
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    g_counting.store(true);
+  });
+  engine.run({});
+  g_counting.store(false);
+  stop.store(true);
+  arm.join();
+  EXPECT_EQ(log.summary().frames, 60U);
+  EXPECT_GT(log.summary().object_views, 100U);
+  EXPECT_GT(log.summary().recognitions, 100U) << "the objects were described and asked in words";
   EXPECT_EQ(g_allocations.load(), 0U);
 }
 
