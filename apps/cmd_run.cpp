@@ -71,6 +71,7 @@ struct RunOptions {
   std::string arm_state_topic = engine::ARM_STATE_TOPIC;
   double arm_state_age_ms = 50.0;
   std::string exclude_zones;  // --exclude-zones: C_instructor capsules, camera frame
+  std::string dictionary;     // --dictionary FILE: the describe node's bag of words
 };
 
 [[noreturn]] void fail(const std::string& message, int code) {
@@ -270,6 +271,16 @@ void run(const RunOptions& o) {
   if (!spec) fail(engine::to_string(spec.error()), EXIT_BAD_INPUT);
   override_source(*spec, o);
   apply_rate(*spec, o.rate);
+  if (!o.dictionary.empty()) {  // the bag of words instead of GOOD (docs/SPIN_IMAGES.md)
+    bool found = false;
+    for (engine::NodeSpec& node : spec->nodes) {
+      if (node.kind != "describe") continue;
+      node.params.assign("descriptor", "bow");
+      node.params.assign("dictionary", o.dictionary);
+      found = true;
+    }
+    if (!found) fail("--dictionary: the graph has no describe node", EXIT_USAGE);
+  }
   if (!o.robot_frames.empty() || !o.exclude_zones.empty()) {
     engine::ParamMap body;
     if (o.robot_frames.empty()) {
@@ -406,6 +417,9 @@ void add_run_command(CLI::App& app) {
   cmd->add_option("--rate", o->rate,
                   "source rate in Hz, or max (no pacing, no deadline); default: the graph's period")
       ->check(check_rate);
+  cmd->add_option("--dictionary", o->dictionary,
+                  "describe objects by the bag of words over this dictionary "
+                  "(`orthoflow dictionary build`) instead of GOOD; a --db store must have it");
   cmd->add_option("--db", o->db,
                   "perceptual memory directory (LevelDB); default: learn in memory only");
   cmd->add_option("--learner", o->learner, "instance or bayes")
