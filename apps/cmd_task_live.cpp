@@ -60,7 +60,7 @@ struct LiveArgs {
   std::string frames;
   std::string start;               // run --start TASK; start TASK
   std::vector<std::string> bring;  // serve_a_meal's categories
-  std::vector<double> area{0.10, -0.50, 0.56, -0.15};
+  std::vector<double> area{0.20, -0.50, 0.56, -0.15};
   std::vector<std::string> keep{"plate"};
   std::vector<double> user_place{-0.35, -0.50};
   double seconds = 0.0;              // run: 0 = until a signal
@@ -387,7 +387,7 @@ void send_command(const LiveArgs& a, const std::optional<graphs::TaskCommand>& c
 void add_area_options(CLI::App* cmd, const std::shared_ptr<LiveArgs>& a) {
   cmd->add_option("--area", a->area,
                   "clear_table: the placing area X0,Y0,X1,Y1 on the table, base frame (m; default "
-                  "0.10,-0.50,0.56,-0.15, the synthetic robot frames')")
+                  "0.20,-0.50,0.56,-0.15, the synthetic robot frames')")
       ->type_name("X0,Y0,X1,Y1")
       ->expected(4)
       ->delimiter(',')

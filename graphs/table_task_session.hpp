@@ -62,7 +62,7 @@ struct TableTaskConfig {
   std::vector<simulation::Category> categories;
   std::vector<std::string> keep{"plate"};  ///< clear_table: table items, they stay
   std::vector<std::string> bring;          ///< serve_a_meal: categories to bring, in order
-  manipulation::TableArea area{{0.10, -0.50}, {0.56, -0.15}};  ///< clear_table: base frame (m)
+  manipulation::TableArea area{{0.20, -0.50}, {0.56, -0.15}};  ///< clear_table: base frame (m)
   Eigen::Vector2d user_place{-0.35, -0.50};    ///< serve_a_meal: the first object's spot
   std::int64_t frame_period_ns = 100'000'000;  ///< the camera's period in simulated time
   std::uint32_t settle_frames = 10;            ///< frames before the person teaches (tracks form)

@@ -62,7 +62,7 @@ struct TableTaskOptions {
   TableTaskKind task = TableTaskKind::CLEAR_TABLE;
   std::vector<std::string> keep{"plate"};        ///< clear_table: table items, they stay
   std::vector<std::string> bring;                ///< serve_a_meal: categories to bring, in order
-  TableArea area{{0.10, -0.50}, {0.56, -0.15}};  ///< clear_table: the placing area (base frame, m)
+  TableArea area{{0.20, -0.50}, {0.56, -0.15}};  ///< clear_table: the placing area (base frame, m)
   Eigen::Vector2d user_place{-0.35, -0.50};      ///< serve_a_meal: the first object's spot
   ExecutionLimits limits{};
   JobOptions job{};  ///< the grasp planner's table, the initial pose, ...

@@ -55,7 +55,7 @@ TaskPlan plan_clear_table(std::span<const TableObject> objects, const ClearTable
     const double db = (xy(b->centre) - options.arm_base).norm();
     return da != db ? da < db : a->track < b->track;
   });
-  // The grid's spots, each half a spacing in from the edges.
+  // The grid's spots, row by row from the area's min corner, each half a spacing in from the edges.
   std::vector<Eigen::Vector2d> spots;
   const double s = options.spacing_m;
   if (s > 0.0) {
@@ -64,12 +64,6 @@ TaskPlan plan_clear_table(std::span<const TableObject> objects, const ClearTable
            x += s)
         spots.emplace_back(x, y);
   }
-  // Farthest from the arm's base first: the arm never reaches over, or comes back past, what it
-  // has placed (ties keep the row order).
-  std::stable_sort(spots.begin(), spots.end(),
-                   [&](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-                     return (a - options.arm_base).norm() > (b - options.arm_base).norm();
-                   });
   // A spot is taken when anything stands within three quarters of a spacing of it.
   std::size_t next = 0;
   for (const TableObject* o : to_move) {

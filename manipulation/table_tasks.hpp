@@ -4,8 +4,7 @@
 /// in which order, from the labels the learner gives. Which joints move them is the pick-and-place
 /// job's (pick_place_job.hpp), and the execution manager runs each job.
 /// - clear_table: every recognised object except the categories marked as table items goes to the
-///   placing area, nearest to the arm's base first, each to the next free spot of a grid there,
-///   the spots farthest from the base first (the arm never reaches over what it placed).
+///   placing area, nearest to the arm's base first, each to the next free spot of a grid there.
 /// - serve_a_meal: the objects of the named categories, in the order named, go to the user's place,
 ///   side by side along the table's x axis.
 /// An object the learner calls Unknown is never moved (the robot does not know what it is); every
