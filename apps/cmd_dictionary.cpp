@@ -1,6 +1,7 @@
 // `orthoflow dictionary build --from DIR... --out FILE [--words 70] [--image-width 4]
 // [--support-length 0.05] [--keypoint-leaf 0.01] [--normal-radius 0.02] [--seed 1]
-// [--iterations 100] [--threads N]` and `orthoflow dictionary show FILE [--json]`: the dictionary
+// [--iterations 100] [--topics K [--alpha 1] [--beta 0.1] [--gibbs-iterations 30]] [--threads N]`
+// and `orthoflow dictionary show FILE [--json]`: the dictionary
 // of visual words of the bag-of-words representation (learning/dictionary.hpp,
 // docs/SPIN_IMAGES.md). `build` is the thesis's exploration stage: every object view (*.pcd) under
 // the directories, labelled or not, is described by its spin images at its keypoints, and k-means
@@ -23,6 +24,7 @@
 #include "formats/pcd_io.hpp"
 #include "kernels/spin_features.hpp"
 #include "learning/dictionary.hpp"
+#include "learning/topic_training.hpp"
 
 namespace orthoflow::apps {
 namespace {
@@ -37,6 +39,9 @@ struct DictionaryOptions {
   float normal_radius = 0.02F;
   std::uint64_t seed = 1;
   std::uint32_t iterations = 100;
+  std::size_t topics = 0;  // 0: no topic model
+  double alpha = 1.0, beta = 0.1;
+  std::uint32_t gibbs = 30;
   std::size_t threads = 0;
   std::string file;
   bool json = false;
@@ -110,11 +115,24 @@ void run_build(const DictionaryOptions& o) {
   for (const std::string& root : o.from) provenance += " " + root;
   auto d = learning::build_dictionary(pool, params, km, provenance);
   if (!d) fail(d.error(), EXIT_USAGE);
+  if (o.topics > 0) {  // the topic layer: LDA over the same views' words
+    learning::TopicFitParams tp;
+    tp.topics = o.topics;
+    tp.alpha = o.alpha;
+    tp.beta = o.beta;
+    tp.iterations = o.gibbs;
+    tp.seed = o.seed;
+    if (auto fitted = learning::add_topics(*d, images, tp); !fitted)
+      fail(fitted.error(), EXIT_USAGE);
+    d->provenance += "; LDA of " + std::to_string(o.topics) + " topics over the views' words, " +
+                     std::to_string(o.gibbs) + " Gibbs sweeps";
+  }
   if (const std::string why = learning::save_dictionary(*d, o.out); !why.empty())
     fail(why, EXIT_FAILURE_GENERIC);
   std::cout << "dictionary " << kernels::dictionary_id_hex(d->id) << ": " << d->words
-            << " words of " << d->dims << " values; " << d->provenance << "\nwrote " << o.out
-            << '\n';
+            << " words of " << d->dims << " values"
+            << (d->topics ? ", " + std::to_string(d->topics->topics) + " topics" : std::string())
+            << "; " << d->provenance << "\nwrote " << o.out << '\n';
 }
 
 void run_show(const DictionaryOptions& o) {
@@ -129,6 +147,7 @@ void run_show(const DictionaryOptions& o) {
                            {"support_angle_cos", d->spin.support_angle_cos},
                            {"keypoint_leaf_m", d->keypoint_leaf},
                            {"normal_radius_m", d->normal_radius},
+                           {"topics", d->topics ? d->topics->topics : 0},
                            {"provenance", d->provenance}};
     std::cout << j.dump() << '\n';
     return;
@@ -164,6 +183,16 @@ void add_dictionary_command(CLI::App& app) {
   build->add_option("--seed", o->seed, "k-means++ seed");
   build->add_option("--iterations", o->iterations, "k-means iterations at most")
       ->check(CLI::Range(1, 100000));
+  build
+      ->add_option("--topics", o->topics,
+                   "also fit LDA with this many topics over the views' words (0: none; thesis: 30)")
+      ->check(CLI::Range(0, 1024));
+  build->add_option("--alpha", o->alpha, "LDA's Dirichlet prior on topics (1.0)")
+      ->check(CLI::Range(1e-6, 1e6));
+  build->add_option("--beta", o->beta, "LDA's Dirichlet prior on words (0.1)")
+      ->check(CLI::Range(1e-6, 1e6));
+  build->add_option("--gibbs-iterations", o->gibbs, "Gibbs sweeps, fitting and inference (30)")
+      ->check(CLI::Range(1, 10000));
   build->add_option("--threads", o->threads,
                     "worker threads (0: all); the words do not depend on it");
   build->callback([o] { run_build(*o); });

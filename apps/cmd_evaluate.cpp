@@ -1,5 +1,5 @@
 // `orthoflow evaluate --dataset DIR --protocol cv10|teacher|teacher-context|noise|downsample
-// [--learner instance,bayes] [--approach nn,1,2] [--representation good,bow --dictionary FILE]
+// [--learner instance,bayes] [--approach nn,1,2] [--representation good,bow,lda --dictionary FILE]
 // [--good-mode invariant,reference] [--bins 5,15] [--runs R]
 // [--seed S] [--folds K] [--levels MM,...] [--tau T] [--breakpoint N] [--threads N] [--out DIR]
 // [--cache DIR | --no-cache]`: the thesis's evaluations (evaluation/, docs/EVALUATION.md). Comma
@@ -65,13 +65,13 @@ std::vector<evaluation::Variant> variants_of(
     const std::vector<std::string> rules = bayes ? std::vector<std::string>{"nn"} : o.approaches;
     for (const std::string& a : rules) {
       for (const std::string& r : o.representations) {
-        if (r != "bow") continue;
+        if (r == "good") continue;
         evaluation::Variant v;
         v.learner = bayes ? evaluation::LearnerKind::BAYES : evaluation::LearnerKind::INSTANCE;
         v.rule = a == "1"   ? evaluation::InstanceRule::APPROACH_1
                  : a == "2" ? evaluation::InstanceRule::APPROACH_2
                             : evaluation::InstanceRule::NEAREST;
-        v.representation = kernels::DescriptorKind::BOW;
+        v.representation = r == "lda" ? kernels::DescriptorKind::LDA : kernels::DescriptorKind::BOW;
         v.dictionary = dictionary;
         out.push_back(v);
       }
@@ -120,10 +120,11 @@ void run_evaluate(const EvaluateOptions& o) {
   auto dataset = evaluation::scan_dataset(o.dataset);
   if (!dataset) { fail(dataset.error().to_string(), EXIT_BAD_INPUT); }
   std::shared_ptr<const kernels::VisualDictionary> dictionary;
-  const bool bow = std::find(o.representations.begin(), o.representations.end(), "bow") !=
-                   o.representations.end();
+  const bool bow = std::any_of(o.representations.begin(), o.representations.end(),
+                               [](const std::string& r) { return r != "good"; });
   if (bow && o.dictionary.empty()) {
-    fail("--representation bow needs --dictionary FILE (orthoflow dictionary build)", EXIT_USAGE);
+    fail("--representation bow or lda needs --dictionary FILE (orthoflow dictionary build)",
+         EXIT_USAGE);
   }
   if (bow) {
     auto d = learning::load_dictionary(o.dictionary);
@@ -186,9 +187,10 @@ void add_evaluate_command(CLI::App& app) {
       ->delimiter(',')
       ->check(CLI::IsMember({"nn", "1", "2"}));
   cmd->add_option("--representation", o->representations,
-                  "good and/or bow (comma list; bow: a bag of words over --dictionary's words)")
+                  "good, bow and/or lda (comma list; bow: a bag of words over --dictionary's "
+                  "words; lda: its topics)")
       ->delimiter(',')
-      ->check(CLI::IsMember({"good", "bow"}));
+      ->check(CLI::IsMember({"good", "bow", "lda"}));
   cmd->add_option("--dictionary", o->dictionary,
                   "bow: the visual words (a file from `orthoflow dictionary build`)");
   cmd->add_option("--good-mode", o->modes, "invariant and/or reference (comma list)")

@@ -47,7 +47,7 @@ learning::MemoryConfig config_of(const MemoryOptions& o) {
       o.bins, o.mode == "reference" ? kernels::GoodMode::REFERENCE : kernels::GoodMode::INVARIANT);
   // A bag-of-words store: with --dictionary, those words (a new store takes them; an existing one
   // must have them); without, the store's own.
-  if (o.representation == "bow" || !o.dictionary.empty()) {
+  if (o.representation != "good" || !o.dictionary.empty()) {
     std::shared_ptr<const kernels::VisualDictionary> words;
     if (!o.dictionary.empty()) {
       auto d = learning::load_dictionary(o.dictionary);
@@ -55,7 +55,9 @@ learning::MemoryConfig config_of(const MemoryOptions& o) {
       words = std::make_shared<const kernels::VisualDictionary>(std::move(d.value()));
     }
     const kernels::GoodConfig good = cfg.descriptor.good;
-    cfg.descriptor = kernels::DescriptorSpec::make_bow(std::move(words));
+    cfg.descriptor = o.representation == "lda"
+                         ? kernels::DescriptorSpec::make_lda(std::move(words))
+                         : kernels::DescriptorSpec::make_bow(std::move(words));
     cfg.descriptor.good = good;
   }
   cfg.learner =
@@ -217,11 +219,12 @@ void add_memory_command(CLI::App& app) {
   cmd->add_option("--bins", o->bins, "GOOD bins per side; must match the store (default 15)")
       ->check(CLI::Range(std::size_t{1}, kernels::GOOD_MAX_BINS));
   cmd->add_option("--representation", o->representation,
-                  "good, or bow (a bag of words; a new store needs --dictionary, an existing one "
-                  "uses its own)")
-      ->check(CLI::IsMember({"good", "bow"}));
-  cmd->add_option("--dictionary", o->dictionary,
-                  "bow: the visual words (`orthoflow dictionary build`); implies bow");
+                  "good, bow (a bag of words) or lda (its topics); a new bow or lda store needs "
+                  "--dictionary, an existing one uses its own")
+      ->check(CLI::IsMember({"good", "bow", "lda"}));
+  cmd->add_option(
+      "--dictionary", o->dictionary,
+      "bow, lda: the visual words (`orthoflow dictionary build`); implies bow unless lda");
   cmd->add_option("--mode", o->mode, "GOOD frame mode; must match the store")
       ->check(CLI::IsMember({"invariant", "reference"}));
   cmd->add_option("--ct", o->ct,

@@ -123,7 +123,7 @@ std::string ViewDescription::key() const {
   // "bow-<dictionary id>-none": a dictionary's words and parameters are all in its id.
   const kernels::GoodConfig& good = descriptor.good;
   std::string k = std::string(kernels::to_string(descriptor.kind)) + "-";
-  if (descriptor.kind == kernels::DescriptorKind::BOW && descriptor.dictionary) {
+  if (descriptor.local() && descriptor.dictionary) {
     k += kernels::dictionary_id_hex(descriptor.dictionary->id) + "-" +
          perturbation_name(perturbation);
   } else {

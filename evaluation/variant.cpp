@@ -16,6 +16,10 @@ std::string Variant::name() const {
   if (representation == kernels::DescriptorKind::BOW) {
     return n + "/bow/" + std::to_string(dictionary ? dictionary->words : 0);
   }
+  if (representation == kernels::DescriptorKind::LDA) {
+    return n + "/lda/" +
+           std::to_string(dictionary && dictionary->topics ? dictionary->topics->topics : 0);
+  }
   n += mode == kernels::GoodMode::INVARIANT ? "/invariant/" : "/reference/";
   return n + std::to_string(bins);
 }
@@ -23,6 +27,9 @@ std::string Variant::name() const {
 kernels::DescriptorSpec Variant::spec() const {
   if (representation == kernels::DescriptorKind::BOW) {
     return kernels::DescriptorSpec::make_bow(dictionary);
+  }
+  if (representation == kernels::DescriptorKind::LDA) {
+    return kernels::DescriptorSpec::make_lda(dictionary);
   }
   return kernels::DescriptorSpec::make_good(bins, mode);
 }

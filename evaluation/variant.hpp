@@ -24,12 +24,13 @@ struct Variant {
   InstanceRule rule = InstanceRule::NEAREST;
   kernels::GoodMode mode = kernels::GoodMode::INVARIANT;
   std::size_t bins = 15;
-  /// The representation: GOOD (mode, bins) or BOW (this dictionary's words).
+  /// The representation: GOOD (mode, bins), BOW (this dictionary's words) or LDA (its topics).
   kernels::DescriptorKind representation = kernels::DescriptorKind::GOOD;
   std::shared_ptr<const kernels::VisualDictionary> dictionary;
   /// @brief The descriptor specification of this variant.
   [[nodiscard]] kernels::DescriptorSpec spec() const;
-  /// @brief "instance-nn/invariant/15", "bayes/reference/5", "instance-nn/bow/70", ...
+  /// @brief "instance-nn/invariant/15", "bayes/reference/5", "instance-nn/bow/70", "bayes/lda/30",
+  /// ...
   [[nodiscard]] std::string name() const;
   /// @brief The descriptor parameters of this variant with perturbation @p p of @p amount_m.
   [[nodiscard]] ViewDescription descriptor(Perturbation p = Perturbation::NONE,

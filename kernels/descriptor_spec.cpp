@@ -12,6 +12,8 @@ std::string_view to_string(DescriptorKind kind) noexcept {
       return "good";
     case DescriptorKind::BOW:
       return "bow";
+    case DescriptorKind::LDA:
+      return "lda";
   }
   return "unknown";
 }
@@ -31,8 +33,18 @@ DescriptorSpec DescriptorSpec::make_bow(
   return s;
 }
 
+DescriptorSpec DescriptorSpec::make_lda(
+    std::shared_ptr<const VisualDictionary> dictionary) noexcept {
+  DescriptorSpec s;
+  s.kind = DescriptorKind::LDA;
+  s.dictionary = std::move(dictionary);
+  return s;
+}
+
 std::size_t DescriptorSpec::length() const noexcept {
   if (kind == DescriptorKind::BOW) return dictionary ? dictionary->words : 0;
+  if (kind == DescriptorKind::LDA)
+    return dictionary && dictionary->topics ? dictionary->topics->topics : 0;
   return 3 * good.bins * good.bins;
 }
 
@@ -45,8 +57,8 @@ Result<void, std::string> DescriptorSpec::validate() const {
   const float t = good.effective_threshold();
   if (!std::isfinite(t) || t < 0.0F)
     return err("descriptor " + describe() + ": the threshold must be finite and >= 0");
-  if (kind == DescriptorKind::BOW) {
-    if (!dictionary) return err(std::string("descriptor bow: no dictionary"));
+  if (local()) {
+    if (!dictionary) return err(std::string(to_string(kind)) + " descriptor: no dictionary");
     const VisualDictionary& d = *dictionary;
     const std::uint32_t w = d.spin.image_width;
     if (w == 0 || w > MAX_SPIN_IMAGE_WIDTH || d.dims != spin_image_bins(w))
@@ -62,19 +74,28 @@ Result<void, std::string> DescriptorSpec::validate() const {
       return err("descriptor " + describe() +
                  ": support length, keypoint leaf and normal radius must be finite and > 0, the "
                  "support angle's cosine in [0, 1]");
+    if (kind == DescriptorKind::LDA &&
+        (!d.topics || d.topics->words != d.words || !d.topics->consistent()))
+      return err("descriptor " + describe() +
+                 ": the dictionary has no topic model of its words (orthoflow dictionary build "
+                 "--topics K)");
   }
   return {};
 }
 
 std::string DescriptorSpec::describe() const {
-  char text[160];
-  if (kind == DescriptorKind::BOW) {
-    if (!dictionary) return "bow (no dictionary)";
+  char text[224];
+  if (local()) {
+    if (!dictionary) return std::string(to_string(kind)) + " (no dictionary)";
     const VisualDictionary& d = *dictionary;
-    std::snprintf(text, sizeof text, "bow words=%zu iw=%u sl=%g vs=%g nr=%g dictionary=%s", d.words,
-                  d.spin.image_width, static_cast<double>(d.spin.support_length),
-                  static_cast<double>(d.keypoint_leaf), static_cast<double>(d.normal_radius),
-                  dictionary_id_hex(d.id).c_str());
+    char topics[96] = "";
+    if (kind == DescriptorKind::LDA && d.topics)
+      std::snprintf(topics, sizeof topics, "topics=%zu alpha=%g beta=%g iterations=%u ",
+                    d.topics->topics, d.topics->alpha, d.topics->beta, d.topics->iterations);
+    std::snprintf(text, sizeof text, "%s %swords=%zu iw=%u sl=%g vs=%g nr=%g dictionary=%s",
+                  std::string(to_string(kind)).c_str(), topics, d.words, d.spin.image_width,
+                  static_cast<double>(d.spin.support_length), static_cast<double>(d.keypoint_leaf),
+                  static_cast<double>(d.normal_radius), dictionary_id_hex(d.id).c_str());
     return text;
   }
   std::snprintf(text, sizeof text, "%g", static_cast<double>(good.effective_threshold()));
@@ -87,7 +108,7 @@ bool DescriptorSpec::operator==(const DescriptorSpec& other) const noexcept {
   const bool same_good = good.bins == other.good.bins && good.mode == other.good.mode &&
                          good.effective_threshold() == other.good.effective_threshold();
   if (kind != other.kind || !same_good) return false;
-  if (kind == DescriptorKind::BOW) {
+  if (local()) {
     if (!dictionary || !other.dictionary) return dictionary == other.dictionary;
     return dictionary->id == other.dictionary->id && dictionary->words == other.dictionary->words;
   }
@@ -95,9 +116,11 @@ bool DescriptorSpec::operator==(const DescriptorSpec& other) const noexcept {
 }
 
 Describer::Describer(const DescriptorSpec& spec) : spec_(spec), good_scratch_(spec.good.bins) {
-  if (spec_.kind == DescriptorKind::BOW && spec_.dictionary) {
+  if (spec_.local() && spec_.dictionary) {
     good_values_.resize(3 * spec_.good.bins * spec_.good.bins);
     word_scratch_.resize(spec_.dictionary->words);
+    if (spec_.kind == DescriptorKind::LDA && spec_.dictionary->topics)
+      topic_scratch_ = TopicScratch(spec_.dictionary->topics->topics, spec_.dictionary->words, 0);
   }
 }
 
@@ -116,8 +139,22 @@ Result<void, GoodError> Describer::describe_bow(PointsView points, std::span<flo
         return err(GoodError::KEYPOINTS_FAILED);
     }
   }
-  features_ = bag_of_words(features.images(), d.view(), word_scratch_, out);
+  if (spec_.kind == DescriptorKind::BOW) {
+    features_ = bag_of_words(features.images(), d.view(), word_scratch_, out);
+    if (features_ == 0) return err(GoodError::NO_FEATURES);
+    return {};
+  }
+  // LDA: the view's words, then its topics (the scratch grows to the largest view).
+  const std::size_t rows = features.images().size() / d.dims;
+  try {
+    if (word_ids_.size() < rows) word_ids_.resize(rows);
+    if (topic_scratch_.z.size() < rows) topic_scratch_.z.resize(rows);
+  } catch (const std::bad_alloc&) { return err(GoodError::OUT_OF_MEMORY); }
+  features_ = assign_words(features.images(), d.view(), word_scratch_, word_ids_);
   if (features_ == 0) return err(GoodError::NO_FEATURES);
+  if (!infer_topics(std::span<const std::uint32_t>(word_ids_.data(), features_), *d.topics,
+                    topic_scratch_, out))
+    return err(GoodError::OUTPUT_TOO_SMALL);
   return {};
 }
 
@@ -129,7 +166,7 @@ Result<DescriptorInfo, GoodError> Describer::describe(PointsView points,
 Result<DescriptorInfo, GoodError> Describer::describe(PointsView points, std::span<float> out,
                                                       SpinFeatures& features) noexcept {
   features_ = 0;
-  if (spec_.kind == DescriptorKind::GOOD) {
+  if (!spec_.local()) {
     auto good = compute_good(points, spec_.good, good_scratch_, out);
     if (!good) return err(good.error());
     return DescriptorInfo{good->length, good->frame, good->bbox, good->flags};

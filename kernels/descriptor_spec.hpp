@@ -24,8 +24,9 @@ namespace orthoflow::kernels {
 enum class DescriptorKind : std::uint8_t {
   GOOD,  ///< the Global Orthographic Object Descriptor: 3 n^2 normalised histogram values
   BOW,   ///< bag of words: the shares of a view's spin images nearest each word of a dictionary
+  LDA,   ///< topic histogram: theta of the view's words under the dictionary's topic model
 };
-/// @brief "good" or "bow".
+/// @brief "good", "bow" or "lda".
 [[nodiscard]] std::string_view to_string(DescriptorKind kind) noexcept;
 
 /// @brief Kind, parameters and length of a descriptor. A plain value; compare with ==.
@@ -43,7 +44,14 @@ struct DescriptorSpec {
   /// @brief A bag-of-words specification over @p dictionary.
   [[nodiscard]] static DescriptorSpec make_bow(
       std::shared_ptr<const VisualDictionary> dictionary) noexcept;
-  /// @brief Values per descriptor (GOOD: 3 n^2; BOW: the dictionary's words).
+  /// @brief A topic specification over @p dictionary's topic model.
+  [[nodiscard]] static DescriptorSpec make_lda(
+      std::shared_ptr<const VisualDictionary> dictionary) noexcept;
+  /// @brief BOW or LDA: described through a dictionary's words.
+  [[nodiscard]] bool local() const noexcept {
+    return kind == DescriptorKind::BOW || kind == DescriptorKind::LDA;
+  }
+  /// @brief Values per descriptor (GOOD: 3 n^2; BOW: the dictionary's words; LDA: its topics).
   [[nodiscard]] std::size_t length() const noexcept;
   /// @brief Every value is a non-negative histogram share (what a naive Bayes learner needs).
   [[nodiscard]] bool histogram() const noexcept;
@@ -97,6 +105,8 @@ class Describer {
   std::vector<float> good_values_;  ///< BOW: GOOD's values, for its frame and box only
   SpinFeatures features_scratch_;
   std::vector<float> word_scratch_;
+  std::vector<std::uint32_t> word_ids_;  ///< LDA: the view's words (grows to the largest view)
+  TopicScratch topic_scratch_;           ///< LDA
   std::size_t features_ = 0;
 };
 

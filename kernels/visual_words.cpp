@@ -47,6 +47,15 @@ std::uint64_t dictionary_id(const VisualDictionary& d) noexcept {
   mix(h, std::bit_cast<std::uint32_t>(d.spin.support_angle_cos));
   mix(h, std::bit_cast<std::uint32_t>(d.keypoint_leaf));
   mix(h, std::bit_cast<std::uint32_t>(d.normal_radius));
+  if (d.topics) {
+    const TopicModel& t = *d.topics;
+    mix(h, t.topics);
+    mix(h, std::bit_cast<std::uint64_t>(t.alpha));
+    mix(h, std::bit_cast<std::uint64_t>(t.beta));
+    mix(h, t.iterations);
+    mix(h, t.seed);
+    for (const std::uint32_t n : t.word_topic) mix(h, n);
+  }
   return h;
 }
 
@@ -95,6 +104,21 @@ std::size_t nearest_word(std::span<const float> feature, DescriptorMatrixView wo
     }
   }
   return best;
+}
+
+std::size_t assign_words(std::span<const float> features, DescriptorMatrixView words,
+                         std::span<float> scratch, std::span<std::uint32_t> out) noexcept {
+  OF_ENFORCE(words.dims > 0 && features.size() % words.dims == 0,
+             "assign_words: the features are not whole rows");
+  OF_ENFORCE(out.size() >= features.size() / words.dims, "assign_words: the output is too short");
+  std::size_t n = 0;
+  for (std::size_t at = 0; at < features.size(); at += words.dims) {
+    const auto f = features.subspan(at, words.dims);
+    if (std::all_of(f.begin(), f.end(), [](float v) { return v == 0.0F; })) continue;
+    const std::size_t w = nearest_word(f, words, scratch);
+    if (w != NO_WORD) out[n++] = static_cast<std::uint32_t>(w);
+  }
+  return n;
 }
 
 std::size_t bag_of_words(std::span<const float> features, DescriptorMatrixView words,

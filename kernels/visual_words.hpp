@@ -10,12 +10,14 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
 
 #include "kernels/distance.hpp"
 #include "kernels/spin_image.hpp"
+#include "kernels/topic_model.hpp"
 
 namespace orthoflow::kernels {
 
@@ -28,14 +30,16 @@ struct VisualDictionary {
   SpinImageParams spin{};       ///< how the pooled spin images were computed
   float keypoint_leaf = 0.01F;  ///< VS, metres: the keypoints' voxel grid
   float normal_radius = 0.02F;  ///< metres: kernels::point_normals' radius
-  std::uint64_t id = 0;         ///< a hash of all of the above (dictionary_id())
+  std::optional<TopicModel> topics;  ///< LDA fitted over the words (the topic layer), if any
+  std::uint64_t id = 0;              ///< a hash of all of the above (dictionary_id())
   std::string provenance;  ///< where the pool came from, k-means seed and iterations (free text)
 
   [[nodiscard]] DescriptorMatrixView view() const noexcept { return {data, dims, words, words}; }
 };
 
-/// @brief FNV-1a 64 over the words, dims, every word value's bits and the parameters (not the
-/// provenance): equal dictionaries have equal ids on every machine.
+/// @brief FNV-1a 64 over the words, dims, every word value's bits and the parameters, and the topic
+/// model's parameters and counts when it has one (not the provenance): equal dictionaries have
+/// equal ids on every machine.
 [[nodiscard]] std::uint64_t dictionary_id(const VisualDictionary& d) noexcept;
 /// @brief "3f2a9c0d11e4b7a0": the id as 16 hex digits.
 [[nodiscard]] std::string dictionary_id_hex(std::uint64_t id);
@@ -56,6 +60,12 @@ inline constexpr std::size_t NO_WORD = std::numeric_limits<std::size_t>::max();
 /// each bin the share of the counted features nearest that word (the histogram sums to 1).
 /// @return the features counted (0: the histogram is all zeros). @pre histogram.size() >=
 /// words.count, scratch.size() >= words.count, features.size() a multiple of words.dims.
+/// @brief The word of every feature row with weight (all-zero rows skipped), in row order, into
+/// @p out (room for every row). @return how many were written.
+[[nodiscard]] std::size_t assign_words(std::span<const float> features, DescriptorMatrixView words,
+                                       std::span<float> scratch,
+                                       std::span<std::uint32_t> out) noexcept;
+
 [[nodiscard]] std::size_t bag_of_words(std::span<const float> features, DescriptorMatrixView words,
                                        std::span<float> scratch,
                                        std::span<float> histogram) noexcept;

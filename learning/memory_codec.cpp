@@ -92,7 +92,7 @@ std::string encode_schema(const kernels::DescriptorSpec& spec) {
       {"bins", spec.good.bins},
       {"mode", spec.good.mode == kernels::GoodMode::INVARIANT ? "invariant" : "reference"},
       {"threshold", spec.good.effective_threshold()}};
-  if (spec.kind == kernels::DescriptorKind::BOW && spec.dictionary) {
+  if (spec.local() && spec.dictionary) {
     const kernels::VisualDictionary& d = *spec.dictionary;
     j["dictionary"] = kernels::dictionary_id_hex(d.id);
     j["words"] = d.words;
@@ -169,15 +169,15 @@ std::optional<kernels::DescriptorSpec> decode_schema(std::string_view json, std:
         "string \"descriptor\")";
     return std::nullopt;
   }
-  const bool bow = kind != j.end() &&
-                   kind->get<std::string>() == kernels::to_string(kernels::DescriptorKind::BOW);
-  if (kind != j.end() && !bow &&
-      kind->get<std::string>() != kernels::to_string(kernels::DescriptorKind::GOOD)) {
-    why = "descriptor \"" + kind->get<std::string>() + "\" is not one this build knows (good, bow)";
+  const std::string kind_name = kind != j.end() ? kind->get<std::string>() : "good";
+  const bool bow = kind_name == kernels::to_string(kernels::DescriptorKind::BOW);
+  const bool lda = kind_name == kernels::to_string(kernels::DescriptorKind::LDA);
+  if (!bow && !lda && kind_name != kernels::to_string(kernels::DescriptorKind::GOOD)) {
+    why = "descriptor \"" + kind_name + "\" is not one this build knows (good, bow, lda)";
     return std::nullopt;
   }
   std::optional<kernels::VisualDictionary> dictionary;
-  if (bow && !(dictionary = schema_dictionary(j, why))) return std::nullopt;
+  if ((bow || lda) && !(dictionary = schema_dictionary(j, why))) return std::nullopt;
   const std::string m = mode->get<std::string>();
   if (m != "invariant" && m != "reference") {
     why = "mode must be \"invariant\" or \"reference\", not \"" + m + "\"";
@@ -189,7 +189,7 @@ std::optional<kernels::DescriptorSpec> decode_schema(std::string_view json, std:
       m == "invariant" ? kernels::GoodMode::INVARIANT : kernels::GoodMode::REFERENCE);
   spec.good.threshold = threshold->get<float>();
   if (dictionary) {
-    spec.kind = kernels::DescriptorKind::BOW;
+    spec.kind = lda ? kernels::DescriptorKind::LDA : kernels::DescriptorKind::BOW;
     spec.dictionary = std::make_shared<const kernels::VisualDictionary>(std::move(*dictionary));
   }
   return spec;

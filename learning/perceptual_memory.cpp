@@ -33,7 +33,7 @@ Result<void, MemoryError> check_schema(PerceptualMemory::State& s, bool created)
                      "a LevelDB database without orthoflow's schema key: not a perceptual memory; "
                      "nothing was changed"));
   }
-  const bool bow = s.cfg.descriptor.kind == kernels::DescriptorKind::BOW;
+  const bool bow = s.cfg.descriptor.local();  // bag of words or topics: over a dictionary
   if (st.IsNotFound()) {
     if (auto valid = s.cfg.descriptor.validate(); !valid) {
       return err(
@@ -61,7 +61,7 @@ Result<void, MemoryError> check_schema(PerceptualMemory::State& s, bool created)
         memory_error(Code::CORRUPT, s.dir,
                      "schema key: " + (stored ? "version " + std::to_string(version) : why)));
   }
-  if (stored->kind == kernels::DescriptorKind::BOW) {
+  if (stored->local()) {
     // The store's own dictionary: its words are in the "d" record, which must be the one the
     // schema names.
     std::string bytes;
@@ -77,7 +77,8 @@ Result<void, MemoryError> check_schema(PerceptualMemory::State& s, bool created)
                                           : own.error())));
     }
     stored->dictionary = std::make_shared<const kernels::VisualDictionary>(std::move(own.value()));
-    if (bow && !s.cfg.descriptor.dictionary) {  // opened as "bow" without words: the store's own
+    if (bow && !s.cfg.descriptor.dictionary &&
+        stored->kind == s.cfg.descriptor.kind) {  // opened as "bow" without words: the store's own
       s.cfg.descriptor = *stored;
       s.learner = make_learner(s.cfg);
     }
@@ -251,8 +252,7 @@ Result<PerceptualMemory, MemoryError> PerceptualMemory::open(const std::filesyst
                                                              const MemoryConfig& cfg,
                                                              OpenMode mode) {
   // A bag of words without its dictionary opens a store with the store's own (check_schema).
-  const bool adopt =
-      cfg.descriptor.kind == kernels::DescriptorKind::BOW && !cfg.descriptor.dictionary;
+  const bool adopt = cfg.descriptor.local() && !cfg.descriptor.dictionary;
   if (auto valid = cfg.descriptor.validate(); !valid && !adopt)
     return err(memory_error(Code::OPEN_FAILED, dir, valid.error()));
   auto s = std::make_unique<State>();
