@@ -12,7 +12,9 @@
 #include "kernels/descriptor_spec.hpp"
 #include "kernels/simd_arch.hpp"
 #include "kernels/spin_features.hpp"
+#include "kernels/topic_model.hpp"
 #include "learning/dictionary.hpp"
+#include "learning/topic_training.hpp"
 
 namespace ok = orthoflow::kernels;
 namespace ol = orthoflow::learning;
@@ -51,10 +53,28 @@ std::shared_ptr<const ok::VisualDictionary> words_of(const ok::PointCloud& cloud
   return d;
 }
 
-void BM_Describe(benchmark::State& state, const char* name, bool bow) {
+/// A topic model of 30 topics over the words, fitted on 40 random documents of 300 words.
+std::shared_ptr<const ok::VisualDictionary> with_topics(
+    std::shared_ptr<const ok::VisualDictionary> words) {
+  auto d = std::make_shared<ok::VisualDictionary>(*words);
+  orthoflow::core::Rng rng(9);
+  std::vector<std::vector<std::uint32_t>> docs(40);
+  for (auto& doc : docs)
+    for (int i = 0; i < 300; ++i) doc.push_back(static_cast<std::uint32_t>(rng.below(d->words)));
+  auto m = ol::fit_lda(docs, d->words, {});
+  if (!m) std::abort();
+  d->topics = std::move(m.value());
+  d->id = ok::dictionary_id(*d);
+  return d;
+}
+
+void BM_Describe(benchmark::State& state, const char* name, int kind) {
   const ok::PointCloud cloud = view(name);
+  const bool bow = kind > 0;
   const ok::DescriptorSpec spec =
-      bow ? ok::DescriptorSpec::make_bow(words_of(cloud, 70)) : ok::DescriptorSpec::make_good(15);
+      kind == 2   ? ok::DescriptorSpec::make_lda(with_topics(words_of(cloud, 90)))
+      : kind == 1 ? ok::DescriptorSpec::make_bow(words_of(cloud, 70))
+                  : ok::DescriptorSpec::make_good(15);
   ok::Describer describer(spec);
   std::vector<float> out(spec.length());
   for (auto _ : state) benchmark::DoNotOptimize(describer.describe(cloud.points(), out));
@@ -83,6 +103,24 @@ void BM_WordsOfAView(benchmark::State& state) {
   if (SIMD) state.SetLabel(ok::simd_arch_name());
 }
 
+// Gibbs inference of one view's topics (30 topics, 90 words, 30 sweeps): sweeps per second.
+void BM_TopicInference(benchmark::State& state) {
+  const auto words = static_cast<std::size_t>(state.range(0));
+  auto d = with_topics(std::make_shared<ok::VisualDictionary>([] {
+    ok::VisualDictionary v;
+    v.words = 90;
+    return v;
+  }()));
+  orthoflow::core::Rng rng(2);
+  std::vector<std::uint32_t> doc(words);
+  for (auto& w : doc) w = static_cast<std::uint32_t>(rng.below(90));
+  ok::TopicScratch scratch(30, 90, words);
+  std::vector<float> theta(30);
+  for (auto _ : state) benchmark::DoNotOptimize(ok::infer_topics(doc, *d->topics, scratch, theta));
+  state.counters["sweeps_per_s"] = benchmark::Counter(
+      30.0 * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+}
+
 void BM_KMeans(benchmark::State& state) {
   const auto rows = static_cast<std::size_t>(state.range(0));
   const auto pool = random_pool(rows, ok::spin_image_bins(4));
@@ -94,10 +132,13 @@ void BM_KMeans(benchmark::State& state) {
 
 }  // namespace
 
-BENCHMARK_CAPTURE(BM_Describe, good_bowl, "bowl", false)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_Describe, bow_bowl, "bowl", true)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_Describe, good_bottle, "bottle", false)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_Describe, bow_bottle, "bottle", true)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Describe, good_bowl, "bowl", 0)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Describe, bow_bowl, "bowl", 1)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Describe, lda_bowl, "bowl", 2)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Describe, good_bottle, "bottle", 0)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Describe, bow_bottle, "bottle", 1)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Describe, lda_bottle, "bottle", 2)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_TopicInference)->Arg(331)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_WordsOfAView<false>)
     ->Name("BM_WordsOfAView/scalar")
     ->Args({271, 70})

@@ -204,3 +204,14 @@ TEST(DictionaryFile, ReadsTheHandWrittenFuzzSeed) {
   EXPECT_EQ(d->provenance, "fuzz seed");
   EXPECT_EQ(d->data[1], 0.5F);
 }
+
+// The second seed has a topic model (file version 2), also written by hand.
+TEST(DictionaryFile, ReadsTheHandWrittenFuzzSeedWithTopics) {
+  auto d = ol::load_dictionary(std::filesystem::path(ORTHOFLOW_SOURCE_DIR) /
+                               "tests/fuzz/corpus/dictionary/two_words_two_topics");
+  ASSERT_TRUE(d) << d.error();
+  ASSERT_TRUE(d->topics);
+  EXPECT_EQ(d->topics->topics, 2U);
+  EXPECT_EQ(d->topics->topic_total, (std::vector<std::uint32_t>{4, 2}));
+  EXPECT_TRUE(d->topics->consistent());
+}
