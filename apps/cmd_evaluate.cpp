@@ -64,13 +64,14 @@ std::vector<evaluation::Variant> variants_of(
     const bool bayes = l == "bayes";
     const std::vector<std::string> rules = bayes ? std::vector<std::string>{"nn"} : o.approaches;
     for (const std::string& a : rules) {
+      evaluation::Variant base;  // the learner and its rule; then each representation
+      base.learner = bayes ? evaluation::LearnerKind::BAYES : evaluation::LearnerKind::INSTANCE;
+      base.rule = a == "1"   ? evaluation::InstanceRule::APPROACH_1
+                  : a == "2" ? evaluation::InstanceRule::APPROACH_2
+                             : evaluation::InstanceRule::NEAREST;
       for (const std::string& r : o.representations) {
         if (r == "good") continue;
-        evaluation::Variant v;
-        v.learner = bayes ? evaluation::LearnerKind::BAYES : evaluation::LearnerKind::INSTANCE;
-        v.rule = a == "1"   ? evaluation::InstanceRule::APPROACH_1
-                 : a == "2" ? evaluation::InstanceRule::APPROACH_2
-                            : evaluation::InstanceRule::NEAREST;
+        evaluation::Variant v = base;
         v.representation = r == "lda" ? kernels::DescriptorKind::LDA : kernels::DescriptorKind::BOW;
         v.dictionary = dictionary;
         out.push_back(v);
@@ -79,11 +80,7 @@ std::vector<evaluation::Variant> variants_of(
                         o.representations.end();
       for (const std::string& m : good ? o.modes : std::vector<std::string>{}) {
         for (const std::size_t b : o.bins) {
-          evaluation::Variant v;
-          v.learner = bayes ? evaluation::LearnerKind::BAYES : evaluation::LearnerKind::INSTANCE;
-          v.rule = a == "1"   ? evaluation::InstanceRule::APPROACH_1
-                   : a == "2" ? evaluation::InstanceRule::APPROACH_2
-                              : evaluation::InstanceRule::NEAREST;
+          evaluation::Variant v = base;
           v.mode = m == "reference" ? kernels::GoodMode::REFERENCE : kernels::GoodMode::INVARIANT;
           v.bins = b;
           out.push_back(v);

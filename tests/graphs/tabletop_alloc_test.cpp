@@ -34,6 +34,15 @@ using orthoflow::test::g_counting;
 namespace orthoflow::graphs {
 namespace {
 
+/// Starts counting allocations once the graph has logged 20 frames (the warm-up), or at @p stop.
+std::thread count_after_warm_up(SessionLog& log, const std::atomic<bool>& stop) {
+  return std::thread([&log, &stop] {
+    while (log.summary().frames < 20 && !stop.load())
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    g_counting.store(true);
+  });
+}
+
 TEST(TabletopAllocations, SteadyStateAllocatesNothingPerFrame) {
   auto learning = test::in_memory_learning();
   // A learner that knows categories, so every ask walks real stored views.
@@ -61,11 +70,7 @@ TEST(TabletopAllocations, SteadyStateAllocatesNothingPerFrame) {
   engine::Engine engine(**graph, {2});
   // warm-up: 20 frames, then count over the remaining 40
   std::atomic<bool> stop{false};
-  std::thread arm([&] {
-    while (log.summary().frames < 20 && !stop.load())
-      std::this_thread::sleep_for(std::chrono::milliseconds(1));
-    g_counting.store(true);
-  });
+  std::thread arm = count_after_warm_up(log, stop);
   std::uint64_t lists = 0, answers = 0;
   std::thread consumer([&] {
     engine::ObjectListPayload list;
@@ -208,11 +213,7 @@ TEST(TabletopAllocations, WithTheBagOfWordsNothingIsAllocatedPerFrame) {
   ASSERT_TRUE(graph) << engine::to_string(graph.error());
   engine::Engine engine(**graph, {2});
   std::atomic<bool> stop{false};
-  std::thread arm([&] {
-    while (log.summary().frames < 20 && !stop.load())
-      std::this_thread::sleep_for(std::chrono::milliseconds(1));
-    g_counting.store(true);
-  });
+  std::thread arm = count_after_warm_up(log, stop);
   engine.run({});
   g_counting.store(false);
   stop.store(true);
