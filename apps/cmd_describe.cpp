@@ -1,7 +1,8 @@
 // `orthoflow describe FILE.pcd [--bins N] [--mode invariant|reference] [--threshold T] [--json]
 // [--png OUT.png]`: the GOOD descriptor of one object cloud (kernels/good.hpp, docs/GOOD.md), with
 // its object frame, bounding box, projection order and flags; --png draws the three projections
-// side by side.
+// side by side. `--dictionary FILE [--representation bow|lda]`: its bag of words or its topics
+// instead (docs/SPIN_IMAGES.md).
 #include <cairo.h>
 
 #include <algorithm>
@@ -19,6 +20,7 @@
 #include "formats/pcd_io.hpp"
 #include "kernels/descriptor_spec.hpp"
 #include "kernels/good.hpp"
+#include "learning/dictionary.hpp"
 
 namespace orthoflow::apps {
 namespace {
@@ -30,6 +32,8 @@ struct DescribeOptions {
   std::optional<float> threshold;
   bool json = false;
   std::string png;
+  std::string representation = "good";
+  std::string dictionary;
 };
 
 struct Described {
@@ -163,9 +167,46 @@ bool write_png(const std::string& path, const Described& d, std::size_t n) {
   throw CLI::RuntimeError(code);
 }
 
+// The bag of words or topics of one view (docs/SPIN_IMAGES.md): the Describer under that
+// specification, as the graph, the memory and the evaluation describe it.
+void run_describe_local(const DescribeOptions& o, const kernels::PointCloud& cloud) {
+  auto words = learning::load_dictionary(o.dictionary);
+  if (!words) fail(words.error(), EXIT_BAD_INPUT);
+  auto dictionary = std::make_shared<const kernels::VisualDictionary>(std::move(words.value()));
+  const kernels::DescriptorSpec spec = o.representation == "lda"
+                                           ? kernels::DescriptorSpec::make_lda(dictionary)
+                                           : kernels::DescriptorSpec::make_bow(dictionary);
+  if (auto valid = spec.validate(); !valid) fail(valid.error(), EXIT_USAGE);
+  kernels::Describer describer(spec);
+  std::vector<float> values(spec.length());
+  auto described = describer.describe(cloud.points(), values);
+  if (!described) fail(o.file + ": " + kernels::to_string(described.error()), EXIT_BAD_INPUT);
+  const nlohmann::json j{{"file", o.file},
+                         {"representation", std::string(kernels::to_string(spec.kind))},
+                         {"specification", spec.describe()},
+                         {"spin_images", describer.features()},
+                         {"descriptor", floats_json(values)},
+                         {"frame", floats_json(described->frame)},
+                         {"bbox", floats_json(described->bbox)}};
+  if (o.json) {
+    std::cout << j.dump() << '\n';
+    return;
+  }
+  std::cout << "file:        " << o.file << "\nspec:        " << spec.describe()
+            << "\nspin images: " << describer.features() << "\nbbox:        " << j["bbox"].dump()
+            << "\ndescriptor:  " << j["descriptor"].dump() << '\n';
+}
+
 void run_describe(const DescribeOptions& o) {
   auto cloud_result = formats::read_pcd(o.file);
   if (!cloud_result) { fail(cloud_result.error().to_string(), EXIT_BAD_INPUT); }
+  if (o.representation != "good" || !o.dictionary.empty()) {
+    if (o.dictionary.empty())
+      fail("--representation bow or lda needs --dictionary FILE", EXIT_USAGE);
+    if (!o.png.empty()) fail("--png draws GOOD's projections only", EXIT_USAGE);
+    run_describe_local(o, *cloud_result);
+    return;
+  }
   // This command shows GOOD's own details (projections, order, entropies), so it calls compute_good
   // directly; the length still comes from the one specification.
   kernels::DescriptorSpec spec = kernels::DescriptorSpec::make_good(
@@ -213,6 +254,11 @@ void add_describe_command(CLI::App& app) {
                 "print one JSON object: descriptor, frame, bbox, order, points_used, flags");
   cmd->add_option("--png", o->png,
                   "draw the three projections with the frame axes into this PNG file");
+  cmd->add_option("--representation", o->representation,
+                  "good, bow (the view's words) or lda (its topics; both need --dictionary)")
+      ->check(CLI::IsMember({"good", "bow", "lda"}));
+  cmd->add_option("--dictionary", o->dictionary,
+                  "the visual words (`orthoflow dictionary build`); implies bow unless lda");
   cmd->callback([o] { run_describe(*o); });
 }
 
