@@ -25,20 +25,25 @@ DescriptorSpec DescriptorSpec::make_good(std::size_t bins, GoodMode mode) noexce
   return s;
 }
 
-DescriptorSpec DescriptorSpec::make_bow(
-    std::shared_ptr<const VisualDictionary> dictionary) noexcept {
+namespace {
+
+DescriptorSpec over_words(DescriptorKind kind, std::shared_ptr<const VisualDictionary> dictionary) {
   DescriptorSpec s;
-  s.kind = DescriptorKind::BOW;
+  s.kind = kind;
   s.dictionary = std::move(dictionary);
   return s;
 }
 
+}  // namespace
+
+DescriptorSpec DescriptorSpec::make_bow(
+    std::shared_ptr<const VisualDictionary> dictionary) noexcept {
+  return over_words(DescriptorKind::BOW, std::move(dictionary));
+}
+
 DescriptorSpec DescriptorSpec::make_lda(
     std::shared_ptr<const VisualDictionary> dictionary) noexcept {
-  DescriptorSpec s;
-  s.kind = DescriptorKind::LDA;
-  s.dictionary = std::move(dictionary);
-  return s;
+  return over_words(DescriptorKind::LDA, std::move(dictionary));
 }
 
 std::size_t DescriptorSpec::length() const noexcept {

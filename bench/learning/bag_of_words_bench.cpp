@@ -10,9 +10,11 @@
 #include "core/rng.hpp"
 #include "formats/pcd_io.hpp"
 #include "kernels/descriptor_spec.hpp"
+#include "kernels/point_normals.hpp"
 #include "kernels/simd_arch.hpp"
 #include "kernels/spin_features.hpp"
 #include "kernels/topic_model.hpp"
+#include "kernels/visual_words.hpp"
 #include "learning/dictionary.hpp"
 #include "learning/topic_training.hpp"
 
@@ -103,6 +105,22 @@ void BM_WordsOfAView(benchmark::State& state) {
   if (SIMD) state.SetLabel(ok::simd_arch_name());
 }
 
+// kernels::point_normals at the keypoints of one real view (VS 1 cm, radius 2 cm): the normals
+// the bag of words spins its images about.
+void BM_PointNormals(benchmark::State& state) {
+  const ok::PointCloud cloud = view("bowl");
+  const std::size_t n = cloud.size();
+  ok::VoxelGridScratch voxels(n);
+  std::vector<float> cx(n), cy(n), cz(n), nx(n), ny(n), nz(n);
+  std::vector<std::uint32_t> keys(n);
+  auto k = ok::voxel_keypoints(cloud.points(), 0.01F, voxels, {cx, cy, cz}, keys);
+  if (!k) std::abort();
+  keys.resize(k.value());
+  for (auto _ : state)
+    benchmark::DoNotOptimize(ok::point_normals(cloud.points(), keys, {}, {nx, ny, nz}));
+  state.counters["keypoints"] = static_cast<double>(keys.size());
+}
+
 // Gibbs inference of one view's topics (30 topics, 90 words, 30 sweeps): sweeps per second.
 void BM_TopicInference(benchmark::State& state) {
   const auto words = static_cast<std::size_t>(state.range(0));
@@ -138,6 +156,7 @@ BENCHMARK_CAPTURE(BM_Describe, lda_bowl, "bowl", 2)->Unit(benchmark::kMillisecon
 BENCHMARK_CAPTURE(BM_Describe, good_bottle, "bottle", 0)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Describe, bow_bottle, "bottle", 1)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Describe, lda_bottle, "bottle", 2)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_PointNormals)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_TopicInference)->Arg(331)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_WordsOfAView<false>)
     ->Name("BM_WordsOfAView/scalar")
