@@ -1,7 +1,8 @@
 // `orthoflow describe FILE.pcd [--bins N] [--mode invariant|reference] [--threshold T] [--json]
 // [--png OUT.png]`: the GOOD descriptor of one object cloud (kernels/good.hpp, docs/GOOD.md), with
 // its object frame, bounding box, projection order and flags; --png draws the three projections
-// side by side. `--dictionary FILE [--representation bow|lda]`: its bag of words or its topics
+// side by side. `--dictionary FILE [--representation bow|lda|local-lda]`: its bag of words, its
+// topics, or its word counts (what Local LDA learns from)
 // instead (docs/SPIN_IMAGES.md).
 #include <cairo.h>
 
@@ -173,9 +174,10 @@ void run_describe_local(const DescribeOptions& o, const kernels::PointCloud& clo
   auto words = learning::load_dictionary(o.dictionary);
   if (!words) fail(words.error(), EXIT_BAD_INPUT);
   auto dictionary = std::make_shared<const kernels::VisualDictionary>(std::move(words.value()));
-  const kernels::DescriptorSpec spec = o.representation == "lda"
-                                           ? kernels::DescriptorSpec::make_lda(dictionary)
-                                           : kernels::DescriptorSpec::make_bow(dictionary);
+  const kernels::DescriptorSpec spec =
+      o.representation == "lda"         ? kernels::DescriptorSpec::make_lda(dictionary)
+      : o.representation == "local-lda" ? kernels::DescriptorSpec::make_local_lda(dictionary)
+                                        : kernels::DescriptorSpec::make_bow(dictionary);
   if (auto valid = spec.validate(); !valid) fail(valid.error(), EXIT_USAGE);
   kernels::Describer describer(spec);
   std::vector<float> values(spec.length());
@@ -255,8 +257,9 @@ void add_describe_command(CLI::App& app) {
   cmd->add_option("--png", o->png,
                   "draw the three projections with the frame axes into this PNG file");
   cmd->add_option("--representation", o->representation,
-                  "good, bow (the view's words) or lda (its topics; both need --dictionary)")
-      ->check(CLI::IsMember({"good", "bow", "lda"}));
+                  "good, bow (the view's words), lda (its topics) or local-lda (its word counts); "
+                  "all but good need --dictionary")
+      ->check(CLI::IsMember({"good", "bow", "lda", "local-lda"}));
   cmd->add_option("--dictionary", o->dictionary,
                   "the visual words (`orthoflow dictionary build`); implies bow unless lda");
   cmd->callback([o] { run_describe(*o); });

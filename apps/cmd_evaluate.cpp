@@ -1,5 +1,7 @@
 // `orthoflow evaluate --dataset DIR --protocol cv10|teacher|teacher-context|noise|downsample
-// [--learner instance,bayes] [--approach nn,1,2] [--representation good,bow,lda --dictionary FILE]
+// [--learner instance,bayes] [--approach nn,1,2]
+// [--representation good,bow,lda,local-lda --dictionary FILE [--local-topics K]
+// [--local-lda-bayes likelihood|histogram]]
 // [--good-mode invariant,reference] [--bins 5,15] [--runs R]
 // [--seed S] [--folds K] [--levels MM,...] [--tau T] [--breakpoint N] [--threads N] [--out DIR]
 // [--cache DIR | --no-cache]`: the thesis's evaluations (evaluation/, docs/EVALUATION.md). Comma
@@ -29,6 +31,8 @@ struct EvaluateOptions {
   std::vector<std::size_t> bins{15};
   std::vector<std::string> representations{"good"};
   std::string dictionary;
+  std::size_t local_topics = 30;
+  std::string local_bayes = "likelihood";
   std::vector<double> levels_mm;
   std::size_t runs = 10;
   std::uint64_t seed = 1;
@@ -72,8 +76,12 @@ std::vector<evaluation::Variant> variants_of(
       for (const std::string& r : o.representations) {
         if (r == "good") continue;
         evaluation::Variant v = base;
-        v.representation = r == "lda" ? kernels::DescriptorKind::LDA : kernels::DescriptorKind::BOW;
+        v.representation = r == "lda"         ? kernels::DescriptorKind::LDA
+                           : r == "local-lda" ? kernels::DescriptorKind::LOCAL_LDA
+                                              : kernels::DescriptorKind::BOW;
         v.dictionary = dictionary;
+        v.local_topics.topics = o.local_topics;
+        v.topic_histogram_bayes = o.local_bayes == "histogram";
         out.push_back(v);
       }
       const bool good = std::find(o.representations.begin(), o.representations.end(), "good") !=
@@ -120,8 +128,10 @@ void run_evaluate(const EvaluateOptions& o) {
   const bool bow = std::any_of(o.representations.begin(), o.representations.end(),
                                [](const std::string& r) { return r != "good"; });
   if (bow && o.dictionary.empty()) {
-    fail("--representation bow or lda needs --dictionary FILE (orthoflow dictionary build)",
-         EXIT_USAGE);
+    fail(
+        "--representation bow, lda or local-lda needs --dictionary FILE (orthoflow dictionary "
+        "build)",
+        EXIT_USAGE);
   }
   if (bow) {
     auto d = learning::load_dictionary(o.dictionary);
@@ -184,10 +194,17 @@ void add_evaluate_command(CLI::App& app) {
       ->delimiter(',')
       ->check(CLI::IsMember({"nn", "1", "2"}));
   cmd->add_option("--representation", o->representations,
-                  "good, bow and/or lda (comma list; bow: a bag of words over --dictionary's "
-                  "words; lda: its topics)")
+                  "good, bow, lda and/or local-lda (comma list; bow: a bag of words over "
+                  "--dictionary's words; lda: its topics; local-lda: topics learned per category)")
       ->delimiter(',')
-      ->check(CLI::IsMember({"good", "bow", "lda"}));
+      ->check(CLI::IsMember({"good", "bow", "lda", "local-lda"}));
+  cmd->add_option("--local-topics", o->local_topics,
+                  "local-lda: topics per category (the thesis: 30)")
+      ->check(CLI::Range(1, static_cast<int>(kernels::MAX_LOCAL_TOPICS)));
+  cmd->add_option("--local-lda-bayes", o->local_bayes,
+                  "local-lda with bayes: likelihood (each category's topic model's likelihood of "
+                  "the words) or histogram (naive Bayes over the topic histogram)")
+      ->check(CLI::IsMember({"likelihood", "histogram"}));
   cmd->add_option("--dictionary", o->dictionary,
                   "bow: the visual words (a file from `orthoflow dictionary build`)");
   cmd->add_option("--good-mode", o->modes, "invariant and/or reference (comma list)")

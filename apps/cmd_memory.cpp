@@ -2,8 +2,8 @@
 // the perceptual memory (learning/perceptual_memory.hpp, docs/LEARNING.md) from the command line.
 // Actions: teach LABEL FILE.pcd..., ask FILE.pcd [--json], correct LABEL FILE.pcd, list, stats,
 // forget LABEL, export FILE, import FILE, calibrate. Descriptors are the store's specification
-// (kernels::Describer; GOOD, or a bag of words with --representation bow / --dictionary FILE) of
-// each PCD.
+// (kernels::Describer; GOOD, or over a dictionary with --representation bow|lda|local-lda /
+// --dictionary FILE) of each PCD.
 #include <cmath>
 #include <iostream>
 #include <memory>
@@ -55,8 +55,9 @@ learning::MemoryConfig config_of(const MemoryOptions& o) {
       words = std::make_shared<const kernels::VisualDictionary>(std::move(d.value()));
     }
     const kernels::GoodConfig good = cfg.descriptor.good;
-    cfg.descriptor = o.representation == "lda"
-                         ? kernels::DescriptorSpec::make_lda(std::move(words))
+    cfg.descriptor = o.representation == "lda" ? kernels::DescriptorSpec::make_lda(std::move(words))
+                     : o.representation == "local-lda"
+                         ? kernels::DescriptorSpec::make_local_lda(std::move(words))
                          : kernels::DescriptorSpec::make_bow(std::move(words));
     cfg.descriptor.good = good;
   }
@@ -123,6 +124,7 @@ void run_ask(const MemoryOptions& o) {
   const auto memory = open_memory(o, learning::OpenMode::READ_ONLY);
   const learning::ViewRecord v = view_of(o.file, memory.config().descriptor);
   learning::AskScratch scratch;
+  memory.learner().prepare(scratch);
   const learning::Prediction p = memory.learner().ask(v.descriptor, scratch);
   if (o.json) {
     const nlohmann::json j{{"label", p.unknown ? "" : std::string(p.label.view())},
@@ -219,9 +221,10 @@ void add_memory_command(CLI::App& app) {
   cmd->add_option("--bins", o->bins, "GOOD bins per side; must match the store (default 15)")
       ->check(CLI::Range(std::size_t{1}, kernels::GOOD_MAX_BINS));
   cmd->add_option("--representation", o->representation,
-                  "good, bow (a bag of words) or lda (its topics); a new bow or lda store needs "
-                  "--dictionary, an existing one uses its own")
-      ->check(CLI::IsMember({"good", "bow", "lda"}));
+                  "good, bow (a bag of words), lda (its topics) or local-lda (word counts, topics "
+                  "learned per category); a new store of these needs --dictionary, an existing "
+                  "one uses its own")
+      ->check(CLI::IsMember({"good", "bow", "lda", "local-lda"}));
   cmd->add_option(
       "--dictionary", o->dictionary,
       "bow, lda: the visual words (`orthoflow dictionary build`); implies bow unless lda");

@@ -70,8 +70,9 @@ struct RunOptions {
   std::string robot_frames;   // --robot-frames FILE: the robot-body filter in front of preprocess
   std::string arm_state_topic = engine::ARM_STATE_TOPIC;
   double arm_state_age_ms = 50.0;
-  std::string exclude_zones;  // --exclude-zones: C_instructor capsules, camera frame
-  std::string dictionary;     // --dictionary FILE: the describe node's bag of words
+  std::string exclude_zones;           // --exclude-zones: C_instructor capsules, camera frame
+  std::string dictionary;              // --dictionary FILE: the describe node's bag of words
+  std::string representation = "bow";  // with --dictionary: bow or local-lda
 };
 
 [[noreturn]] void fail(const std::string& message, int code) {
@@ -275,7 +276,7 @@ void run(const RunOptions& o) {
     bool found = false;
     for (engine::NodeSpec& node : spec->nodes) {
       if (node.kind != "describe") continue;
-      node.params.assign("descriptor", "bow");
+      node.params.assign("descriptor", o.representation);
       node.params.assign("dictionary", o.dictionary);
       found = true;
     }
@@ -420,6 +421,10 @@ void add_run_command(CLI::App& app) {
   cmd->add_option("--dictionary", o->dictionary,
                   "describe objects by the bag of words over this dictionary "
                   "(`orthoflow dictionary build`) instead of GOOD; a --db store must have it");
+  cmd->add_option("--representation", o->representation,
+                  "with --dictionary: bow (the bag of words) or local-lda (word counts; topics "
+                  "learned per category)")
+      ->check(CLI::IsMember({"bow", "local-lda"}));
   cmd->add_option("--db", o->db,
                   "perceptual memory directory (LevelDB); default: learn in memory only");
   cmd->add_option("--learner", o->learner, "instance or bayes")

@@ -1,13 +1,15 @@
 #include "evaluation/variant.hpp"
 
 #include "core/assert.hpp"
-#include "learning/bayes_learner.hpp"
-#include "learning/instance_learner.hpp"
+#include "learning/learner_choice.hpp"
 
 namespace orthoflow::evaluation {
 
 std::string Variant::name() const {
   std::string n = learner == LearnerKind::BAYES ? "bayes" : "instance";
+  if (learner == LearnerKind::BAYES && topic_histogram_bayes &&
+      representation == kernels::DescriptorKind::LOCAL_LDA)
+    n += "-topics";
   if (learner == LearnerKind::INSTANCE) {
     n += rule == InstanceRule::NEAREST      ? "-nn"
          : rule == InstanceRule::APPROACH_1 ? "-nocd1"
@@ -20,6 +22,10 @@ std::string Variant::name() const {
     return n + "/lda/" +
            std::to_string(dictionary && dictionary->topics ? dictionary->topics->topics : 0);
   }
+  if (representation == kernels::DescriptorKind::LOCAL_LDA) {
+    return n + "/local-lda/" + std::to_string(local_topics.topics) + "x" +
+           std::to_string(dictionary ? dictionary->words : 0);
+  }
   n += mode == kernels::GoodMode::INVARIANT ? "/invariant/" : "/reference/";
   return n + std::to_string(bins);
 }
@@ -31,6 +37,9 @@ kernels::DescriptorSpec Variant::spec() const {
   if (representation == kernels::DescriptorKind::LDA) {
     return kernels::DescriptorSpec::make_lda(dictionary);
   }
+  if (representation == kernels::DescriptorKind::LOCAL_LDA) {
+    return kernels::DescriptorSpec::make_local_lda(dictionary, local_topics);
+  }
   return kernels::DescriptorSpec::make_good(bins, mode);
 }
 
@@ -39,22 +48,20 @@ ViewDescription Variant::descriptor(Perturbation p, double amount_m, std::uint64
 }
 
 std::unique_ptr<learning::Learner> Variant::make_learner() const {
-  const std::size_t length = spec().length();
-  if (learner == LearnerKind::BAYES) {
-    learning::BayesConfig cfg;
-    cfg.descriptor_length = length;
-    return std::make_unique<learning::BayesLearner>(cfg);
-  }
   learning::InstanceConfig cfg;
-  cfg.descriptor_length = length;
   cfg.normalise = rule != InstanceRule::NEAREST;
   cfg.approach = rule == InstanceRule::APPROACH_2 ? learning::NocdApproach::MEAN_DISTANCE
                                                   : learning::NocdApproach::MIN_DISTANCE;
-  return std::make_unique<learning::InstanceLearner>(cfg);
+  return learning::make_learner(spec(),
+                                learner == LearnerKind::BAYES ? learning::LearnerKind::BAYES
+                                                              : learning::LearnerKind::INSTANCE,
+                                cfg, learning::BayesConfig{}, topic_histogram_bayes);
 }
 
 ClassLearner::ClassLearner(const Variant& variant, const std::vector<std::string>& categories)
-    : categories_(categories), learner_(variant.make_learner()) {}
+    : categories_(categories), learner_(variant.make_learner()) {
+  learner_->prepare(scratch_);
+}
 
 void ClassLearner::teach(std::uint32_t cls, std::span<const float> views) {
   const std::size_t length = learner_->descriptor_length();

@@ -27,10 +27,15 @@ struct Variant {
   /// The representation: GOOD (mode, bins), BOW (this dictionary's words) or LDA (its topics).
   kernels::DescriptorKind representation = kernels::DescriptorKind::GOOD;
   std::shared_ptr<const kernels::VisualDictionary> dictionary;
+  /// LOCAL_LDA: the topics every category learns.
+  kernels::LocalTopics local_topics{};
+  /// LOCAL_LDA with the Bayes learner: naive Bayes over topic histograms instead of the topic
+  /// models' likelihood (learning/local_lda_learner.hpp).
+  bool topic_histogram_bayes = false;
   /// @brief The descriptor specification of this variant.
   [[nodiscard]] kernels::DescriptorSpec spec() const;
   /// @brief "instance-nn/invariant/15", "bayes/reference/5", "instance-nn/bow/70", "bayes/lda/30",
-  /// ...
+  /// "bayes/local-lda/30x90", ...
   [[nodiscard]] std::string name() const;
   /// @brief The descriptor parameters of this variant with perturbation @p p of @p amount_m.
   [[nodiscard]] ViewDescription descriptor(Perturbation p = Perturbation::NONE,

@@ -7,14 +7,17 @@
 namespace orthoflow::graphs {
 
 Result<kernels::DescriptorSpec, std::string> parse_describe_params(const engine::ParamMap& params) {
-  if (auto ok = params.only(
-          {"descriptor", "bins", "mode", "threshold", "dictionary", "max_object_points"});
+  if (auto ok = params.only({"descriptor", "bins", "mode", "threshold", "dictionary",
+                             "max_object_points", "local_topics"});
       !ok)
     return err(ok.error());
   kernels::DescriptorSpec spec;  // thesis: GOOD, 15 bins; invariant frame by default (docs/GOOD.md)
   std::string e, kind = "good", mode = "invariant", dictionary;
-  take(params.choice("descriptor", "good", {"good", "bow"}), kind, e);
-  if (kind == "bow") take(params.text("dictionary", ""), dictionary, e);
+  take(params.choice("descriptor", "good", {"good", "bow", "local-lda"}), kind, e);
+  if (kind != "good") take(params.text("dictionary", ""), dictionary, e);
+  if (kind == "local-lda")
+    take(params.integer("local_topics", 30, 1, kernels::MAX_LOCAL_TOPICS), spec.local_topics.topics,
+         e);
   take(params.integer("bins", 15, 1, MAX_GOOD_BINS), spec.good.bins, e);
   take(params.choice("mode", "invariant", {"invariant", "reference"}), mode, e);
   if (params.has("threshold")) {
@@ -24,12 +27,12 @@ Result<kernels::DescriptorSpec, std::string> parse_describe_params(const engine:
   if (!e.empty()) return err(e);
   spec.good.mode =
       mode == "invariant" ? kernels::GoodMode::INVARIANT : kernels::GoodMode::REFERENCE;
-  if (kind == "bow") {  // the bag of words over a dictionary file (docs/SPIN_IMAGES.md)
+  if (kind != "good") {  // over a dictionary file (docs/SPIN_IMAGES.md)
     if (dictionary.empty())
-      return err(std::string("describe: descriptor bow needs a dictionary file (dictionary: ...)"));
+      return err("describe: descriptor " + kind + " needs a dictionary file (dictionary: ...)");
     auto words = learning::load_dictionary(dictionary);
     if (!words) return err("describe: " + words.error());
-    spec.kind = kernels::DescriptorKind::BOW;
+    spec.kind = kind == "bow" ? kernels::DescriptorKind::BOW : kernels::DescriptorKind::LOCAL_LDA;
     spec.dictionary = std::make_shared<const kernels::VisualDictionary>(std::move(words.value()));
     if (auto valid = spec.validate(); !valid) return err("describe: " + valid.error());
   }

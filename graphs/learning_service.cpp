@@ -49,12 +49,8 @@ Result<std::unique_ptr<LearningService>, std::string> LearningService::open(
     if (!memory) return err("learning: " + memory.error().to_string());
     s->memory_ = std::make_unique<learning::PerceptualMemory>(std::move(*memory));
     s->worker_ = std::thread([raw = s.get()] { raw->worker_loop(); });
-  } else if (cfg.learner == learning::LearnerKind::BAYES) {
-    cfg.bayes.descriptor_length = length;
-    s->learner_ = std::make_unique<learning::BayesLearner>(cfg.bayes);
   } else {
-    cfg.instance.descriptor_length = length;
-    s->learner_ = std::make_unique<learning::InstanceLearner>(cfg.instance);
+    s->learner_ = learning::make_learner(cfg.descriptor, cfg.learner, cfg.instance, cfg.bayes);
   }
   return s;
 }

@@ -46,7 +46,9 @@ class Recognise final : public engine::Node {
         p_(p),
         service_(service),
         memories_(service.descriptor_length()),
-        desk_(service, memories_) {}
+        desk_(service, memories_) {
+    service.learner().prepare(scratch_);  // Local LDA's topic scratch, sized once
+  }
   std::span<const engine::PortSpec> inputs() const noexcept override { return {PORTS, 1}; }
   std::span<const engine::PortSpec> outputs() const noexcept override { return {PORTS + 1, 1}; }
   bool stateful() const noexcept override { return true; }

@@ -100,7 +100,7 @@ class Describe final : public engine::Node {
   Describe(std::size_t capacity, const kernels::DescriptorSpec& spec, std::size_t slots,
            std::size_t max_object_points)
       : capacity_(capacity), describers_(slots * MAX_OBJECTS, kernels::Describer(spec)) {
-    if (spec.kind == kernels::DescriptorKind::BOW) {
+    if (spec.local()) {  // bow or local-lda: spin features first
       // More scratches than the arena can run at once: hardware threads, and never fewer than 4.
       const std::size_t workers = std::max<std::size_t>(4, std::thread::hardware_concurrency());
       pool_ = std::make_unique<FeaturePool>(workers + 1, max_object_points,

@@ -14,6 +14,8 @@ std::string_view to_string(DescriptorKind kind) noexcept {
       return "bow";
     case DescriptorKind::LDA:
       return "lda";
+    case DescriptorKind::LOCAL_LDA:
+      return "local-lda";
   }
   return "unknown";
 }
@@ -46,8 +48,16 @@ DescriptorSpec DescriptorSpec::make_lda(
   return over_words(DescriptorKind::LDA, std::move(dictionary));
 }
 
+DescriptorSpec DescriptorSpec::make_local_lda(std::shared_ptr<const VisualDictionary> dictionary,
+                                              const LocalTopics& topics) noexcept {
+  DescriptorSpec s = over_words(DescriptorKind::LOCAL_LDA, std::move(dictionary));
+  s.local_topics = topics;
+  return s;
+}
+
 std::size_t DescriptorSpec::length() const noexcept {
-  if (kind == DescriptorKind::BOW) return dictionary ? dictionary->words : 0;
+  if (kind == DescriptorKind::BOW || kind == DescriptorKind::LOCAL_LDA)
+    return dictionary ? dictionary->words : 0;
   if (kind == DescriptorKind::LDA)
     return dictionary && dictionary->topics ? dictionary->topics->topics : 0;
   return 3 * good.bins * good.bins;
@@ -84,19 +94,30 @@ Result<void, std::string> DescriptorSpec::validate() const {
       return err("descriptor " + describe() +
                  ": the dictionary has no topic model of its words (orthoflow dictionary build "
                  "--topics K)");
+    const LocalTopics& lt = local_topics;
+    if (kind == DescriptorKind::LOCAL_LDA &&
+        (lt.topics == 0 || lt.topics > MAX_LOCAL_TOPICS || !(lt.alpha > 0.0) || !(lt.beta > 0.0) ||
+         !std::isfinite(lt.alpha) || !std::isfinite(lt.beta) || lt.iterations > MAX_GIBBS_SWEEPS))
+      return err("descriptor " + describe() + ": Local LDA needs 1.." +
+                 std::to_string(MAX_LOCAL_TOPICS) + " topics, finite alpha and beta > 0, and at " +
+                 "most " + std::to_string(MAX_GIBBS_SWEEPS) + " sweeps");
   }
   return {};
 }
 
 std::string DescriptorSpec::describe() const {
-  char text[224];
+  char text[288];
   if (local()) {
     if (!dictionary) return std::string(to_string(kind)) + " (no dictionary)";
     const VisualDictionary& d = *dictionary;
-    char topics[96] = "";
+    char topics[128] = "";
     if (kind == DescriptorKind::LDA && d.topics)
       std::snprintf(topics, sizeof topics, "topics=%zu alpha=%g beta=%g iterations=%u ",
                     d.topics->topics, d.topics->alpha, d.topics->beta, d.topics->iterations);
+    if (kind == DescriptorKind::LOCAL_LDA)
+      std::snprintf(topics, sizeof topics, "topics=%zu alpha=%g beta=%g iterations=%u seed=%llu ",
+                    local_topics.topics, local_topics.alpha, local_topics.beta,
+                    local_topics.iterations, static_cast<unsigned long long>(local_topics.seed));
     std::snprintf(text, sizeof text, "%s %swords=%zu iw=%u sl=%g vs=%g nr=%g dictionary=%s",
                   std::string(to_string(kind)).c_str(), topics, d.words, d.spin.image_width,
                   static_cast<double>(d.spin.support_length), static_cast<double>(d.keypoint_leaf),
@@ -115,7 +136,8 @@ bool DescriptorSpec::operator==(const DescriptorSpec& other) const noexcept {
   if (kind != other.kind || !same_good) return false;
   if (local()) {
     if (!dictionary || !other.dictionary) return dictionary == other.dictionary;
-    return dictionary->id == other.dictionary->id && dictionary->words == other.dictionary->words;
+    return dictionary->id == other.dictionary->id && dictionary->words == other.dictionary->words &&
+           (kind != DescriptorKind::LOCAL_LDA || local_topics == other.local_topics);
   }
   return true;
 }
@@ -144,8 +166,10 @@ Result<void, GoodError> Describer::describe_bow(PointsView points, std::span<flo
         return err(GoodError::KEYPOINTS_FAILED);
     }
   }
-  if (spec_.kind == DescriptorKind::BOW) {
-    features_ = bag_of_words(features.images(), d.view(), word_scratch_, out);
+  if (spec_.kind == DescriptorKind::BOW || spec_.kind == DescriptorKind::LOCAL_LDA) {
+    features_ = spec_.kind == DescriptorKind::BOW
+                    ? bag_of_words(features.images(), d.view(), word_scratch_, out)
+                    : word_counts(features.images(), d.view(), word_scratch_, out);
     if (features_ == 0) return err(GoodError::NO_FEATURES);
     return {};
   }

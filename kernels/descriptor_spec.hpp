@@ -4,7 +4,9 @@
 /// travel together as one value (STYLE rule 18). The describe node, the learners, the perceptual
 /// memory, the evaluation and the CLI ask the specification for the length instead of computing one
 /// of their own, and a store records the specification it was written with. Kinds: GOOD, and the
-/// bag of words over spin images (BOW, with its dictionary); the topic models are to come.
+/// bag of words over spin images (BOW, with its dictionary), the topic histogram of LDA (topics
+/// shared by every category, fitted with the dictionary), and the word counts Local LDA learns
+/// topics from per category.
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -25,8 +27,9 @@ enum class DescriptorKind : std::uint8_t {
   GOOD,  ///< the Global Orthographic Object Descriptor: 3 n^2 normalised histogram values
   BOW,   ///< bag of words: the shares of a view's spin images nearest each word of a dictionary
   LDA,   ///< topic histogram: theta of the view's words under the dictionary's topic model
+  LOCAL_LDA,  ///< the view's word counts; the learner describes them in each category's topics
 };
-/// @brief "good", "bow" or "lda".
+/// @brief "good", "bow", "lda" or "local-lda".
 [[nodiscard]] std::string_view to_string(DescriptorKind kind) noexcept;
 
 /// @brief Kind, parameters and length of a descriptor. A plain value; compare with ==.
@@ -37,6 +40,8 @@ struct DescriptorSpec {
   GoodConfig good{};
   /// Kind BOW: the dictionary, which carries the spin images' parameters (shared, read-only).
   std::shared_ptr<const VisualDictionary> dictionary;
+  /// Kind LOCAL_LDA: the topics every category learns (the learner's, not the describer's).
+  LocalTopics local_topics{};
 
   /// @brief A GOOD specification.
   [[nodiscard]] static DescriptorSpec make_good(std::size_t bins,
@@ -47,19 +52,23 @@ struct DescriptorSpec {
   /// @brief A topic specification over @p dictionary's topic model.
   [[nodiscard]] static DescriptorSpec make_lda(
       std::shared_ptr<const VisualDictionary> dictionary) noexcept;
-  /// @brief BOW or LDA: described through a dictionary's words.
-  [[nodiscard]] bool local() const noexcept {
-    return kind == DescriptorKind::BOW || kind == DescriptorKind::LDA;
-  }
-  /// @brief Values per descriptor (GOOD: 3 n^2; BOW: the dictionary's words; LDA: its topics).
+  /// @brief Word counts over @p dictionary, for Local LDA with @p topics per category.
+  [[nodiscard]] static DescriptorSpec make_local_lda(
+      std::shared_ptr<const VisualDictionary> dictionary, const LocalTopics& topics = {}) noexcept;
+  /// @brief BOW, LDA or LOCAL_LDA: described through a dictionary's words.
+  [[nodiscard]] bool local() const noexcept { return kind != DescriptorKind::GOOD; }
+  /// @brief Values per descriptor (GOOD: 3 n^2; BOW and LOCAL_LDA: the dictionary's words; LDA:
+  /// its topics).
   [[nodiscard]] std::size_t length() const noexcept;
-  /// @brief Every value is a non-negative histogram share (what a naive Bayes learner needs).
+  /// @brief Every value is non-negative: a histogram share, or a word count (LOCAL_LDA), what a
+  /// naive Bayes learner needs.
   [[nodiscard]] bool histogram() const noexcept;
   /// @brief Checks the parameters (bins in 1..GOOD_MAX_BINS, a finite non-negative threshold; BOW:
   /// a dictionary with words whose length fits its spin images, finite positive leaf and radius).
   [[nodiscard]] Result<void, std::string> validate() const;
   /// @brief "good bins=15 mode=invariant threshold=0.015", "bow words=70 iw=4 sl=0.05 vs=0.01
-  /// nr=0.02 dictionary=3f2a9c0d11e4b7a0": what a mismatch error names.
+  /// nr=0.02 dictionary=3f2a9c0d11e4b7a0", "local-lda topics=30 alpha=1 beta=0.1 iterations=30
+  /// seed=1 words=90 ...": what a mismatch error names.
   [[nodiscard]] std::string describe() const;
   /// @brief Same kind and parameters (GOOD: the effective threshold, so unset equals the mode's
   /// default; BOW: the same dictionary id and GOOD parameters).

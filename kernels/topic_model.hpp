@@ -35,6 +35,22 @@ struct TopicModel {
   [[nodiscard]] bool consistent() const noexcept;  ///< sizes agree and n_k = sum over w of n_kw
 };
 
+/// @brief Most topics a Local LDA category may have (its counts are K x V per category).
+inline constexpr std::size_t MAX_LOCAL_TOPICS = 1024;
+/// @brief Most Gibbs sweeps a specification may ask for (the thesis: 30).
+inline constexpr std::uint32_t MAX_GIBBS_SWEEPS = 10000;
+
+/// @brief The priors and sampling of topics learned per category (the thesis's Local LDA, chapter
+/// 4: its default K = 30 with 90 words, alpha 1.0, beta 0.1, 30 Gibbs sweeps).
+struct LocalTopics {
+  std::size_t topics = 30;  ///< K, in every category
+  double alpha = 1.0;
+  double beta = 0.1;
+  std::uint32_t iterations = 30;  ///< Gibbs sweeps of a taught view and of a target
+  std::uint64_t seed = 1;         ///< of every draw (mixed with the view's words)
+  [[nodiscard]] bool operator==(const LocalTopics&) const noexcept = default;
+};
+
 /// @brief Scratch of topic inference, sized once for a model and documents of up to max_words.
 struct TopicScratch {
   TopicScratch() = default;

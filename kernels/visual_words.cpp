@@ -121,21 +121,27 @@ std::size_t assign_words(std::span<const float> features, DescriptorMatrixView w
   return n;
 }
 
-std::size_t bag_of_words(std::span<const float> features, DescriptorMatrixView words,
-                         std::span<float> scratch, std::span<float> histogram) noexcept {
+std::size_t word_counts(std::span<const float> features, DescriptorMatrixView words,
+                        std::span<float> scratch, std::span<float> counts) noexcept {
   OF_ENFORCE(words.dims > 0 && features.size() % words.dims == 0,
-             "bag_of_words: the features are not whole rows");
-  OF_ENFORCE(histogram.size() >= words.count, "bag_of_words: the histogram is too short");
-  std::fill_n(histogram.begin(), words.count, 0.0F);
+             "word_counts: the features are not whole rows");
+  OF_ENFORCE(counts.size() >= words.count, "word_counts: the histogram is too short");
+  std::fill_n(counts.begin(), words.count, 0.0F);
   std::size_t counted = 0;
   for (std::size_t at = 0; at < features.size(); at += words.dims) {
     const auto f = features.subspan(at, words.dims);
     if (std::all_of(f.begin(), f.end(), [](float v) { return v == 0.0F; })) continue;
     const std::size_t w = nearest_word(f, words, scratch);
     if (w == NO_WORD) continue;
-    histogram[w] += 1.0F;
+    counts[w] += 1.0F;
     ++counted;
   }
+  return counted;
+}
+
+std::size_t bag_of_words(std::span<const float> features, DescriptorMatrixView words,
+                         std::span<float> scratch, std::span<float> histogram) noexcept {
+  const std::size_t counted = word_counts(features, words, scratch, histogram);
   if (counted > 0) {
     const float inv = 1.0F / static_cast<float>(counted);
     for (std::size_t j = 0; j < words.count; ++j) histogram[j] *= inv;

@@ -55,17 +55,23 @@ inline constexpr std::size_t NO_WORD = std::numeric_limits<std::size_t>::max();
 [[nodiscard]] std::size_t nearest_word_scalar(std::span<const float> feature,
                                               DescriptorMatrixView words) noexcept;
 
-/// @brief The bag of words of @p features (rows of words.dims values, one per spin image; rows
-/// that are all zeros, images without weight, are skipped) into @p histogram (words.count bins):
-/// each bin the share of the counted features nearest that word (the histogram sums to 1).
-/// @return the features counted (0: the histogram is all zeros). @pre histogram.size() >=
-/// words.count, scratch.size() >= words.count, features.size() a multiple of words.dims.
 /// @brief The word of every feature row with weight (all-zero rows skipped), in row order, into
 /// @p out (room for every row). @return how many were written.
 [[nodiscard]] std::size_t assign_words(std::span<const float> features, DescriptorMatrixView words,
                                        std::span<float> scratch,
                                        std::span<std::uint32_t> out) noexcept;
 
+/// @brief How many of @p features (rows of words.dims values, one per spin image; rows that are
+/// all zeros, images without weight, are skipped) are nearest each word, into @p counts
+/// (words.count bins of whole numbers): the view's words as Local LDA takes them.
+/// @return the features counted (the sum of the counts). @pre counts.size() >= words.count,
+/// scratch.size() >= words.count, features.size() a multiple of words.dims.
+[[nodiscard]] std::size_t word_counts(std::span<const float> features, DescriptorMatrixView words,
+                                      std::span<float> scratch, std::span<float> counts) noexcept;
+
+/// @brief The bag of words: word_counts() divided by their sum, so each bin is the share of the
+/// counted features nearest that word (the histogram sums to 1). @return the features counted
+/// (0: the histogram is all zeros). @pre as word_counts().
 [[nodiscard]] std::size_t bag_of_words(std::span<const float> features, DescriptorMatrixView words,
                                        std::span<float> scratch,
                                        std::span<float> histogram) noexcept;

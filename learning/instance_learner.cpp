@@ -48,7 +48,8 @@ constexpr std::size_t COLUMN_PAD = 16;
 
 // A new category holding @p base's views followed by @p views; every new view adds its distances to
 // all earlier views to pair_sum (thesis: ICD_n <- ICD(C_n) after C_n <- C_{n-1} U {O_n}).
-CategoryPtr extend(const InstanceCategory& base, DescriptorBatch views, std::size_t dims) {
+CategoryPtr extend(const InstanceCategory& base, DescriptorBatch views, std::size_t dims,
+                   kernels::Metric metric) {
   auto c = std::make_shared<InstanceCategory>();
   c->id = base.id;
   c->label = base.label;
@@ -66,7 +67,7 @@ CategoryPtr extend(const InstanceCategory& base, DescriptorBatch views, std::siz
     const std::size_t col = base.count + v;
     for (std::size_t d = 0; d < dims; ++d) { c->soa[d * c->stride + col] = q[d]; }
     const kernels::DescriptorMatrixView earlier{c->soa, dims, col, c->stride};
-    kernels::distances(q, earlier, kernels::Metric::L2, dist);
+    kernels::distances(q, earlier, metric, dist);
     for (std::size_t j = 0; j < col; ++j) { c->pair_sum += static_cast<double>(dist[j]); }
   }
   return c;
@@ -116,11 +117,11 @@ auto finisher(const InstanceConfig& cfg) {
   };
 }
 
-// Min (approach I) or mean (approach II) of the L2 distances from @p query to the views of @p c,
-// walked in chunks of the scratch size (thesis eq. OCD, approaches I and II). NaN distances
-// propagate.
+// Min (approach I) or mean (approach II) of the distances (L2, or chi-squared for topics) from @p
+// query to the views of @p c, walked in chunks of the scratch size (thesis eq. OCD, approaches I
+// and II). NaN distances propagate.
 float ocd(std::span<const float> query, const InstanceCategory& c, bool mean,
-          std::span<float> buffer) noexcept {
+          kernels::Metric metric, std::span<float> buffer) noexcept {
   const std::size_t dims = query.size();
   float min_d = std::numeric_limits<float>::infinity();
   double sum = 0.0;
@@ -131,7 +132,7 @@ float ocd(std::span<const float> query, const InstanceCategory& c, bool mean,
         std::min(buffer.size(), c.stride - j0);  // padding columns when they fit
     const kernels::DescriptorMatrixView chunk{std::span<const float>(c.soa).subspan(j0), dims,
                                               computed, c.stride};
-    kernels::distances(query, chunk, kernels::Metric::L2, buffer.first(computed));
+    kernels::distances(query, chunk, metric, buffer.first(computed));
     for (std::size_t j = 0; j < n; ++j) {
       saw_nan = saw_nan || std::isnan(buffer[j]);
       min_d = std::min(min_d, buffer[j]);
@@ -165,7 +166,8 @@ Result<CategoryId, LearnError> InstanceLearner::teach(std::string_view label,
     InstanceCategory fresh;
     fresh.id = id;
     fresh.label = Label::from(label);
-    return extend(existing == nullptr ? fresh : *existing, views, cfg_.descriptor_length);
+    return extend(existing == nullptr ? fresh : *existing, views, cfg_.descriptor_length,
+                  cfg_.metric);
   };
   return upsert_category(writer_, *cell_, label, make, finisher(cfg_));
 }
@@ -178,7 +180,7 @@ Prediction InstanceLearner::ask(std::span<const float> descriptor,
   const bool mean = cfg_.normalise && cfg_.approach == NocdApproach::MEAN_DISTANCE;
   for (std::size_t k = 0; k < snap->categories.size(); ++k) {
     const InstanceCategory& c = *snap->categories[k];
-    const float o = ocd(descriptor, c, mean, scratch.distances());
+    const float o = ocd(descriptor, c, mean, cfg_.metric, scratch.distances());
     float score = o;
     if (cfg_.normalise) {
       score = cfg_.approach == NocdApproach::MIN_DISTANCE
@@ -200,7 +202,7 @@ Result<void, LearnError> InstanceLearner::forget(std::string_view label) {
 // The category without its last views.count() views, which must equal @p views bit for bit;
 // null when none would be left. The pair sum is recomputed over the views that stay.
 Result<CategoryPtr, LearnError> without_last(const InstanceCategory& c, DescriptorBatch views,
-                                             std::size_t dims) {
+                                             std::size_t dims, kernels::Metric metric) {
   const std::size_t n = views.count();
   if (n > c.count) { return err(LearnError::NOT_LAST_VIEWS); }
   const std::size_t keep = c.count - n;
@@ -219,13 +221,13 @@ Result<CategoryPtr, LearnError> without_last(const InstanceCategory& c, Descript
   InstanceCategory base;
   base.id = c.id;
   base.label = c.label;
-  return extend(base, DescriptorBatch{kept, dims}, dims);
+  return extend(base, DescriptorBatch{kept, dims}, dims, metric);
 }
 
 Result<void, LearnError> InstanceLearner::retract(std::string_view label, DescriptorBatch views) {
   if (auto r = validate_batch(views, cfg_.descriptor_length, false); !r) { return err(r.error()); }
   auto make = [&](const InstanceCategory& c) {
-    return without_last(c, views, cfg_.descriptor_length);
+    return without_last(c, views, cfg_.descriptor_length, cfg_.metric);
   };
   return shrink_category(writer_, *cell_, label, make, finisher(cfg_));
 }
@@ -245,7 +247,7 @@ Result<void, LearnError> InstanceLearner::restore(std::span<const RestoredCatego
     InstanceCategory base;
     base.id = rc.id;
     base.label = Label::from(rc.label);
-    next.push_back(extend(base, rc.views, cfg_.descriptor_length));
+    next.push_back(extend(base, rc.views, cfg_.descriptor_length, cfg_.metric));
     next_id = std::max(next_id, rc.id + 1);
   }
   replace_categories(writer_, *cell_, std::move(next), next_id, finisher(cfg_));

@@ -2,7 +2,8 @@
 /// @file
 /// @brief Instance-based open-ended learner (thesis chapter 5, "Normalized Object-Category
 /// Distance"): a category is the set of its stored views; D = Euclidean (L2) distance between GOOD
-/// descriptors.
+/// descriptors and bags of words, chi-squared between topic histograms (PIPELINE.md section 7;
+/// InstanceConfig::metric).
 /// - ICD(C) = sum_{U != V} D(U, V) / (|C| (|C| - 1))  (mean pairwise distance)
 /// - approach I:  OCD = min_{O in C} D(T, O),  NOCD = OCD / ICD(C)
 /// - approach II: OCD = mean_{O in C} D(T, O), NOCD = 2 OCD / (ICD(C) + mean ICD over categories)
@@ -16,6 +17,7 @@
 #include <memory>
 #include <mutex>
 
+#include "kernels/distance.hpp"
 #include "learning/learner.hpp"
 
 namespace orthoflow::learning {
@@ -30,7 +32,9 @@ enum class NocdApproach : std::uint8_t {
 struct InstanceConfig {
   std::size_t descriptor_length = 675;  ///< 3 n^2 (n = 15)
   NocdApproach approach = NocdApproach::MIN_DISTANCE;
-  bool normalise = true;  ///< false: plain nearest neighbour, score = L2 distance
+  bool normalise = true;  ///< false: plain nearest neighbour, score = the distance
+  kernels::Metric metric = kernels::Metric::L2;  ///< D; learning::make_learner() picks
+                                                 ///< CHI_SQUARED for LDA topic histograms
   float classification_threshold =
       std::numeric_limits<float>::infinity();  ///< CT; infinity = never Unknown
   float default_icd =

@@ -15,6 +15,7 @@
 
 #include "core/fixed_text.hpp"
 #include "core/result.hpp"
+#include "kernels/topic_model.hpp"
 
 namespace orthoflow::learning {
 
@@ -49,17 +50,19 @@ struct Prediction {
 /// @brief Why a teach, correct, forget or restore was refused. Nothing is changed when one is
 /// returned.
 enum class LearnError : std::uint8_t {
-  EMPTY_LABEL,     ///< the label is ""
-  LABEL_TOO_LONG,  ///< the label has more than LABEL_MAX_BYTES bytes
-  BAD_CHARACTERS,  ///< the label is not valid UTF-8 or holds a control character
-                   ///< (core/label_text.hpp)
-  NO_VIEWS,        ///< the batch holds no view
-  WRONG_LENGTH,    ///< a descriptor's length differs from descriptor_length()
-  NOT_FINITE,      ///< a descriptor value is NaN or infinite
-  NEGATIVE_VALUE,  ///< a histogram value is negative (BayesLearner: histograms only)
-  UNKNOWN_LABEL,   ///< forget() of a label that was never taught
-  DUPLICATE_ID,    ///< restore() got two categories with one id or one label
-  NOT_LAST_VIEWS,  ///< retract(): the views are not the category's last ones (or more than it has)
+  EMPTY_LABEL,      ///< the label is ""
+  LABEL_TOO_LONG,   ///< the label has more than LABEL_MAX_BYTES bytes
+  BAD_CHARACTERS,   ///< the label is not valid UTF-8 or holds a control character
+                    ///< (core/label_text.hpp)
+  NO_VIEWS,         ///< the batch holds no view
+  WRONG_LENGTH,     ///< a descriptor's length differs from descriptor_length()
+  NOT_FINITE,       ///< a descriptor value is NaN or infinite
+  NEGATIVE_VALUE,   ///< a histogram value is negative (BayesLearner: histograms only)
+  UNKNOWN_LABEL,    ///< forget() of a label that was never taught
+  DUPLICATE_ID,     ///< restore() got two categories with one id or one label
+  NOT_LAST_VIEWS,   ///< retract(): the views are not the category's last ones (or more than it has)
+  NOT_WORD_COUNTS,  ///< LocalLdaLearner: a value is not a whole number, or a view has no word or
+                    ///< more than max_words
 };
 /// @brief A sentence saying what was wrong, e.g. "label longer than 63 bytes".
 [[nodiscard]] const char* to_string(LearnError error) noexcept;
@@ -99,6 +102,11 @@ class AskScratch {
   [[nodiscard]] std::span<float> distances() noexcept { return distances_; }
   /// @brief Hazard-slot hint (learning/snapshot_cell.hpp): the slot this thread used last.
   std::size_t slot_hint = 0;
+  /// @brief LocalLdaLearner: a target's words, its topics in one category and the temporary copy
+  /// of that category's counts. Empty until Learner::prepare() sizes them (once, before asking).
+  std::vector<std::uint32_t> words;
+  std::vector<float> theta;
+  kernels::TopicScratch topics;
 
  private:
   std::vector<float> distances_;
@@ -161,6 +169,10 @@ class Learner {
   /// snapshot.
   [[nodiscard]] virtual Prediction ask(std::span<const float> descriptor,
                                        AskScratch& scratch) const noexcept = 0;
+  /// @brief Sizes @p scratch for ask() once, so that asking allocates nothing (LocalLdaLearner
+  /// needs its topic scratch; the others need nothing). Call it on each scratch before its first
+  /// ask().
+  virtual void prepare(AskScratch& scratch) const { (void)scratch; }
   /// @brief Removes category @p label and all its views. @note Thread-safe; publishes one snapshot.
   [[nodiscard]] virtual Result<void, LearnError> forget(std::string_view label) = 0;
   /// @brief Takes back the last views.count() views taught to @p label (undo of a teach or
@@ -182,7 +194,8 @@ class Learner {
   [[nodiscard]] virtual std::vector<CategorySummary> categories() const = 0;
   /// @brief Values per descriptor (3 n^2 for GOOD with n bins).
   [[nodiscard]] virtual std::size_t descriptor_length() const noexcept = 0;
-  /// @brief "instance" or "bayes".
+  /// @brief "instance", "bayes", "local-lda-instance", "local-lda-likelihood" or
+  /// "local-lda-topic-bayes".
   [[nodiscard]] virtual const char* kind() const noexcept = 0;
 };
 

@@ -102,6 +102,14 @@ std::string encode_schema(const kernels::DescriptorSpec& spec) {
     j["keypoint_leaf"] = d.keypoint_leaf;
     j["normal_radius"] = d.normal_radius;
   }
+  if (spec.kind == kernels::DescriptorKind::LOCAL_LDA) {
+    const kernels::LocalTopics& t = spec.local_topics;
+    j["local_topics"] = {{"topics", t.topics},
+                         {"alpha", t.alpha},
+                         {"beta", t.beta},
+                         {"iterations", t.iterations},
+                         {"seed", t.seed}};
+  }
   return j.dump();
 }
 
@@ -135,6 +143,17 @@ std::optional<kernels::VisualDictionary> schema_dictionary(const nlohmann::json&
         "\"keypoint_leaf\", \"normal_radius\"";
     return std::nullopt;
   }
+  for (const char* n : numbers) {
+    const double v = j[n].get<double>();
+    if (!std::isfinite(v) || std::abs(v) > 1e30) {  // a float of the specification
+      why = std::string("\"") + n + "\" is not a finite number";
+      return std::nullopt;
+    }
+  }
+  if (width->get<std::uint64_t>() > kernels::MAX_SPIN_IMAGE_WIDTH) {
+    why = "\"image_width\" is more than " + std::to_string(kernels::MAX_SPIN_IMAGE_WIDTH);
+    return std::nullopt;
+  }
   kernels::VisualDictionary d;
   d.id = value;
   d.words = words->get<std::size_t>();
@@ -145,6 +164,38 @@ std::optional<kernels::VisualDictionary> schema_dictionary(const nlohmann::json&
   d.keypoint_leaf = j["keypoint_leaf"].get<float>();
   d.normal_radius = j["normal_radius"].get<float>();
   return d;
+}
+
+/// The topics a "local-lda" schema names, or false with @p why.
+bool schema_local_topics(const nlohmann::json& j, kernels::LocalTopics& t, std::string& why) {
+  const auto o = j.find("local_topics");
+  const bool ok = o != j.end() && o->is_object() && o->contains("topics") &&
+                  (*o)["topics"].is_number_unsigned() && o->contains("alpha") &&
+                  (*o)["alpha"].is_number() && o->contains("beta") && (*o)["beta"].is_number() &&
+                  o->contains("iterations") && (*o)["iterations"].is_number_unsigned() &&
+                  o->contains("seed") && (*o)["seed"].is_number_unsigned();
+  if (!ok) {
+    why =
+        "a \"local-lda\" schema needs \"local_topics\" with unsigned \"topics\", "
+        "\"iterations\" and \"seed\", and numbers \"alpha\" and \"beta\"";
+    return false;
+  }
+  t.topics = (*o)["topics"].get<std::size_t>();
+  t.alpha = (*o)["alpha"].get<double>();
+  t.beta = (*o)["beta"].get<double>();
+  const auto sweeps = (*o)["iterations"].get<std::uint64_t>();
+  t.iterations = static_cast<std::uint32_t>(std::min<std::uint64_t>(sweeps, UINT32_MAX));
+  t.seed = (*o)["seed"].get<std::uint64_t>();
+  // The learner's preconditions (kernels::DescriptorSpec::validate): a store never hands it others.
+  if (t.topics == 0 || t.topics > kernels::MAX_LOCAL_TOPICS || !(t.alpha > 0.0) ||
+      !(t.beta > 0.0) || !std::isfinite(t.alpha) || !std::isfinite(t.beta) ||
+      sweeps > kernels::MAX_GIBBS_SWEEPS) {
+    why = "\"local_topics\" out of range: 1.." + std::to_string(kernels::MAX_LOCAL_TOPICS) +
+          " topics, finite alpha and beta > 0, at most " +
+          std::to_string(kernels::MAX_GIBBS_SWEEPS) + " iterations";
+    return false;
+  }
+  return true;
 }
 
 }  // namespace
@@ -172,24 +223,40 @@ std::optional<kernels::DescriptorSpec> decode_schema(std::string_view json, std:
   const std::string kind_name = kind != j.end() ? kind->get<std::string>() : "good";
   const bool bow = kind_name == kernels::to_string(kernels::DescriptorKind::BOW);
   const bool lda = kind_name == kernels::to_string(kernels::DescriptorKind::LDA);
-  if (!bow && !lda && kind_name != kernels::to_string(kernels::DescriptorKind::GOOD)) {
-    why = "descriptor \"" + kind_name + "\" is not one this build knows (good, bow, lda)";
+  const bool local_lda = kind_name == kernels::to_string(kernels::DescriptorKind::LOCAL_LDA);
+  if (!bow && !lda && !local_lda &&
+      kind_name != kernels::to_string(kernels::DescriptorKind::GOOD)) {
+    why =
+        "descriptor \"" + kind_name + "\" is not one this build knows (good, bow, lda, local-lda)";
     return std::nullopt;
   }
   std::optional<kernels::VisualDictionary> dictionary;
-  if ((bow || lda) && !(dictionary = schema_dictionary(j, why))) return std::nullopt;
+  if ((bow || lda || local_lda) && !(dictionary = schema_dictionary(j, why))) return std::nullopt;
+  kernels::LocalTopics topics;
+  if (local_lda && !schema_local_topics(j, topics, why)) return std::nullopt;
   const std::string m = mode->get<std::string>();
   if (m != "invariant" && m != "reference") {
     why = "mode must be \"invariant\" or \"reference\", not \"" + m + "\"";
     return std::nullopt;
   }
-  version = schema->get<std::uint32_t>();
+  const double t = threshold->get<double>();
+  if (bins->get<std::uint64_t>() == 0 || bins->get<std::uint64_t>() > kernels::GOOD_MAX_BINS ||
+      !(t >= 0.0) || t > 1e30) {
+    why = "bins must be 1.." + std::to_string(kernels::GOOD_MAX_BINS) +
+          " and the threshold a finite number >= 0";
+    return std::nullopt;
+  }
+  version =
+      static_cast<std::uint32_t>(std::min<std::uint64_t>(schema->get<std::uint64_t>(), UINT32_MAX));
   auto spec = kernels::DescriptorSpec::make_good(
       bins->get<std::size_t>(),
       m == "invariant" ? kernels::GoodMode::INVARIANT : kernels::GoodMode::REFERENCE);
   spec.good.threshold = threshold->get<float>();
   if (dictionary) {
-    spec.kind = lda ? kernels::DescriptorKind::LDA : kernels::DescriptorKind::BOW;
+    spec.kind = lda         ? kernels::DescriptorKind::LDA
+                : local_lda ? kernels::DescriptorKind::LOCAL_LDA
+                            : kernels::DescriptorKind::BOW;
+    spec.local_topics = topics;
     spec.dictionary = std::make_shared<const kernels::VisualDictionary>(std::move(*dictionary));
   }
   return spec;

@@ -14,12 +14,11 @@ namespace {
 
 using Code = MemoryError::Code;
 
-std::unique_ptr<Learner> make_learner(MemoryConfig& cfg) {
+std::unique_ptr<Learner> learner_for(MemoryConfig& cfg) {
   const std::size_t length = cfg.descriptor.length();
   cfg.instance.descriptor_length = length;
   cfg.bayes.descriptor_length = length;
-  if (cfg.learner == LearnerKind::BAYES) { return std::make_unique<BayesLearner>(cfg.bayes); }
-  return std::make_unique<InstanceLearner>(cfg.instance);
+  return learning::make_learner(cfg.descriptor, cfg.learner, cfg.instance, cfg.bayes);
 }
 
 // The schema key: written when the store was just created, compared on every later open. A LevelDB
@@ -80,7 +79,7 @@ Result<void, MemoryError> check_schema(PerceptualMemory::State& s, bool created)
     if (bow && !s.cfg.descriptor.dictionary &&
         stored->kind == s.cfg.descriptor.kind) {  // opened as "bow" without words: the store's own
       s.cfg.descriptor = *stored;
-      s.learner = make_learner(s.cfg);
+      s.learner = learner_for(s.cfg);
     }
   }
   if (!(*stored == s.cfg.descriptor)) {
@@ -148,10 +147,6 @@ Result<void, MemoryError> load(PerceptualMemory::State& s) {
 MemoryError memory_error(MemoryError::Code code, const std::filesystem::path& where,
                          const std::string& what) {
   return MemoryError{code, where.string() + ": " + what};
-}
-
-const char* to_string(LearnerKind kind) noexcept {
-  return kind == LearnerKind::BAYES ? "bayes" : "instance";
 }
 
 const char* to_string(MemoryError::Code code) noexcept {
@@ -258,7 +253,7 @@ Result<PerceptualMemory, MemoryError> PerceptualMemory::open(const std::filesyst
   auto s = std::make_unique<State>();
   s->dir = dir;
   s->cfg = cfg;
-  if (!adopt) s->learner = make_learner(s->cfg);  // else made once the store's words are known
+  if (!adopt) s->learner = learner_for(s->cfg);  // else made once the store's words are known
   auto create = prepare(*s, mode);
   if (!create) return err(create.error());
   std::error_code ignored;  // LevelDB creates only the last path component; Open reports failures

@@ -15,17 +15,12 @@
 #include "kernels/descriptor_spec.hpp"
 #include "learning/bayes_learner.hpp"
 #include "learning/instance_learner.hpp"
+#include "learning/learner_choice.hpp"
 
 namespace orthoflow::learning {
 
 /// @brief Store schema version written under the schema key and in the first export line.
 inline constexpr std::uint32_t MEMORY_SCHEMA_VERSION = 1;
-
-/// @brief Which learner a memory feeds. Every store can be opened with either (views and Bayes
-/// accumulators are always both stored).
-enum class LearnerKind : std::uint8_t { INSTANCE, BAYES };
-/// @brief "instance" or "bayes".
-[[nodiscard]] const char* to_string(LearnerKind kind) noexcept;
 
 /// @brief Plain configuration of a memory.
 struct MemoryConfig {

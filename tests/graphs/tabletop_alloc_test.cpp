@@ -182,7 +182,9 @@ TEST(TabletopAllocations, WithTheRobotBodyFilterNothingIsAllocatedPerFrame) {
 // The same graph describing objects by the bag of words (describe: descriptor bow, a dictionary
 // file): the spin-feature scratch of the describe node's pool is reserved once, so keypoints,
 // normals, spin images and words allocate nothing per frame either; the learner asks in words.
-TEST(TabletopAllocations, WithTheBagOfWordsNothingIsAllocatedPerFrame) {
+// The describe node over a dictionary (bow: the bag of words; local-lda: word counts, asked in
+// every category's topics): 60 frames of 5 objects, counted after warm-up.
+void expect_no_allocation_over_words(const std::string& kind) {
   core::Rng rng(4);
   std::vector<float> pool(2000 * 45);
   for (float& v : pool) v = static_cast<float>(rng.uniform() * rng.uniform() * 0.2);
@@ -194,7 +196,7 @@ TEST(TabletopAllocations, WithTheBagOfWordsNothingIsAllocatedPerFrame) {
   ASSERT_EQ(learning::save_dictionary(*words, file), "");
   auto spec = test::tabletop_spec({{"source", {{"objects", "5"}, {"frames", "60"}}},
                                    {"recognise", {{"instructor", "0"}}},
-                                   {"describe", {{"descriptor", "bow"}, {"dictionary", file}}}});
+                                   {"describe", {{"descriptor", kind}, {"dictionary", file}}}});
   auto descriptor = descriptor_of_graph(spec);
   ASSERT_TRUE(descriptor) << descriptor.error();
   ASSERT_EQ(descriptor->length(), 20U);
@@ -202,7 +204,7 @@ TEST(TabletopAllocations, WithTheBagOfWordsNothingIsAllocatedPerFrame) {
   settings.memory.descriptor = *descriptor;
   auto learning = LearningService::open(settings);
   ASSERT_TRUE(learning) << learning.error();
-  std::vector<float> views(2 * 20, 0.05F);
+  std::vector<float> views(2 * 20, kind == "bow" ? 0.05F : 2.0F);  // shares or word counts
   ASSERT_TRUE((*learning)->teach("thing", std::span<const float>(views).first(20), 0, 0, {}).ok());
   ASSERT_TRUE((*learning)->teach("other", std::span<const float>(views).last(20), 0, 0, {}).ok());
   auto json = LineWriter::open("/dev/null");
@@ -222,6 +224,14 @@ TEST(TabletopAllocations, WithTheBagOfWordsNothingIsAllocatedPerFrame) {
   EXPECT_GT(log.summary().object_views, 100U);
   EXPECT_GT(log.summary().recognitions, 100U) << "the objects were described and asked in words";
   EXPECT_EQ(g_allocations.load(), 0U);
+}
+
+TEST(TabletopAllocations, WithTheBagOfWordsNothingIsAllocatedPerFrame) {
+  expect_no_allocation_over_words("bow");
+}
+
+TEST(TabletopAllocations, WithLocalLdaNothingIsAllocatedPerFrame) {
+  expect_no_allocation_over_words("local-lda");
 }
 
 TEST(LabelsWriterAllocations, OfferingAFrameAllocatesNothing) {

@@ -31,6 +31,32 @@ std::unique_ptr<InstanceLearner> make_ab(const InstanceConfig& base) {
 }
 const std::vector<float> QUERY{5, 0};
 
+// Topic histograms are compared by chi-squared (PIPELINE.md section 7): A = (0.5, 0.5), B = (1, 0),
+// T = (0.8, 0.2). L2: D(T, A) = 0.424 > D(T, B) = 0.283, so B. Chi-squared, sum (a - b)^2 / (a +
+// b): D(T, A) = 0.09 / 1.3 + 0.09 / 0.7 = 0.1978 < D(T, B) = 0.04 / 1.8 + 0.04 / 0.2 = 0.2222, so
+// A.
+TEST(InstanceLearner, TheMetricIsChosenAndChiSquaredIsComputedAsByHand) {
+  for (const kernels::Metric metric : {kernels::Metric::L2, kernels::Metric::CHI_SQUARED}) {
+    InstanceConfig cfg;
+    cfg.descriptor_length = 2;
+    cfg.normalise = false;
+    cfg.metric = metric;
+    InstanceLearner learner(cfg);
+    ASSERT_TRUE(learner.teach("A", batch({0.5F, 0.5F}, 2)));
+    ASSERT_TRUE(learner.teach("B", batch({1.0F, 0.0F}, 2)));
+    AskScratch scratch;
+    const Prediction p = learner.ask(std::vector<float>{0.8F, 0.2F}, scratch);
+    if (metric == kernels::Metric::L2) {
+      EXPECT_EQ(p.label.view(), "B");
+      EXPECT_NEAR(p.score, std::sqrt(0.08F), 1e-6F);
+    } else {
+      EXPECT_EQ(p.label.view(), "A");
+      EXPECT_NEAR(p.score, 0.09F / 1.3F + 0.09F / 0.7F, 1e-6F);
+      EXPECT_NEAR(p.runner_up_score, 0.04F / 1.8F + 0.04F / 0.2F, 1e-6F);
+    }
+  }
+}
+
 TEST(InstanceLearner, ApproachOneNormalisesMinDistanceByIcd) {
   auto learner_ptr = make_ab(InstanceConfig{});
   auto& learner = *learner_ptr;
