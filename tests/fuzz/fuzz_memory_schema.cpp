@@ -19,8 +19,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
   std::uint32_t again_version = 0;
   std::string again_why;
-  const auto again = orthoflow::learning::decode_schema(
-      orthoflow::learning::encode_schema(*spec), again_version, again_why);
+  const auto again = orthoflow::learning::decode_schema(orthoflow::learning::encode_schema(*spec),
+                                                        again_version, again_why);
   // encode_schema writes this build's version; everything else must come back equal.
   if (!again || !(*again == *spec) || again->describe() != spec->describe()) { __builtin_trap(); }
   return 0;
