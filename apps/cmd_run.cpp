@@ -72,7 +72,7 @@ struct RunOptions {
   double arm_state_age_ms = 50.0;
   std::string exclude_zones;           // --exclude-zones: C_instructor capsules, camera frame
   std::string dictionary;              // --dictionary FILE: the describe node's bag of words
-  std::string representation = "bow";  // with --dictionary: bow or local-lda
+  std::string representation = "bow";  // with --dictionary: bow, lda or local-lda
 };
 
 [[noreturn]] void fail(const std::string& message, int code) {
@@ -422,9 +422,9 @@ void add_run_command(CLI::App& app) {
                   "describe objects by the bag of words over this dictionary "
                   "(`orthoflow dictionary build`) instead of GOOD; a --db store must have it");
   cmd->add_option("--representation", o->representation,
-                  "with --dictionary: bow (the bag of words) or local-lda (word counts; topics "
-                  "learned per category)")
-      ->check(CLI::IsMember({"bow", "local-lda"}));
+                  "with --dictionary: bow (the bag of words), lda (its topics; a dictionary built "
+                  "with --topics) or local-lda (word counts; topics learned per category)")
+      ->check(CLI::IsMember({"bow", "lda", "local-lda"}));
   cmd->add_option("--db", o->db,
                   "perceptual memory directory (LevelDB); default: learn in memory only");
   cmd->add_option("--learner", o->learner, "instance or bayes")

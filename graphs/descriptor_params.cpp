@@ -13,7 +13,7 @@ Result<kernels::DescriptorSpec, std::string> parse_describe_params(const engine:
     return err(ok.error());
   kernels::DescriptorSpec spec;  // thesis: GOOD, 15 bins; invariant frame by default (docs/GOOD.md)
   std::string e, kind = "good", mode = "invariant", dictionary;
-  take(params.choice("descriptor", "good", {"good", "bow", "local-lda"}), kind, e);
+  take(params.choice("descriptor", "good", {"good", "bow", "lda", "local-lda"}), kind, e);
   if (kind != "good") take(params.text("dictionary", ""), dictionary, e);
   if (kind == "local-lda")
     take(params.integer("local_topics", 30, 1, kernels::MAX_LOCAL_TOPICS), spec.local_topics.topics,
@@ -32,7 +32,9 @@ Result<kernels::DescriptorSpec, std::string> parse_describe_params(const engine:
       return err("describe: descriptor " + kind + " needs a dictionary file (dictionary: ...)");
     auto words = learning::load_dictionary(dictionary);
     if (!words) return err("describe: " + words.error());
-    spec.kind = kind == "bow" ? kernels::DescriptorKind::BOW : kernels::DescriptorKind::LOCAL_LDA;
+    spec.kind = kind == "bow"   ? kernels::DescriptorKind::BOW
+                : kind == "lda" ? kernels::DescriptorKind::LDA
+                                : kernels::DescriptorKind::LOCAL_LDA;
     spec.dictionary = std::make_shared<const kernels::VisualDictionary>(std::move(words.value()));
     if (auto valid = spec.validate(); !valid) return err("describe: " + valid.error());
   }

@@ -68,17 +68,18 @@ class Track final : public engine::Node {
   std::vector<TrackOutput> outputs_;
 };
 
-/// The bag of words' spin-feature scratches: one per call that can run at once (the arena's
-/// threads), each reserved once for max_object_points, taken and given back lock-free.
+/// The scratches of describing over a dictionary (spin features; LDA: words and topic counts):
+/// one per call that can run at once (the arena's threads), each reserved once for
+/// max_object_points, taken and given back lock-free.
 class FeaturePool {
  public:
-  FeaturePool(std::size_t count, std::size_t max_points, std::uint32_t image_width)
+  FeaturePool(std::size_t count, std::size_t max_points, const kernels::DescriptorSpec& spec)
       : scratch_(count), busy_(count) {
-    for (auto& s : scratch_) s.reserve(max_points, image_width);
+    for (auto& s : scratch_) s.reserve(spec, max_points);
     for (auto& b : busy_) b.store(false);
   }
   /// @brief A free scratch, or nullptr when every one is taken (one pass: bounded).
-  kernels::SpinFeatures* take() noexcept {
+  kernels::WordScratch* take() noexcept {
     for (std::size_t i = 0; i < busy_.size(); ++i) {
       bool expected = false;
       if (busy_[i].compare_exchange_strong(expected, true, std::memory_order_acquire))
@@ -86,12 +87,12 @@ class FeaturePool {
     }
     return nullptr;
   }
-  void give(kernels::SpinFeatures* s) noexcept {
+  void give(kernels::WordScratch* s) noexcept {
     busy_[static_cast<std::size_t>(s - scratch_.data())].store(false, std::memory_order_release);
   }
 
  private:
-  std::vector<kernels::SpinFeatures> scratch_;
+  std::vector<kernels::WordScratch> scratch_;
   std::vector<std::atomic<bool>> busy_;
 };
 
@@ -100,11 +101,10 @@ class Describe final : public engine::Node {
   Describe(std::size_t capacity, const kernels::DescriptorSpec& spec, std::size_t slots,
            std::size_t max_object_points)
       : capacity_(capacity), describers_(slots * MAX_OBJECTS, kernels::Describer(spec)) {
-    if (spec.local()) {  // bow or local-lda: spin features first
+    if (spec.local()) {  // bow, lda or local-lda: spin features first
       // More scratches than the arena can run at once: hardware threads, and never fewer than 4.
       const std::size_t workers = std::max<std::size_t>(4, std::thread::hardware_concurrency());
-      pool_ = std::make_unique<FeaturePool>(workers + 1, max_object_points,
-                                            spec.dictionary->spin.image_width);
+      pool_ = std::make_unique<FeaturePool>(workers + 1, max_object_points, spec);
     }
   }
   std::span<const engine::PortSpec> inputs() const noexcept override { return {DESCRIBE_PORTS, 1}; }
@@ -123,7 +123,7 @@ class Describe final : public engine::Node {
       kernels::Describer& describer = describers_[in.slot * MAX_OBJECTS + in.object_index];
       const auto view = block.object_view(in.object_index);
       const auto room = block.descriptor(in.object_index);
-      kernels::SpinFeatures* features = pool_ ? pool_->take() : nullptr;
+      kernels::WordScratch* features = pool_ ? pool_->take() : nullptr;
       // GOOD, or (more calls at once than hardware threads, e.g. --threads above the cores) the
       // describer's own scratch, which grows: correct, but it may allocate.
       auto described =
@@ -143,7 +143,7 @@ class Describe final : public engine::Node {
  private:
   std::size_t capacity_;
   std::vector<kernels::Describer> describers_;
-  std::unique_ptr<FeaturePool> pool_;  ///< bag of words only
+  std::unique_ptr<FeaturePool> pool_;  ///< over a dictionary only
 };
 
 NodeResult make_track(const ParamMap& params, const engine::NodeContext& context) {

@@ -142,20 +142,28 @@ bool DescriptorSpec::operator==(const DescriptorSpec& other) const noexcept {
   return true;
 }
 
+void WordScratch::reserve(const DescriptorSpec& spec, std::size_t max_points) {
+  if (!spec.local() || !spec.dictionary) return;
+  const VisualDictionary& d = *spec.dictionary;
+  features.reserve(max_points, d.spin.image_width);
+  if (spec.kind == DescriptorKind::LDA && d.topics) {
+    words.resize(max_points);
+    topics = TopicScratch(d.topics->topics, d.words, max_points);
+  }
+}
+
 Describer::Describer(const DescriptorSpec& spec) : spec_(spec), good_scratch_(spec.good.bins) {
   if (spec_.local() && spec_.dictionary) {
     good_values_.resize(3 * spec_.good.bins * spec_.good.bins);
     word_scratch_.resize(spec_.dictionary->words);
-    if (spec_.kind == DescriptorKind::LDA && spec_.dictionary->topics)
-      topic_scratch_ = TopicScratch(spec_.dictionary->topics->topics, spec_.dictionary->words, 0);
   }
 }
 
-Result<void, GoodError> Describer::describe_bow(PointsView points, std::span<float> out,
-                                                SpinFeatures& features) {
+Result<void, GoodError> Describer::describe_words(PointsView points, std::span<float> out,
+                                                  WordScratch& scratch) {
   const VisualDictionary& d = *spec_.dictionary;
   const SpinFeatureParams params{d.spin, d.keypoint_leaf, d.normal_radius};
-  auto computed = features.compute(points, params);
+  auto computed = scratch.features.compute(points, params);
   if (!computed) {
     switch (computed.error()) {
       case SpinFeatureError::OUT_OF_MEMORY:
@@ -166,34 +174,39 @@ Result<void, GoodError> Describer::describe_bow(PointsView points, std::span<flo
         return err(GoodError::KEYPOINTS_FAILED);
     }
   }
+  const std::span<const float> images = scratch.features.images();
   if (spec_.kind == DescriptorKind::BOW || spec_.kind == DescriptorKind::LOCAL_LDA) {
     features_ = spec_.kind == DescriptorKind::BOW
-                    ? bag_of_words(features.images(), d.view(), word_scratch_, out)
-                    : word_counts(features.images(), d.view(), word_scratch_, out);
+                    ? bag_of_words(images, d.view(), word_scratch_, out)
+                    : word_counts(images, d.view(), word_scratch_, out);
     if (features_ == 0) return err(GoodError::NO_FEATURES);
     return {};
   }
-  // LDA: the view's words, then its topics (the scratch grows to the largest view).
-  const std::size_t rows = features.images().size() / d.dims;
+  // LDA: the view's words, then its topics (a scratch not reserved for the view grows).
+  const TopicModel& model = *d.topics;
+  const std::size_t rows = images.size() / d.dims;
   try {
-    if (word_ids_.size() < rows) word_ids_.resize(rows);
-    if (topic_scratch_.z.size() < rows) topic_scratch_.z.resize(rows);
+    if (scratch.words.size() < rows) scratch.words.resize(rows);
+    if (scratch.topics.word_topic.size() < model.topics * model.words ||
+        scratch.topics.p.size() < model.topics)
+      scratch.topics = TopicScratch(model.topics, model.words, rows);
+    if (scratch.topics.z.size() < rows) scratch.topics.z.resize(rows);
   } catch (const std::bad_alloc&) { return err(GoodError::OUT_OF_MEMORY); }
-  features_ = assign_words(features.images(), d.view(), word_scratch_, word_ids_);
+  features_ = assign_words(images, d.view(), word_scratch_, scratch.words);
   if (features_ == 0) return err(GoodError::NO_FEATURES);
-  if (!infer_topics(std::span<const std::uint32_t>(word_ids_.data(), features_), *d.topics,
-                    topic_scratch_, out))
+  if (!infer_topics(std::span<const std::uint32_t>(scratch.words.data(), features_), model,
+                    scratch.topics, out))
     return err(GoodError::OUTPUT_TOO_SMALL);
   return {};
 }
 
 Result<DescriptorInfo, GoodError> Describer::describe(PointsView points,
                                                       std::span<float> out) noexcept {
-  return describe(points, out, features_scratch_);
+  return describe(points, out, own_);
 }
 
 Result<DescriptorInfo, GoodError> Describer::describe(PointsView points, std::span<float> out,
-                                                      SpinFeatures& features) noexcept {
+                                                      WordScratch& scratch) noexcept {
   features_ = 0;
   if (!spec_.local()) {
     auto good = compute_good(points, spec_.good, good_scratch_, out);
@@ -204,8 +217,8 @@ Result<DescriptorInfo, GoodError> Describer::describe(PointsView points, std::sp
   // The frame and box come from GOOD (the grasp planner needs them whatever the representation).
   auto good = compute_good(points, spec_.good, good_scratch_, good_values_);
   if (!good) return err(good.error());
-  auto bow = describe_bow(points, out, features);
-  if (!bow) return err(bow.error());
+  auto words = describe_words(points, out, scratch);
+  if (!words) return err(words.error());
   return DescriptorInfo{spec_.length(), good->frame, good->bbox, good->flags};
 }
 

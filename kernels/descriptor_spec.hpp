@@ -83,6 +83,18 @@ struct DescriptorInfo {
   std::uint32_t flags = 0;        ///< GoodResult::flags
 };
 
+/// @brief The working memory of describing one view over a dictionary: its spin features, and for
+/// LDA its words and the topic sampler's scratch. Reserved once, describers that never run at once
+/// can share it and describe without allocating (the graph keeps a pool of them).
+struct WordScratch {
+  SpinFeatures features;
+  std::vector<std::uint32_t> words;  ///< LDA: the view's words
+  TopicScratch topics;               ///< LDA: the temporary copy of the topic counts
+  /// @brief Sizes it for views of up to @p max_points points under @p spec (GOOD: nothing).
+  /// @throws std::bad_alloc.
+  void reserve(const DescriptorSpec& spec, std::size_t max_points);
+};
+
 /// @brief Describes object views under one specification; owns its scratch (sized once).
 /// @note Not thread-safe: one describer per thread (or per concurrent object).
 class Describer {
@@ -96,26 +108,24 @@ class Describer {
   /// compute_good(); the words are exact, kernels/visual_words.hpp).
   [[nodiscard]] Result<DescriptorInfo, GoodError> describe(PointsView points,
                                                            std::span<float> out) noexcept;
-  /// @brief describe() with the spin features' scratch given by the caller (BOW; GOOD ignores
-  /// it): describers that never run at once may share one (the graph keeps one per worker, each
-  /// reserved once, so that describing allocates nothing).
+  /// @brief describe() with the scratch given by the caller (GOOD ignores it): describers that
+  /// never run at once may share one (the graph keeps one per worker, each reserved once, so that
+  /// describing allocates nothing). A scratch too small for a view grows (it may allocate).
   [[nodiscard]] Result<DescriptorInfo, GoodError> describe(PointsView points, std::span<float> out,
-                                                           SpinFeatures& features) noexcept;
+                                                           WordScratch& scratch) noexcept;
   /// @brief BOW: the spin images counted in the last describe() (0 for GOOD).
   [[nodiscard]] std::size_t features() const noexcept { return features_; }
 
  private:
-  /// BOW: the view's spin features, then their words.
-  [[nodiscard]] Result<void, GoodError> describe_bow(PointsView points, std::span<float> out,
-                                                     SpinFeatures& features);
+  /// Over the dictionary: the view's spin features, then their words (and for LDA its topics).
+  [[nodiscard]] Result<void, GoodError> describe_words(PointsView points, std::span<float> out,
+                                                       WordScratch& scratch);
 
   DescriptorSpec spec_;
   GoodScratch good_scratch_;
   std::vector<float> good_values_;  ///< BOW: GOOD's values, for its frame and box only
-  SpinFeatures features_scratch_;
+  WordScratch own_;                 ///< describe() without a scratch: grows to the largest view
   std::vector<float> word_scratch_;
-  std::vector<std::uint32_t> word_ids_;  ///< LDA: the view's words (grows to the largest view)
-  TopicScratch topic_scratch_;           ///< LDA
   std::size_t features_ = 0;
 };
 

@@ -23,6 +23,7 @@
 #include "graphs/labels_writer.hpp"
 #include "kernels/frame_labels.hpp"
 #include "learning/dictionary.hpp"
+#include "learning/topic_training.hpp"
 #include "tabletop_run.hpp"
 
 #include "tests/support/counting_new.hpp"  // the one TU of this binary that replaces operator new
@@ -182,8 +183,9 @@ TEST(TabletopAllocations, WithTheRobotBodyFilterNothingIsAllocatedPerFrame) {
 // The same graph describing objects by the bag of words (describe: descriptor bow, a dictionary
 // file): the spin-feature scratch of the describe node's pool is reserved once, so keypoints,
 // normals, spin images and words allocate nothing per frame either; the learner asks in words.
-// The describe node over a dictionary (bow: the bag of words; local-lda: word counts, asked in
-// every category's topics): 60 frames of 5 objects, counted after warm-up.
+// The describe node over a dictionary (bow: the bag of words; lda: its topics, sampled per object;
+// local-lda: word counts, asked in every category's topics): 60 frames of 5 objects, counted after
+// warm-up.
 void expect_no_allocation_over_words(const std::string& kind) {
   core::Rng rng(4);
   std::vector<float> pool(2000 * 45);
@@ -192,6 +194,16 @@ void expect_no_allocation_over_words(const std::string& kind) {
   km.k = 20;
   auto words = learning::build_dictionary(pool, {}, km, "alloc test");
   ASSERT_TRUE(words) << words.error();
+  const std::size_t length = kind == "lda" ? 5 : 20;  // topics, or words
+  if (kind == "lda") {
+    std::vector<std::vector<float>> views(20);
+    for (std::size_t v = 0; v < views.size(); ++v)
+      views[v].assign(pool.begin() + static_cast<std::ptrdiff_t>(v * 100 * 45),
+                      pool.begin() + static_cast<std::ptrdiff_t>((v + 1) * 100 * 45));
+    learning::TopicFitParams tp;
+    tp.topics = length;
+    ASSERT_TRUE(learning::add_topics(*words, views, tp));
+  }
   const std::string file = std::string(ORTHOFLOW_BINARY_DIR) + "/tabletop_alloc_test_words.ofwd";
   ASSERT_EQ(learning::save_dictionary(*words, file), "");
   auto spec = test::tabletop_spec({{"source", {{"objects", "5"}, {"frames", "60"}}},
@@ -199,14 +211,18 @@ void expect_no_allocation_over_words(const std::string& kind) {
                                    {"describe", {{"descriptor", kind}, {"dictionary", file}}}});
   auto descriptor = descriptor_of_graph(spec);
   ASSERT_TRUE(descriptor) << descriptor.error();
-  ASSERT_EQ(descriptor->length(), 20U);
+  ASSERT_EQ(descriptor->length(), length);
   LearningSettings settings;
   settings.memory.descriptor = *descriptor;
   auto learning = LearningService::open(settings);
   ASSERT_TRUE(learning) << learning.error();
-  std::vector<float> views(2 * 20, kind == "bow" ? 0.05F : 2.0F);  // shares or word counts
-  ASSERT_TRUE((*learning)->teach("thing", std::span<const float>(views).first(20), 0, 0, {}).ok());
-  ASSERT_TRUE((*learning)->teach("other", std::span<const float>(views).last(20), 0, 0, {}).ok());
+  // Shares (bag of words, topics) or word counts (Local LDA).
+  std::vector<float> views(2 * length,
+                           kind == "local-lda" ? 2.0F : 1.0F / static_cast<float>(length));
+  ASSERT_TRUE(
+      (*learning)->teach("thing", std::span<const float>(views).first(length), 0, 0, {}).ok());
+  ASSERT_TRUE(
+      (*learning)->teach("other", std::span<const float>(views).last(length), 0, 0, {}).ok());
   auto json = LineWriter::open("/dev/null");
   ASSERT_TRUE(json);
   SessionLog log(std::move(*json));
@@ -228,6 +244,10 @@ void expect_no_allocation_over_words(const std::string& kind) {
 
 TEST(TabletopAllocations, WithTheBagOfWordsNothingIsAllocatedPerFrame) {
   expect_no_allocation_over_words("bow");
+}
+
+TEST(TabletopAllocations, WithLdaTopicsNothingIsAllocatedPerFrame) {
+  expect_no_allocation_over_words("lda");
 }
 
 TEST(TabletopAllocations, WithLocalLdaNothingIsAllocatedPerFrame) {
