@@ -81,31 +81,12 @@ std::unique_ptr<InstanceSnapshot> finish(std::vector<CategoryPtr> categories,
   s->categories = std::move(categories);
   s->generation = generation;
   s->next_id = next_id;
-  double defined_sum = 0.0;
-  std::size_t defined = 0;
+  std::vector<PairSum> sums;
   for (const CategoryPtr& c : s->categories) {
     s->views += c->count;
-    if (c->count >= 2) {
-      const double n = static_cast<double>(c->count);
-      defined_sum +=
-          std::max(2.0 * c->pair_sum / (n * (n - 1.0)), static_cast<double>(cfg.min_icd));
-      ++defined;
-    }
+    sums.push_back(PairSum{c->count, c->pair_sum});
   }
-  const double fallback = defined > 0 ? defined_sum / static_cast<double>(defined)
-                                      : static_cast<double>(cfg.default_icd);
-  double all_sum = 0.0;
-  for (const CategoryPtr& c : s->categories) {
-    const double n = static_cast<double>(c->count);
-    const double icd = c->count >= 2 ? std::max(2.0 * c->pair_sum / (n * (n - 1.0)),
-                                                static_cast<double>(cfg.min_icd))
-                                     : fallback;
-    s->icd.push_back(static_cast<float>(icd));
-    all_sum += icd;
-  }
-  s->mean_icd = s->categories.empty()
-                    ? cfg.default_icd
-                    : static_cast<float>(all_sum / static_cast<double>(s->categories.size()));
+  s->mean_icd = category_icds(sums, cfg.min_icd, cfg.default_icd, s->icd);
   return s;
 }
 

@@ -67,6 +67,32 @@ Result<void, LearnError> validate_batch(DescriptorBatch views, std::size_t lengt
   return {};
 }
 
+float category_icds(std::span<const PairSum> categories, float min_icd, float default_icd,
+                    std::vector<float>& icd) {
+  const auto measured_icd = [min_icd](const PairSum& c) {
+    const double n = static_cast<double>(c.views);
+    return std::max(2.0 * c.sum / (n * (n - 1.0)), static_cast<double>(min_icd));
+  };
+  double measured_sum = 0.0;
+  std::size_t measured = 0;
+  for (const PairSum& c : categories) {
+    if (c.views < 2) continue;
+    measured_sum += measured_icd(c);
+    ++measured;
+  }
+  const double fallback = measured > 0 ? measured_sum / static_cast<double>(measured)
+                                       : static_cast<double>(default_icd);
+  double all = 0.0;
+  icd.clear();
+  for (const PairSum& c : categories) {
+    const double value = c.views >= 2 ? measured_icd(c) : fallback;
+    icd.push_back(static_cast<float>(value));
+    all += value;
+  }
+  return categories.empty() ? default_icd
+                            : static_cast<float>(all / static_cast<double>(categories.size()));
+}
+
 Result<void, LearnError> validate_restored(std::span<const RestoredCategory> categories,
                                            std::size_t length, bool histograms) noexcept {
   for (std::size_t k = 0; k < categories.size(); ++k) {

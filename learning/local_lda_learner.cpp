@@ -185,31 +185,13 @@ auto finisher(const LocalLdaConfig& cfg) {
     s->categories = std::move(categories);
     s->generation = generation;
     s->next_id = next_id;
-    // ICD as InstanceLearner forms it: a category of one view takes the mean of the others.
-    double sum = 0.0;
-    std::size_t measured = 0;
+    // ICD as InstanceLearner forms it, between the views' topic histograms.
+    std::vector<PairSum> sums;
     for (const CategoryPtr& c : s->categories) {
       s->views += c->views.size();
-      if (c->views.size() >= 2) {
-        const double n = static_cast<double>(c->views.size());
-        sum += std::max(2.0 * c->pair_sum / (n * (n - 1.0)), static_cast<double>(cfg.min_icd));
-        ++measured;
-      }
+      sums.push_back(PairSum{c->views.size(), c->pair_sum});
     }
-    const double fallback =
-        measured > 0 ? sum / static_cast<double>(measured) : static_cast<double>(cfg.default_icd);
-    double all = 0.0;
-    for (const CategoryPtr& c : s->categories) {
-      const double n = static_cast<double>(c->views.size());
-      const double icd = c->views.size() >= 2 ? std::max(2.0 * c->pair_sum / (n * (n - 1.0)),
-                                                         static_cast<double>(cfg.min_icd))
-                                              : fallback;
-      s->icd.push_back(static_cast<float>(icd));
-      all += icd;
-    }
-    s->mean_icd = s->categories.empty()
-                      ? cfg.default_icd
-                      : static_cast<float>(all / static_cast<double>(s->categories.size()));
+    s->mean_icd = category_icds(sums, cfg.min_icd, cfg.default_icd, s->icd);
     return s;
   };
 }

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <span>
+#include <vector>
 
 #include "learning/learner.hpp"
 
@@ -54,6 +55,19 @@ class RankedScores {
   Label best_label_;
   Label second_label_;
 };
+
+/// @brief One category's views and the sum of their pairwise distances, as the ICD needs them.
+struct PairSum {
+  std::size_t views = 0;
+  double sum = 0.0;  ///< over unordered pairs of distinct views
+};
+
+/// @brief ICD of every category (thesis chapter 5): the mean pairwise distance of a category of two
+/// or more views (never below @p min_icd); a category of one view takes the mean of those, or
+/// @p default_icd while none has two. Writes one ICD per category to @p icd. @return their mean
+/// (approach II), or @p default_icd when there is no category.
+float category_icds(std::span<const PairSum> categories, float min_icd, float default_icd,
+                    std::vector<float>& icd);
 
 /// @brief Checks restored categories: labels, views (when @p need_views or present), and that no id
 /// or label appears twice (DUPLICATE_ID).
