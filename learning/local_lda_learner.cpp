@@ -112,13 +112,14 @@ void update_log_p(LocalLdaCategory& c, float count_scale) {
 }
 
 // Thesis: the new instance's words are drawn topics against the category's counts, which then
-// keep them (the incremental update); its theta joins the category's rows.
-void teach_view(LocalLdaCategory& c, std::span<const float> counts, std::size_t max_words) {
+// keep them (the incremental update); its theta joins the category's rows (settle() then derives
+// what the decision rules need). @p buffer: room for max_words words.
+void teach_view(LocalLdaCategory& c, std::span<const float> counts,
+                std::span<std::uint32_t> buffer) {
   const std::size_t K = c.model.topics, V = c.model.words;
   auto view = std::make_shared<LocalLdaView>();
-  view->words.resize(max_words);
-  const std::size_t n = expand_word_counts(counts, view->words).value();
-  view->words.resize(n);
+  const std::size_t n = expand_word_counts(counts, buffer).value();
+  view->words.assign(buffer.begin(), buffer.begin() + static_cast<std::ptrdiff_t>(n));
   kernels::TopicScratch scratch(K, V, n);
   std::vector<float> theta(K);
   OF_ENFORCE(kernels::infer_topics(view->words, c.model, scratch, theta),
@@ -126,11 +127,7 @@ void teach_view(LocalLdaCategory& c, std::span<const float> counts, std::size_t 
   std::copy_n(scratch.word_topic.begin(), K * V, c.model.word_topic.begin());
   std::copy_n(scratch.topic_total.begin(), K, c.model.topic_total.begin());
   view->z.assign(scratch.z.begin(), scratch.z.begin() + static_cast<std::ptrdiff_t>(n));
-  const std::size_t rows = c.views.size();
-  for (std::size_t r = 0; r < rows; ++r)
-    c.pair_sum += chi_squared(theta, std::span<const float>(c.theta).subspan(r * K, K));
   c.theta.insert(c.theta.end(), theta.begin(), theta.end());
-  for (std::size_t k = 0; k < K; ++k) c.theta_sum[k] += static_cast<double>(theta[k]);
   c.views.push_back(std::move(view));
 }
 
@@ -160,6 +157,17 @@ void redescribe(LocalLdaCategory& c) {
                                      std::span<float>(c.theta).subspan(r * K, K)),
                "Local LDA: a taught view was refused by the sampler");
   sum_rows(c);
+}
+
+// After a teach, retract or restore: the views' theta (described again, or as taught), their pair
+// and theta sums, and log P(k | C).
+void settle(LocalLdaCategory& c, const LocalLdaConfig& cfg) {
+  if (cfg.redescribe) {
+    redescribe(c);
+  } else {
+    sum_rows(c);
+  }
+  update_log_p(c, cfg.count_scale);
 }
 
 LocalLdaCategory empty_category(const LocalLdaConfig& cfg, CategoryId id, std::string_view label) {
@@ -199,11 +207,11 @@ auto finisher(const LocalLdaConfig& cfg) {
 // The category without its last views.count() views, which must be @p views; null when none
 // would be left.
 Result<CategoryPtr, LearnError> without_last(const LocalLdaCategory& c, DescriptorBatch views,
-                                             const LocalLdaConfig& cfg) {
+                                             const LocalLdaConfig& cfg,
+                                             std::span<std::uint32_t> words) {
   const std::size_t n = views.count(), K = c.model.topics, V = c.model.words;
   if (n > c.views.size()) return err(LearnError::NOT_LAST_VIEWS);
   const std::size_t keep = c.views.size() - n;
-  std::vector<std::uint32_t> words(cfg.max_words);
   for (std::size_t v = 0; v < n; ++v) {
     const std::size_t count = expand_word_counts(views.view(v), words).value();
     const std::vector<std::uint32_t>& taught = c.views[keep + v]->words;
@@ -225,9 +233,7 @@ Result<CategoryPtr, LearnError> without_last(const LocalLdaCategory& c, Descript
   }
   next->views.assign(c.views.begin(), c.views.begin() + static_cast<std::ptrdiff_t>(keep));
   next->theta.assign(c.theta.begin(), c.theta.begin() + static_cast<std::ptrdiff_t>(keep * K));
-  sum_rows(*next);
-  if (cfg.redescribe) redescribe(*next);
-  update_log_p(*next, cfg.count_scale);
+  settle(*next, cfg);
   return CategoryPtr{std::move(next)};
 }
 
@@ -261,9 +267,8 @@ Result<CategoryId, LearnError> LocalLdaLearner::teach(std::string_view label,
   auto make = [&](const LocalLdaCategory* existing, CategoryId id) {
     auto c = std::make_shared<LocalLdaCategory>(
         existing == nullptr ? empty_category(cfg_, id, label) : *existing);
-    for (std::size_t v = 0; v < views.count(); ++v) teach_view(*c, views.view(v), cfg_.max_words);
-    if (cfg_.redescribe) redescribe(*c);
-    update_log_p(*c, cfg_.count_scale);
+    for (std::size_t v = 0; v < views.count(); ++v) teach_view(*c, views.view(v), buffer);
+    settle(*c, cfg_);
     return CategoryPtr{std::move(c)};
   };
   return upsert_category(writer_, *cell_, label, make, finisher(cfg_));
@@ -337,7 +342,7 @@ Result<void, LearnError> LocalLdaLearner::retract(std::string_view label, Descri
   if (auto r = validate_batch(views, cfg_.words, true); !r) return err(r.error());
   std::vector<std::uint32_t> buffer;
   if (auto r = check_counts(views, cfg_.max_words, buffer); !r) return err(r.error());
-  auto make = [&](const LocalLdaCategory& c) { return without_last(c, views, cfg_); };
+  auto make = [&](const LocalLdaCategory& c) { return without_last(c, views, cfg_, buffer); };
   return shrink_category(writer_, *cell_, label, make, finisher(cfg_));
 }
 
@@ -353,10 +358,8 @@ Result<void, LearnError> LocalLdaLearner::restore(std::span<const RestoredCatego
   std::vector<CategoryPtr> next;
   for (const RestoredCategory& rc : categories) {
     auto c = std::make_shared<LocalLdaCategory>(empty_category(cfg_, rc.id, rc.label));
-    for (std::size_t v = 0; v < rc.views.count(); ++v)
-      teach_view(*c, rc.views.view(v), cfg_.max_words);
-    if (cfg_.redescribe) redescribe(*c);
-    update_log_p(*c, cfg_.count_scale);
+    for (std::size_t v = 0; v < rc.views.count(); ++v) teach_view(*c, rc.views.view(v), buffer);
+    settle(*c, cfg_);
     next.push_back(std::move(c));
     next_id = std::max(next_id, rc.id + 1);
   }
