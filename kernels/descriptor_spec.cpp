@@ -94,10 +94,7 @@ Result<void, std::string> DescriptorSpec::validate() const {
       return err("descriptor " + describe() +
                  ": the dictionary has no topic model of its words (orthoflow dictionary build "
                  "--topics K)");
-    const LocalTopics& lt = local_topics;
-    if (kind == DescriptorKind::LOCAL_LDA &&
-        (lt.topics == 0 || lt.topics > MAX_LOCAL_TOPICS || !(lt.alpha > 0.0) || !(lt.beta > 0.0) ||
-         !std::isfinite(lt.alpha) || !std::isfinite(lt.beta) || lt.iterations > MAX_GIBBS_SWEEPS))
+    if (kind == DescriptorKind::LOCAL_LDA && !local_topics.valid())
       return err("descriptor " + describe() + ": Local LDA needs 1.." +
                  std::to_string(MAX_LOCAL_TOPICS) + " topics, finite alpha and beta > 0, and at " +
                  "most " + std::to_string(MAX_GIBBS_SWEEPS) + " sweeps");

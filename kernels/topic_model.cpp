@@ -1,6 +1,7 @@
 #include "kernels/topic_model.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <numeric>
 
 namespace orthoflow::kernels {
@@ -15,6 +16,11 @@ bool TopicModel::consistent() const noexcept {
     if (sum != topic_total[k]) return false;
   }
   return true;
+}
+
+bool LocalTopics::valid() const noexcept {
+  return topics > 0 && topics <= MAX_LOCAL_TOPICS && alpha > 0.0 && beta > 0.0 &&
+         std::isfinite(alpha) && std::isfinite(beta) && iterations <= MAX_GIBBS_SWEEPS;
 }
 
 TopicScratch::TopicScratch(std::size_t topics, std::size_t words, std::size_t max_words)

@@ -49,6 +49,9 @@ struct LocalTopics {
   std::uint32_t iterations = 30;  ///< Gibbs sweeps of a taught view and of a target
   std::uint64_t seed = 1;         ///< of every draw (mixed with the view's words)
   [[nodiscard]] bool operator==(const LocalTopics&) const noexcept = default;
+  /// @brief 1..MAX_LOCAL_TOPICS topics, finite alpha and beta > 0, at most MAX_GIBBS_SWEEPS sweeps:
+  /// the one rule the specification, a store's schema and the learner check.
+  [[nodiscard]] bool valid() const noexcept;
 };
 
 /// @brief Scratch of topic inference, sized once for a model and documents of up to max_words.

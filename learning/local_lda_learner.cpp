@@ -240,12 +240,10 @@ Result<CategoryPtr, LearnError> without_last(const LocalLdaCategory& c, Descript
 }  // namespace
 
 LocalLdaLearner::LocalLdaLearner(const LocalLdaConfig& cfg) : cfg_(cfg) {
-  const kernels::LocalTopics& t = cfg.topics;
   OF_ENFORCE(cfg.words > 0, "LocalLdaConfig::words must be positive");
-  OF_ENFORCE(t.topics > 0 && t.topics <= kernels::MAX_LOCAL_TOPICS,
-             "LocalLdaConfig: topics must be 1..MAX_LOCAL_TOPICS");
-  OF_ENFORCE(t.alpha > 0.0 && t.beta > 0.0 && std::isfinite(t.alpha) && std::isfinite(t.beta),
-             "LocalLdaConfig: alpha and beta must be finite and > 0");
+  OF_ENFORCE(cfg.topics.valid(),
+             "LocalLdaConfig: 1..MAX_LOCAL_TOPICS topics, finite alpha and beta > 0, at most "
+             "MAX_GIBBS_SWEEPS sweeps");
   OF_ENFORCE(cfg.max_words > 0, "LocalLdaConfig::max_words must be positive");
   OF_ENFORCE(!std::isnan(cfg.classification_threshold), "LocalLdaConfig: CT is NaN");
   OF_ENFORCE(cfg.default_icd > 0.0F && std::isfinite(cfg.default_icd) && cfg.min_icd > 0.0F &&

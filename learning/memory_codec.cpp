@@ -186,10 +186,8 @@ bool schema_local_topics(const nlohmann::json& j, kernels::LocalTopics& t, std::
   const auto sweeps = (*o)["iterations"].get<std::uint64_t>();
   t.iterations = static_cast<std::uint32_t>(std::min<std::uint64_t>(sweeps, UINT32_MAX));
   t.seed = (*o)["seed"].get<std::uint64_t>();
-  // The learner's preconditions (kernels::DescriptorSpec::validate): a store never hands it others.
-  if (t.topics == 0 || t.topics > kernels::MAX_LOCAL_TOPICS || !(t.alpha > 0.0) ||
-      !(t.beta > 0.0) || !std::isfinite(t.alpha) || !std::isfinite(t.beta) ||
-      sweeps > kernels::MAX_GIBBS_SWEEPS) {
+  // The learner's preconditions: a store never hands it others.
+  if (!t.valid()) {  // sweeps past UINT32_MAX were clamped to it, past the limit too
     why = "\"local_topics\" out of range: 1.." + std::to_string(kernels::MAX_LOCAL_TOPICS) +
           " topics, finite alpha and beta > 0, at most " +
           std::to_string(kernels::MAX_GIBBS_SWEEPS) + " iterations";
