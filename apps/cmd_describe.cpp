@@ -174,10 +174,11 @@ void run_describe_local(const DescribeOptions& o, const kernels::PointCloud& clo
   auto words = learning::load_dictionary(o.dictionary);
   if (!words) fail(words.error(), EXIT_BAD_INPUT);
   auto dictionary = std::make_shared<const kernels::VisualDictionary>(std::move(words.value()));
-  const kernels::DescriptorSpec spec =
-      o.representation == "lda"         ? kernels::DescriptorSpec::make_lda(dictionary)
-      : o.representation == "local-lda" ? kernels::DescriptorSpec::make_local_lda(dictionary)
-                                        : kernels::DescriptorSpec::make_bow(dictionary);
+  // --dictionary without --representation: the bag of words.
+  const auto kind =
+      kernels::descriptor_kind(o.representation).value_or(kernels::DescriptorKind::BOW);
+  const kernels::DescriptorSpec spec = kernels::DescriptorSpec::over_dictionary(
+      kind == kernels::DescriptorKind::GOOD ? kernels::DescriptorKind::BOW : kind, dictionary);
   if (auto valid = spec.validate(); !valid) fail(valid.error(), EXIT_USAGE);
   kernels::Describer describer(spec);
   std::vector<float> values(spec.length());

@@ -76,9 +76,7 @@ std::vector<evaluation::Variant> variants_of(
       for (const std::string& r : o.representations) {
         if (r == "good") continue;
         evaluation::Variant v = base;
-        v.representation = r == "lda"         ? kernels::DescriptorKind::LDA
-                           : r == "local-lda" ? kernels::DescriptorKind::LOCAL_LDA
-                                              : kernels::DescriptorKind::BOW;
+        v.representation = kernels::descriptor_kind(r).value_or(kernels::DescriptorKind::BOW);
         v.dictionary = dictionary;
         v.local_topics.topics = o.local_topics;
         v.topic_histogram_bayes = o.local_bayes == "histogram";

@@ -55,10 +55,11 @@ learning::MemoryConfig config_of(const MemoryOptions& o) {
       words = std::make_shared<const kernels::VisualDictionary>(std::move(d.value()));
     }
     const kernels::GoodConfig good = cfg.descriptor.good;
-    cfg.descriptor = o.representation == "lda" ? kernels::DescriptorSpec::make_lda(std::move(words))
-                     : o.representation == "local-lda"
-                         ? kernels::DescriptorSpec::make_local_lda(std::move(words))
-                         : kernels::DescriptorSpec::make_bow(std::move(words));
+    const auto kind =
+        kernels::descriptor_kind(o.representation).value_or(kernels::DescriptorKind::BOW);
+    cfg.descriptor = kernels::DescriptorSpec::over_dictionary(
+        kind == kernels::DescriptorKind::GOOD ? kernels::DescriptorKind::BOW : kind,
+        std::move(words));
     cfg.descriptor.good = good;
   }
   cfg.learner =

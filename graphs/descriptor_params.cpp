@@ -32,9 +32,7 @@ Result<kernels::DescriptorSpec, std::string> parse_describe_params(const engine:
       return err("describe: descriptor " + kind + " needs a dictionary file (dictionary: ...)");
     auto words = learning::load_dictionary(dictionary);
     if (!words) return err("describe: " + words.error());
-    spec.kind = kind == "bow"   ? kernels::DescriptorKind::BOW
-                : kind == "lda" ? kernels::DescriptorKind::LDA
-                                : kernels::DescriptorKind::LOCAL_LDA;
+    spec.kind = kernels::descriptor_kind(kind).value_or(kernels::DescriptorKind::BOW);
     spec.dictionary = std::make_shared<const kernels::VisualDictionary>(std::move(words.value()));
     if (auto valid = spec.validate(); !valid) return err("describe: " + valid.error());
   }

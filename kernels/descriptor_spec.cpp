@@ -20,6 +20,13 @@ std::string_view to_string(DescriptorKind kind) noexcept {
   return "unknown";
 }
 
+std::optional<DescriptorKind> descriptor_kind(std::string_view name) noexcept {
+  for (const DescriptorKind k :
+       {DescriptorKind::GOOD, DescriptorKind::BOW, DescriptorKind::LDA, DescriptorKind::LOCAL_LDA})
+    if (to_string(k) == name) return k;
+  return std::nullopt;
+}
+
 DescriptorSpec DescriptorSpec::make_good(std::size_t bins, GoodMode mode) noexcept {
   DescriptorSpec s;
   s.good.bins = bins;
@@ -27,30 +34,27 @@ DescriptorSpec DescriptorSpec::make_good(std::size_t bins, GoodMode mode) noexce
   return s;
 }
 
-namespace {
-
-DescriptorSpec over_words(DescriptorKind kind, std::shared_ptr<const VisualDictionary> dictionary) {
+DescriptorSpec DescriptorSpec::over_dictionary(
+    DescriptorKind kind, std::shared_ptr<const VisualDictionary> dictionary) noexcept {
   DescriptorSpec s;
   s.kind = kind;
   s.dictionary = std::move(dictionary);
   return s;
 }
 
-}  // namespace
-
 DescriptorSpec DescriptorSpec::make_bow(
     std::shared_ptr<const VisualDictionary> dictionary) noexcept {
-  return over_words(DescriptorKind::BOW, std::move(dictionary));
+  return over_dictionary(DescriptorKind::BOW, std::move(dictionary));
 }
 
 DescriptorSpec DescriptorSpec::make_lda(
     std::shared_ptr<const VisualDictionary> dictionary) noexcept {
-  return over_words(DescriptorKind::LDA, std::move(dictionary));
+  return over_dictionary(DescriptorKind::LDA, std::move(dictionary));
 }
 
 DescriptorSpec DescriptorSpec::make_local_lda(std::shared_ptr<const VisualDictionary> dictionary,
                                               const LocalTopics& topics) noexcept {
-  DescriptorSpec s = over_words(DescriptorKind::LOCAL_LDA, std::move(dictionary));
+  DescriptorSpec s = over_dictionary(DescriptorKind::LOCAL_LDA, std::move(dictionary));
   s.local_topics = topics;
   return s;
 }

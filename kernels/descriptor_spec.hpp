@@ -10,6 +10,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -31,6 +32,8 @@ enum class DescriptorKind : std::uint8_t {
 };
 /// @brief "good", "bow", "lda" or "local-lda".
 [[nodiscard]] std::string_view to_string(DescriptorKind kind) noexcept;
+/// @brief The kind to_string() names @p name, or std::nullopt.
+[[nodiscard]] std::optional<DescriptorKind> descriptor_kind(std::string_view name) noexcept;
 
 /// @brief Kind, parameters and length of a descriptor. A plain value; compare with ==.
 struct DescriptorSpec {
@@ -52,6 +55,10 @@ struct DescriptorSpec {
   /// @brief A topic specification over @p dictionary's topic model.
   [[nodiscard]] static DescriptorSpec make_lda(
       std::shared_ptr<const VisualDictionary> dictionary) noexcept;
+  /// @brief A specification of @p kind (BOW, LDA or LOCAL_LDA with the thesis's topics) over
+  /// @p dictionary.
+  [[nodiscard]] static DescriptorSpec over_dictionary(
+      DescriptorKind kind, std::shared_ptr<const VisualDictionary> dictionary) noexcept;
   /// @brief Word counts over @p dictionary, for Local LDA with @p topics per category.
   [[nodiscard]] static DescriptorSpec make_local_lda(
       std::shared_ptr<const VisualDictionary> dictionary, const LocalTopics& topics = {}) noexcept;

@@ -219,17 +219,16 @@ std::optional<kernels::DescriptorSpec> decode_schema(std::string_view json, std:
     return std::nullopt;
   }
   const std::string kind_name = kind != j.end() ? kind->get<std::string>() : "good";
-  const bool bow = kind_name == kernels::to_string(kernels::DescriptorKind::BOW);
-  const bool lda = kind_name == kernels::to_string(kernels::DescriptorKind::LDA);
-  const bool local_lda = kind_name == kernels::to_string(kernels::DescriptorKind::LOCAL_LDA);
-  if (!bow && !lda && !local_lda &&
-      kind_name != kernels::to_string(kernels::DescriptorKind::GOOD)) {
+  const auto named = kernels::descriptor_kind(kind_name);
+  if (!named) {
     why =
         "descriptor \"" + kind_name + "\" is not one this build knows (good, bow, lda, local-lda)";
     return std::nullopt;
   }
   std::optional<kernels::VisualDictionary> dictionary;
-  if ((bow || lda || local_lda) && !(dictionary = schema_dictionary(j, why))) return std::nullopt;
+  const bool local_lda = named == kernels::DescriptorKind::LOCAL_LDA;
+  if (named != kernels::DescriptorKind::GOOD && !(dictionary = schema_dictionary(j, why)))
+    return std::nullopt;
   kernels::LocalTopics topics;
   if (local_lda && !schema_local_topics(j, topics, why)) return std::nullopt;
   const std::string m = mode->get<std::string>();
@@ -251,9 +250,7 @@ std::optional<kernels::DescriptorSpec> decode_schema(std::string_view json, std:
       m == "invariant" ? kernels::GoodMode::INVARIANT : kernels::GoodMode::REFERENCE);
   spec.good.threshold = threshold->get<float>();
   if (dictionary) {
-    spec.kind = lda         ? kernels::DescriptorKind::LDA
-                : local_lda ? kernels::DescriptorKind::LOCAL_LDA
-                            : kernels::DescriptorKind::BOW;
+    spec.kind = *named;
     spec.local_topics = topics;
     spec.dictionary = std::make_shared<const kernels::VisualDictionary>(std::move(*dictionary));
   }
