@@ -46,7 +46,9 @@ void run_task(const TaskArgs& a) {
     if (!o.described) continue;  // no frame, no box: nothing to plan with
     boxes.push_back(manipulation::object_box_in_base(scene.base_from_camera, o.frame, o.bbox));
     objects.push_back({static_cast<std::uint32_t>(o.track), o.label,
-                       boxes.back().base_from_object.translation()});
+                       boxes.back().base_from_object.translation(),
+                       manipulation::footprint_radius(
+                           manipulation::upright_box(boxes.back(), scene.table).extents)});
   }
   manipulation::TaskPlan plan;
   if (a.task == "clear_table") {

@@ -86,7 +86,8 @@ Result<void, std::string> TableTaskRunner::start(std::span<const std::string> kn
     }
   }
   std::vector<TableObject> objects;
-  for (const SeenObject& s : seen_) objects.push_back({s.track, s.label, s.centre});
+  for (const SeenObject& s : seen_)
+    objects.push_back({s.track, s.label, s.centre, footprint_radius(s.box.extents)});
   TaskPlan plan;
   if (options_.task == TableTaskKind::CLEAR_TABLE) {
     ClearTableOptions o;
@@ -109,7 +110,9 @@ Result<void, std::string> TableTaskRunner::start(std::span<const std::string> kn
     r.to = m.place;
     moves_.push_back(std::move(r));
     planned_.push_back(it->centre);
+    radii_.push_back(m.radius_m);
   }
+  occupied_ = std::move(plan.occupied);
   state_ = State::MOVING;
   return {};
 }
@@ -196,6 +199,20 @@ bool TableTaskRunner::placing() const noexcept {
 bool TableTaskRunner::arm_hides(const Vector3d& base_point, double radius_m) const noexcept {
   return occludes(std::span(sight_).first(sight_count_), Vector3d::Zero(),
                   camera_from_base_ * base_point, radius_m);
+}
+
+bool TableTaskRunner::spots_swap(std::size_t a, std::size_t b) const {
+  if (options_.task != TableTaskKind::CLEAR_TABLE) return true;  // the user's places: one size
+  const Vector2d at_a = moves_[a].to, at_b = moves_[b].to;
+  std::vector<Footprint> others = occupied_;
+  for (std::size_t k = 0; k < moves_.size(); ++k)  // every other place given (a retry repeats one)
+    if (moves_[k].to != at_a && moves_[k].to != at_b) others.push_back({moves_[k].to, radii_[k]});
+  const Footprint a_at_b{at_b, radii_[a]}, b_at_a{at_a, radii_[b]};
+  const double gap = ClearTableOptions{}.gap_m;  // as start() planned
+  others.push_back(b_at_a);
+  if (!fits_in_area(options_.area, a_at_b, others, gap)) return false;
+  others.back() = a_at_b;
+  return fits_in_area(options_.area, b_at_a, others, gap);
 }
 
 std::size_t TableTaskRunner::add_spheres(const SeenObject& o, std::size_t used) {
@@ -322,6 +339,7 @@ void TableTaskRunner::start_move(std::int64_t now_ns, const jaco::ArmSnapshot& a
   std::size_t spot = move_;
   for (const auto& [above, rise, aside] : WAYS) {
     for (spot = move_; spot < moves_.size() && !job; ++spot) {
+      if (spot != move_ && !spots_swap(move_, spot)) continue;
       const Vector3d place(moves_[spot].to.x(), moves_[spot].to.y(), s->centre.z());
       made.clear();
       for (std::size_t k = 0; k < plan->feasible_count; ++k) {
@@ -477,6 +495,7 @@ std::size_t TableTaskRunner::add_retries() {
     r.retry_of = k;
     moves_.push_back(std::move(r));
     planned_.push_back(planned_[k]);
+    radii_.push_back(radii_[k]);
   }
   return moves_.size() - first_pass;
 }

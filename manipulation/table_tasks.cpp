@@ -31,53 +31,73 @@ const char* to_string(StayReason reason) noexcept {
   return "unknown";
 }
 
+double footprint_radius(const Eigen::Vector3d& extents) noexcept {
+  return 0.5 * std::max(extents.x(), extents.y());
+}
+
+bool fits_in_area(const TableArea& area, const Footprint& f, std::span<const Footprint> others,
+                  double gap_m) noexcept {
+  constexpr double SLACK = 1e-9;  // a place exactly at the limit fits
+  if (!f.centre.allFinite() || !std::isfinite(f.radius_m) || f.radius_m < 0.0) return false;
+  const Eigen::Array2d r = Eigen::Array2d::Constant(f.radius_m);
+  if ((f.centre.array() - r < area.min.array() - SLACK).any() ||
+      (f.centre.array() + r > area.max.array() + SLACK).any())
+    return false;
+  return std::none_of(others.begin(), others.end(), [&](const Footprint& o) {
+    return (o.centre - f.centre).norm() < o.radius_m + f.radius_m + gap_m - SLACK;
+  });
+}
+
 TaskPlan plan_clear_table(std::span<const TableObject> objects, const ClearTableOptions& options) {
   TaskPlan plan;
   std::vector<const TableObject*> to_move;
-  std::vector<Eigen::Vector2d> occupied;  // what already stands in the area
+  const auto footprint = [](const TableObject& o) {
+    return Footprint{xy(o.centre), std::max(o.radius_m, 0.0)};
+  };
   for (const TableObject& o : objects) {
+    const bool in_area = options.area.contains(xy(o.centre));
     if (o.label.empty()) {
       plan.stays.push_back({o.track, o.label, StayReason::UNKNOWN});
     } else if (listed(options.table_items, o.label)) {
       plan.stays.push_back({o.track, o.label, StayReason::TABLE_ITEM});
-    } else if (options.area.contains(xy(o.centre))) {
+    } else if (in_area) {
       plan.stays.push_back({o.track, o.label, StayReason::IN_PLACE});
-      occupied.push_back(xy(o.centre));
     } else {
       to_move.push_back(&o);
+      continue;
     }
+    if (in_area) plan.occupied.push_back(footprint(o));  // whatever stands in the area takes room
   }
-  for (const TableObject& o : objects)  // an Unknown object or a table item in the area takes room
-    if (o.label.empty() || listed(options.table_items, o.label))
-      if (options.area.contains(xy(o.centre))) occupied.push_back(xy(o.centre));
   std::sort(to_move.begin(), to_move.end(), [&](const TableObject* a, const TableObject* b) {
     const double da = (xy(a->centre) - options.arm_base).norm();
     const double db = (xy(b->centre) - options.arm_base).norm();
     return da != db ? da < db : a->track < b->track;
   });
-  // The grid's spots, row by row from the area's min corner, each half a spacing in from the edges.
-  std::vector<Eigen::Vector2d> spots;
-  const double s = options.spacing_m;
-  if (s > 0.0) {
-    for (double y = options.area.min.y() + s / 2; y <= options.area.max.y() - s / 2 + 1e-9; y += s)
-      for (double x = options.area.min.x() + s / 2; x <= options.area.max.x() - s / 2 + 1e-9;
-           x += s)
-        spots.emplace_back(x, y);
-  }
-  // A spot is taken when anything stands within three quarters of a spacing of it.
-  std::size_t next = 0;
+  // Each object's place: the first of a fine grid, row by row (+x) from the area's min corner,
+  // where its footprint fits beside everything that stands there or was given a place before it.
+  // At most 1000 places along a side: a bounded search whatever the options.
+  const Eigen::Vector2d size = options.area.max - options.area.min;
+  const bool grid = options.step_m > 0.0 && std::isfinite(options.step_m) && size.allFinite() &&
+                    (size.array() >= 0).all();
+  const double step = grid ? std::max(options.step_m, size.maxCoeff() / 1000.0) : 0.0;
+  const long columns = grid ? static_cast<long>(std::floor(size.x() / step)) + 1 : 0;
+  const long rows = grid ? static_cast<long>(std::floor(size.y() / step)) + 1 : 0;
+  std::vector<Footprint> taken = plan.occupied;
   for (const TableObject* o : to_move) {
-    while (next < spots.size() &&
-           std::any_of(occupied.begin(), occupied.end(), [&](const Eigen::Vector2d& p) {
-             return (p - spots[next]).norm() < 0.75 * s;
-           }))
-      ++next;
-    if (next == spots.size()) {
+    Footprint f = footprint(*o);
+    bool found = false;
+    for (long j = 0; j < rows && !found; ++j) {
+      for (long i = 0; i < columns && !found; ++i) {
+        f.centre = options.area.min + Eigen::Vector2d(double(i) * step, double(j) * step);
+        found = fits_in_area(options.area, f, taken, options.gap_m);
+      }
+    }
+    if (!found) {
       plan.stays.push_back({o->track, o->label, StayReason::NO_ROOM});
       continue;
     }
-    plan.moves.push_back({o->track, o->label, spots[next]});
-    occupied.push_back(spots[next]);
+    plan.moves.push_back({o->track, o->label, f.centre, f.radius_m});
+    taken.push_back(f);
   }
   return plan;
 }

@@ -4,7 +4,9 @@
 /// in which order, from the labels the learner gives. Which joints move them is the pick-and-place
 /// job's (pick_place_job.hpp), and the execution manager runs each job.
 /// - clear_table: every recognised object except the categories marked as table items goes to the
-///   placing area, nearest to the arm's base first, each to the next free spot of a grid there.
+///   placing area, nearest to the arm's base first, each to the first place there that its
+///   footprint fits: inside the area and a gap clear of every other footprint (spots sized by each
+///   object, not one grid for all).
 /// - serve_a_meal: the objects of the named categories, in the order named, go to the user's place,
 ///   side by side along the table's x axis.
 /// An object the learner calls Unknown is never moved (the robot does not know what it is); every
@@ -23,6 +25,19 @@ struct TableObject {
   std::uint32_t track = 0;
   std::string label;  ///< empty: Unknown
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  double radius_m = 0.0;  ///< its footprint on the table, a circle (footprint_radius())
+};
+
+/// @brief The footprint radius of an object whose upright box has edge lengths @p extents (x, y on
+/// the table): half the longer one. Tableware is round, and a round object's box is a square
+/// around it; a square box's corners reach 41 % further, a mug's handle a few millimetres: the
+/// planner's gap between footprints (ClearTableOptions::gap_m) covers them.
+[[nodiscard]] double footprint_radius(const Eigen::Vector3d& extents) noexcept;
+
+/// @brief A circle on the table (base frame x, y).
+struct Footprint {
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+  double radius_m = 0.0;
 };
 
 /// @brief One move of a task: the object and where its centre goes (x, y on the table).
@@ -30,6 +45,7 @@ struct TaskMove {
   std::uint32_t track = 0;
   std::string label;
   Eigen::Vector2d place = Eigen::Vector2d::Zero();
+  double radius_m = 0.0;  ///< the object's footprint, which its place was chosen for
 };
 
 /// @brief Why an object stays where it is.
@@ -51,6 +67,8 @@ struct TaskStay {
 struct TaskPlan {
   std::vector<TaskMove> moves;  ///< in execution order
   std::vector<TaskStay> stays;
+  /// clear_table: what stands in the placing area and stays (its room is taken).
+  std::vector<Footprint> occupied;
 };
 
 /// @brief A rectangle on the table (base frame x, y; min <= max).
@@ -65,9 +83,18 @@ struct TableArea {
 struct ClearTableOptions {
   TableArea area;                        ///< the placing area
   std::vector<std::string> table_items;  ///< categories that stay (e.g. "plate")
-  double spacing_m = 0.15;               ///< spots of the area's grid, and the room each needs
+  /// The room between two footprints: the hand opens 2 cm wider than what it holds, and its fingers
+  /// are about 1.5 cm thick on either side.
+  double gap_m = 0.05;
+  /// Places are tried on a grid this fine, row by row (+x) from the area's min corner.
+  double step_m = 0.01;
   Eigen::Vector2d arm_base = Eigen::Vector2d::Zero();  ///< "nearest first" is measured from here
 };
+
+/// @brief True if @p f lies inside @p area and at least @p gap_m clear of every footprint of
+/// @p others. False for a non-finite or negative footprint.
+[[nodiscard]] bool fits_in_area(const TableArea& area, const Footprint& f,
+                                std::span<const Footprint> others, double gap_m) noexcept;
 
 struct ServeOptions {
   std::vector<std::string> categories;                   ///< what to bring, in this order

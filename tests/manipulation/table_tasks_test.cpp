@@ -1,5 +1,7 @@
 // clear_table and serve_a_meal as plans (manipulation/table_tasks.hpp): who moves, in which order,
 // to which spot, and why everything else stays.
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 #include "manipulation/table_tasks.hpp"
@@ -23,40 +25,102 @@ StayReason stay_of(const TaskPlan& plan, std::uint32_t track) {
   return StayReason::UNKNOWN;
 }
 
-TEST(ClearTable, NearestFirstToFreeSpotsAndEveryStayHasItsReason) {
+// Every move's footprint lies in the area, clear by the gap of everything that stays there and of
+// every other move's.
+void expect_every_place_fits(const TaskPlan& plan, const ClearTableOptions& options) {
+  for (std::size_t i = 0; i < plan.moves.size(); ++i) {
+    std::vector<Footprint> others = plan.occupied;
+    for (std::size_t k = 0; k < plan.moves.size(); ++k)
+      if (k != i) others.push_back({plan.moves[k].place, plan.moves[k].radius_m});
+    EXPECT_TRUE(fits_in_area(options.area, {plan.moves[i].place, plan.moves[i].radius_m}, others,
+                             options.gap_m))
+        << "move " << i << " at " << plan.moves[i].place.transpose();
+  }
+}
+
+TEST(ClearTable, NearestFirstToFreePlacesAndEveryStayHasItsReason) {
   const std::vector<TableObject> objects{
-      {1, "mug", Vector3d(0.30, -0.30, 0.05)},    // 0.42 m from the base
-      {2, "bottle", Vector3d(0.50, 0.10, 0.10)},  // 0.51 m
-      {3, "plate", Vector3d(0.20, -0.10, 0.01)},  // a table item
-      {4, "", Vector3d(0.25, 0.00, 0.04)},        // Unknown
-      {5, "bowl", Vector3d(-0.42, -0.52, 0.03)},  // already in the area, on its first spot
-      {6, "cup", Vector3d(0.10, 0.05, 0.05)},     // 0.11 m: first
+      {1, "mug", Vector3d(0.30, -0.30, 0.05), 0.05},    // 0.42 m from the base
+      {2, "bottle", Vector3d(0.50, 0.10, 0.10), 0.04},  // 0.51 m
+      {3, "plate", Vector3d(0.20, -0.10, 0.01), 0.12},  // a table item
+      {4, "", Vector3d(0.25, 0.00, 0.04), 0.04},        // Unknown
+      {5, "bowl", Vector3d(-0.42, -0.52, 0.03), 0.06},  // already in the area, in its corner
+      {6, "cup", Vector3d(0.10, 0.05, 0.05), 0.04},     // 0.11 m: first
   };
   ClearTableOptions options;
-  options.area = {Vector2d(-0.5, -0.6), Vector2d(-0.2, -0.3)};  // 2 x 2 spots of 0.15 m
+  options.area = {Vector2d(-0.5, -0.6), Vector2d(-0.2, -0.3)};
   options.table_items = {"plate"};
   const TaskPlan plan = plan_clear_table(objects, options);
   EXPECT_EQ(tracks(plan), (std::vector<std::uint32_t>{6, 1, 2}));
   ASSERT_EQ(plan.moves.size(), 3U);
-  EXPECT_TRUE(plan.moves[0].place.isApprox(Vector2d(-0.275, -0.525))) << "the bowl holds spot 1";
-  EXPECT_TRUE(plan.moves[1].place.isApprox(Vector2d(-0.425, -0.375)));
-  EXPECT_TRUE(plan.moves[2].place.isApprox(Vector2d(-0.275, -0.375)));
+  // The cup: the first row that fits it is 4 cm in (its radius); along it, the first place 15 cm
+  // (0.06 + 0.04 + the 5 cm gap) from the bowl's centre: dx >= sqrt(0.15^2 - 0.04^2) = 0.1446.
+  EXPECT_NEAR(plan.moves[0].place.x(), -0.27, 1e-9);
+  EXPECT_NEAR(plan.moves[0].place.y(), -0.56, 1e-9);
+  EXPECT_DOUBLE_EQ(plan.moves[1].radius_m, 0.05) << "a move carries the footprint it was placed by";
+  ASSERT_EQ(plan.occupied.size(), 1U);
+  EXPECT_TRUE(plan.occupied[0].centre.isApprox(Vector2d(-0.42, -0.52)));
+  expect_every_place_fits(plan, options);
   EXPECT_EQ(stay_of(plan, 3), StayReason::TABLE_ITEM);
   EXPECT_EQ(stay_of(plan, 4), StayReason::UNKNOWN);
   EXPECT_EQ(stay_of(plan, 5), StayReason::IN_PLACE);
   EXPECT_EQ(plan.stays.size(), 3U);
 }
 
-TEST(ClearTable, AFullAreaLeavesTheRestWithNoRoom) {
-  const std::vector<TableObject> objects{{1, "mug", Vector3d(0.3, 0, 0)},
-                                         {2, "mug", Vector3d(0.3, 0, 0)}};  // a tie: track order
+TEST(ClearTable, PlacesAreSizedByEachFootprintNotOneGridForAll) {
+  // The demo's area (0.36 x 0.35 m). A 0.15 m grid had four spots for anything; cans (3.3 cm) pack
+  // nine, in rows that interleave.
   ClearTableOptions options;
-  options.area = {Vector2d(-0.5, -0.5), Vector2d(-0.35, -0.35)};  // one spot
+  options.area = {Vector2d(0.20, -0.50), Vector2d(0.56, -0.15)};
+  std::vector<TableObject> cans;
+  for (std::uint32_t k = 0; k < 12; ++k)
+    cans.push_back({k, "can", Vector3d(-0.3, 0.1 + 0.01 * k, 0.06), 0.033});
+  const TaskPlan plan = plan_clear_table(cans, options);
+  EXPECT_EQ(plan.moves.size(), 9U);
+  EXPECT_EQ(plan.stays.size(), 3U);
+  for (const TaskStay& s : plan.stays) EXPECT_EQ(s.reason, StayReason::NO_ROOM);
+  expect_every_place_fits(plan, options);
+  // Two flasks (7 cm) and three bottles (4.5 cm) fit too: five objects, where the grid had four.
+  const std::vector<TableObject> mixed{{1, "flask", Vector3d(0.1, 0.3, 0.06), 0.07},
+                                       {2, "flask", Vector3d(0.1, 0.4, 0.06), 0.07},
+                                       {3, "bottle", Vector3d(0.1, 0.5, 0.06), 0.045},
+                                       {4, "bottle", Vector3d(0.1, 0.6, 0.06), 0.045},
+                                       {5, "bottle", Vector3d(0.1, 0.7, 0.06), 0.045}};
+  const TaskPlan five = plan_clear_table(mixed, options);
+  EXPECT_EQ(tracks(five), (std::vector<std::uint32_t>{1, 2, 3, 4, 5}));
+  expect_every_place_fits(five, options);
+}
+
+TEST(ClearTable, AFullAreaLeavesTheRestWithNoRoom) {
+  const std::vector<TableObject> objects{{1, "mug", Vector3d(0.3, 0, 0), 0.05},
+                                         {2, "mug", Vector3d(0.3, 0, 0), 0.05},   // a tie
+                                         {3, "tray", Vector3d(0.5, 0, 0), 0.2}};  // wider than it
+  ClearTableOptions options;
+  options.area = {Vector2d(-0.5, -0.5), Vector2d(-0.35, -0.35)};  // room for one mug
   const TaskPlan plan = plan_clear_table(objects, options);
   EXPECT_EQ(tracks(plan), (std::vector<std::uint32_t>{1}));
+  EXPECT_TRUE(plan.moves[0].place.isApprox(Vector2d(-0.45, -0.45)));
   EXPECT_EQ(stay_of(plan, 2), StayReason::NO_ROOM);
-  options.spacing_m = 0.0;
-  EXPECT_TRUE(plan_clear_table(objects, options).moves.empty()) << "no spacing: no spot";
+  EXPECT_EQ(stay_of(plan, 3), StayReason::NO_ROOM);
+  for (const double step : {0.0, -0.01, std::nan("")}) {
+    options.step_m = step;
+    EXPECT_TRUE(plan_clear_table(objects, options).moves.empty()) << "no grid: no place";
+  }
+  options.step_m = 1e-12;  // bounded: at most 1000 places along a side
+  EXPECT_EQ(tracks(plan_clear_table(objects, options)), (std::vector<std::uint32_t>{1}));
+}
+
+TEST(ClearTable, AFootprintFitsInsideTheAreaAndClearOfTheOthers) {
+  const TableArea area{Vector2d(0, 0), Vector2d(0.3, 0.2)};
+  const Footprint others[] = {{Vector2d(0.05, 0.05), 0.05}};
+  EXPECT_TRUE(fits_in_area(area, {Vector2d(0.25, 0.05), 0.05}, others, 0.1)) << "exactly";
+  EXPECT_FALSE(fits_in_area(area, {Vector2d(0.249, 0.05), 0.05}, others, 0.1));
+  EXPECT_FALSE(fits_in_area(area, {Vector2d(0.26, 0.05), 0.05}, {}, 0.1)) << "over the edge";
+  EXPECT_TRUE(fits_in_area(area, {Vector2d(0.3, 0.2), 0.0}, {}, 0.1)) << "a point on the corner";
+  EXPECT_FALSE(fits_in_area(area, {Vector2d(0.2, 0.1), -0.01}, {}, 0.1));
+  EXPECT_FALSE(fits_in_area(area, {Vector2d(std::nan(""), 0.1), 0.01}, {}, 0.1));
+  EXPECT_FALSE(fits_in_area(area, {Vector2d(0.2, 0.1), INFINITY}, {}, 0.1));
+  EXPECT_DOUBLE_EQ(footprint_radius(Vector3d(0.12, 0.08, 0.3)), 0.06);
 }
 
 TEST(ServeAMeal, TheNamedCategoriesInOrderToTheUsersPlace) {
