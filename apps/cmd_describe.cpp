@@ -18,6 +18,7 @@
 
 #include "apps/commands.hpp"
 #include "apps/json_numbers.hpp"
+#include "apps/spin_set_options.hpp"
 #include "formats/pcd_io.hpp"
 #include "kernels/descriptor_spec.hpp"
 #include "kernels/good.hpp"
@@ -35,6 +36,7 @@ struct DescribeOptions {
   std::string png;
   std::string representation = "good";
   std::string dictionary;
+  kernels::SpinSetParams spin{};  // --spin-*
 };
 
 struct Described {
@@ -171,14 +173,17 @@ bool write_png(const std::string& path, const Described& d, std::size_t n) {
 // The bag of words or topics of one view (docs/SPIN_IMAGES.md): the Describer under that
 // specification, as the graph, the memory and the evaluation describe it.
 void run_describe_local(const DescribeOptions& o, const kernels::PointCloud& cloud) {
-  auto words = learning::load_dictionary(o.dictionary);
-  if (!words) fail(words.error(), EXIT_BAD_INPUT);
-  auto dictionary = std::make_shared<const kernels::VisualDictionary>(std::move(words.value()));
-  // --dictionary without --representation: the bag of words.
   const auto kind =
       kernels::descriptor_kind(o.representation).value_or(kernels::DescriptorKind::BOW);
-  const kernels::DescriptorSpec spec = kernels::DescriptorSpec::over_dictionary(
-      kind == kernels::DescriptorKind::GOOD ? kernels::DescriptorKind::BOW : kind, dictionary);
+  kernels::DescriptorSpec spec = kernels::DescriptorSpec::make_spin_set(o.spin);
+  if (kind != kernels::DescriptorKind::SPIN_SET) {
+    auto words = learning::load_dictionary(o.dictionary);
+    if (!words) fail(words.error(), EXIT_BAD_INPUT);
+    auto dictionary = std::make_shared<const kernels::VisualDictionary>(std::move(words.value()));
+    // --dictionary without --representation: the bag of words.
+    spec = kernels::DescriptorSpec::over_dictionary(
+        kind == kernels::DescriptorKind::GOOD ? kernels::DescriptorKind::BOW : kind, dictionary);
+  }
   if (auto valid = spec.validate(); !valid) fail(valid.error(), EXIT_USAGE);
   kernels::Describer describer(spec);
   std::vector<float> values(spec.length());
@@ -204,8 +209,8 @@ void run_describe(const DescribeOptions& o) {
   auto cloud_result = formats::read_pcd(o.file);
   if (!cloud_result) { fail(cloud_result.error().to_string(), EXIT_BAD_INPUT); }
   if (o.representation != "good" || !o.dictionary.empty()) {
-    if (o.dictionary.empty())
-      fail("--representation bow or lda needs --dictionary FILE", EXIT_USAGE);
+    if (o.dictionary.empty() && o.representation != "spin")
+      fail("--representation bow, lda or local-lda needs --dictionary FILE", EXIT_USAGE);
     if (!o.png.empty()) fail("--png draws GOOD's projections only", EXIT_USAGE);
     run_describe_local(o, *cloud_result);
     return;
@@ -257,10 +262,12 @@ void add_describe_command(CLI::App& app) {
                 "print one JSON object: descriptor, frame, bbox, order, points_used, flags");
   cmd->add_option("--png", o->png,
                   "draw the three projections with the frame axes into this PNG file");
-  cmd->add_option("--representation", o->representation,
-                  "good, bow (the view's words), lda (its topics) or local-lda (its word counts); "
-                  "all but good need --dictionary")
-      ->check(CLI::IsMember({"good", "bow", "lda", "local-lda"}));
+  cmd->add_option(
+         "--representation", o->representation,
+         "good, spin (the set of its spin images), bow (the view's words), lda (its "
+         "topics) or local-lda (its word counts); bow, lda and local-lda need --dictionary")
+      ->check(CLI::IsMember({"good", "spin", "bow", "lda", "local-lda"}));
+  add_spin_set_options(cmd, o->spin);
   cmd->add_option("--dictionary", o->dictionary,
                   "the visual words (`orthoflow dictionary build`); implies bow unless lda");
   cmd->callback([o] { run_describe(*o); });

@@ -1,7 +1,8 @@
 // `orthoflow evaluate --dataset DIR --protocol cv10|teacher|teacher-context|noise|downsample
 // [--learner instance,bayes] [--approach nn,1,2]
-// [--representation good,bow,lda,local-lda --dictionary FILE [--local-topics K]
-// [--local-lda-bayes likelihood|histogram]]
+// [--representation good,spin,bow,lda,local-lda [--spin-keypoints N --spin-width IW
+// --spin-support SL --spin-leaf VS] --dictionary FILE
+// [--local-topics K] [--local-lda-bayes likelihood|histogram]]
 // [--good-mode invariant,reference] [--bins 5,15] [--runs R]
 // [--seed S] [--folds K] [--levels MM,...] [--tau T] [--breakpoint N] [--threads N] [--out DIR]
 // [--cache DIR | --no-cache]`: the thesis's evaluations (evaluation/, docs/EVALUATION.md). Comma
@@ -15,6 +16,7 @@
 #include <vector>
 
 #include "apps/commands.hpp"
+#include "apps/spin_set_options.hpp"
 #include "evaluation/progress.hpp"
 #include "evaluation/report.hpp"
 #include "learning/dictionary.hpp"
@@ -32,6 +34,7 @@ struct EvaluateOptions {
   std::vector<std::string> representations{"good"};
   std::string dictionary;
   std::size_t local_topics = 30;
+  kernels::SpinSetParams spin{};  // --spin-*
   std::string local_bayes = "likelihood";
   std::vector<double> levels_mm;
   std::size_t runs = 10;
@@ -74,12 +77,13 @@ std::vector<evaluation::Variant> variants_of(
                   : a == "2" ? evaluation::InstanceRule::APPROACH_2
                              : evaluation::InstanceRule::NEAREST;
       for (const std::string& r : o.representations) {
-        if (r == "good") continue;
+        if (r == "good" || (bayes && r == "spin")) continue;  // naive Bayes has no form over sets
         evaluation::Variant v = base;
         v.representation = kernels::descriptor_kind(r).value_or(kernels::DescriptorKind::BOW);
         v.dictionary = dictionary;
         v.local_topics.topics = o.local_topics;
         v.topic_histogram_bayes = o.local_bayes == "histogram";
+        v.spin_set = o.spin;
         out.push_back(v);
       }
       const bool good = std::find(o.representations.begin(), o.representations.end(), "good") !=
@@ -124,7 +128,7 @@ void run_evaluate(const EvaluateOptions& o) {
   if (!dataset) { fail(dataset.error().to_string(), EXIT_BAD_INPUT); }
   std::shared_ptr<const kernels::VisualDictionary> dictionary;
   const bool bow = std::any_of(o.representations.begin(), o.representations.end(),
-                               [](const std::string& r) { return r != "good"; });
+                               [](const std::string& r) { return r != "good" && r != "spin"; });
   if (bow && o.dictionary.empty()) {
     fail(
         "--representation bow, lda or local-lda needs --dictionary FILE (orthoflow dictionary "
@@ -139,6 +143,10 @@ void run_evaluate(const EvaluateOptions& o) {
   evaluation::EvalOptions eo;
   eo.protocol = protocol_of(o.protocol);
   eo.variants = variants_of(o, dictionary);
+  if (eo.variants.empty())
+    fail(
+        "no variant to evaluate: naive Bayes has no form over spin-image sets (--learner instance)",
+        EXIT_USAGE);
   eo.runs = o.runs;
   eo.seed = o.seed;
   eo.folds = o.folds;
@@ -192,10 +200,12 @@ void add_evaluate_command(CLI::App& app) {
       ->delimiter(',')
       ->check(CLI::IsMember({"nn", "1", "2"}));
   cmd->add_option("--representation", o->representations,
-                  "good, bow, lda and/or local-lda (comma list; bow: a bag of words over "
-                  "--dictionary's words; lda: its topics; local-lda: topics learned per category)")
+                  "good, spin, bow, lda and/or local-lda (comma list; spin: the set of a view's "
+                  "spin images, instance learner only; bow: a bag of words over --dictionary's "
+                  "words; lda: its topics; local-lda: topics learned per category)")
       ->delimiter(',')
-      ->check(CLI::IsMember({"good", "bow", "lda", "local-lda"}));
+      ->check(CLI::IsMember({"good", "spin", "bow", "lda", "local-lda"}));
+  add_spin_set_options(cmd, o->spin);
   cmd->add_option("--local-topics", o->local_topics,
                   "local-lda: topics per category (the thesis: 30)")
       ->check(CLI::Range(1, static_cast<int>(kernels::MAX_LOCAL_TOPICS)));

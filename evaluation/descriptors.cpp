@@ -123,7 +123,13 @@ std::string ViewDescription::key() const {
   // "bow-<dictionary id>-none": a dictionary's words and parameters are all in its id.
   const kernels::GoodConfig& good = descriptor.good;
   std::string k = std::string(kernels::to_string(descriptor.kind)) + "-";
-  if (descriptor.local() && descriptor.dictionary) {
+  if (descriptor.kind == kernels::DescriptorKind::SPIN_SET) {
+    // "spin-<fnv of its specification>-none": every parameter is in describe().
+    char id[17];
+    std::snprintf(id, sizeof id, "%016llx",
+                  static_cast<unsigned long long>(fnv1a(descriptor.describe())));
+    k += std::string(id) + "-" + perturbation_name(perturbation);
+  } else if (descriptor.local() && descriptor.dictionary) {
     k += kernels::dictionary_id_hex(descriptor.dictionary->id) + "-" +
          perturbation_name(perturbation);
   } else {

@@ -26,6 +26,9 @@ std::string Variant::name() const {
     return n + "/local-lda/" + std::to_string(local_topics.topics) + "x" +
            std::to_string(dictionary ? dictionary->words : 0);
   }
+  if (representation == kernels::DescriptorKind::SPIN_SET) {
+    return n + "/spin/" + std::to_string(spin_set.max_keypoints);
+  }
   n += mode == kernels::GoodMode::INVARIANT ? "/invariant/" : "/reference/";
   return n + std::to_string(bins);
 }
@@ -39,6 +42,9 @@ kernels::DescriptorSpec Variant::spec() const {
   }
   if (representation == kernels::DescriptorKind::LOCAL_LDA) {
     return kernels::DescriptorSpec::make_local_lda(dictionary, local_topics);
+  }
+  if (representation == kernels::DescriptorKind::SPIN_SET) {
+    return kernels::DescriptorSpec::make_spin_set(spin_set);
   }
   return kernels::DescriptorSpec::make_good(bins, mode);
 }

@@ -32,10 +32,12 @@ struct Variant {
   /// LOCAL_LDA with the Bayes learner: naive Bayes over topic histograms instead of the topic
   /// models' likelihood (learning/local_lda_learner.hpp).
   bool topic_histogram_bayes = false;
+  /// SPIN_SET: the spin images' parameters and the most a view keeps (the instance learner only).
+  kernels::SpinSetParams spin_set{};
   /// @brief The descriptor specification of this variant.
   [[nodiscard]] kernels::DescriptorSpec spec() const;
   /// @brief "instance-nn/invariant/15", "bayes/reference/5", "instance-nn/bow/70", "bayes/lda/30",
-  /// "bayes/local-lda/30x90", ...
+  /// "bayes/local-lda/30x90", "instance-nocd1/spin/128", ...
   [[nodiscard]] std::string name() const;
   /// @brief The descriptor parameters of this variant with perturbation @p p of @p amount_m.
   [[nodiscard]] ViewDescription descriptor(Perturbation p = Perturbation::NONE,

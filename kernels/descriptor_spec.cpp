@@ -16,13 +16,15 @@ std::string_view to_string(DescriptorKind kind) noexcept {
       return "lda";
     case DescriptorKind::LOCAL_LDA:
       return "local-lda";
+    case DescriptorKind::SPIN_SET:
+      return "spin";
   }
   return "unknown";
 }
 
 std::optional<DescriptorKind> descriptor_kind(std::string_view name) noexcept {
-  for (const DescriptorKind k :
-       {DescriptorKind::GOOD, DescriptorKind::BOW, DescriptorKind::LDA, DescriptorKind::LOCAL_LDA})
+  for (const DescriptorKind k : {DescriptorKind::GOOD, DescriptorKind::BOW, DescriptorKind::LDA,
+                                 DescriptorKind::LOCAL_LDA, DescriptorKind::SPIN_SET})
     if (to_string(k) == name) return k;
   return std::nullopt;
 }
@@ -59,7 +61,15 @@ DescriptorSpec DescriptorSpec::make_local_lda(std::shared_ptr<const VisualDictio
   return s;
 }
 
+DescriptorSpec DescriptorSpec::make_spin_set(const SpinSetParams& params) noexcept {
+  DescriptorSpec s;
+  s.kind = DescriptorKind::SPIN_SET;
+  s.spin_set = params;
+  return s;
+}
+
 std::size_t DescriptorSpec::length() const noexcept {
+  if (kind == DescriptorKind::SPIN_SET) return spin_set.length();
   if (kind == DescriptorKind::BOW || kind == DescriptorKind::LOCAL_LDA)
     return dictionary ? dictionary->words : 0;
   if (kind == DescriptorKind::LDA)
@@ -67,7 +77,7 @@ std::size_t DescriptorSpec::length() const noexcept {
   return 3 * good.bins * good.bins;
 }
 
-bool DescriptorSpec::histogram() const noexcept { return true; }
+bool DescriptorSpec::histogram() const noexcept { return kind != DescriptorKind::SPIN_SET; }
 
 Result<void, std::string> DescriptorSpec::validate() const {
   if (good.bins == 0 || good.bins > GOOD_MAX_BINS) {
@@ -76,6 +86,12 @@ Result<void, std::string> DescriptorSpec::validate() const {
   const float t = good.effective_threshold();
   if (!std::isfinite(t) || t < 0.0F)
     return err("descriptor " + describe() + ": the threshold must be finite and >= 0");
+  if (kind == DescriptorKind::SPIN_SET && !spin_set.valid())
+    return err("descriptor " + describe() + ": spin images of width 1.." +
+               std::to_string(MAX_SPIN_IMAGE_WIDTH) +
+               ", support length, keypoint leaf and normal radius finite and > 0, the support " +
+               "angle's cosine in [0, 1], and 1.." + std::to_string(MAX_SET_KEYPOINTS) +
+               " keypoints");
   if (local()) {
     if (!dictionary) return err(std::string(to_string(kind)) + " descriptor: no dictionary");
     const VisualDictionary& d = *dictionary;
@@ -125,6 +141,15 @@ std::string DescriptorSpec::describe() const {
                   static_cast<double>(d.normal_radius), dictionary_id_hex(d.id).c_str());
     return text;
   }
+  if (kind == DescriptorKind::SPIN_SET) {
+    const SpinFeatureParams& f = spin_set.features;
+    std::snprintf(text, sizeof text, "spin keypoints=%u iw=%u sl=%g sa=%g vs=%g nr=%g",
+                  spin_set.max_keypoints, f.spin.image_width,
+                  static_cast<double>(f.spin.support_length),
+                  static_cast<double>(f.spin.support_angle_cos),
+                  static_cast<double>(f.keypoint_leaf), static_cast<double>(f.normal_radius));
+    return text;
+  }
   std::snprintf(text, sizeof text, "%g", static_cast<double>(good.effective_threshold()));
   return std::string(to_string(kind)) + " bins=" + std::to_string(good.bins) +
          " mode=" + (good.mode == GoodMode::INVARIANT ? "invariant" : "reference") +
@@ -135,6 +160,7 @@ bool DescriptorSpec::operator==(const DescriptorSpec& other) const noexcept {
   const bool same_good = good.bins == other.good.bins && good.mode == other.good.mode &&
                          good.effective_threshold() == other.good.effective_threshold();
   if (kind != other.kind || !same_good) return false;
+  if (kind == DescriptorKind::SPIN_SET) return spin_set == other.spin_set;
   if (local()) {
     if (!dictionary || !other.dictionary) return dictionary == other.dictionary;
     return dictionary->id == other.dictionary->id && dictionary->words == other.dictionary->words &&
@@ -144,6 +170,8 @@ bool DescriptorSpec::operator==(const DescriptorSpec& other) const noexcept {
 }
 
 void WordScratch::reserve(const DescriptorSpec& spec, std::size_t max_points) {
+  if (spec.kind == DescriptorKind::SPIN_SET && spec.spin_set.valid())
+    features.reserve(max_points, spec.spin_set.features.spin.image_width);
   if (!spec.local() || !spec.dictionary) return;
   const VisualDictionary& d = *spec.dictionary;
   features.reserve(max_points, d.spin.image_width);
@@ -154,6 +182,8 @@ void WordScratch::reserve(const DescriptorSpec& spec, std::size_t max_points) {
 }
 
 Describer::Describer(const DescriptorSpec& spec) : spec_(spec), good_scratch_(spec.good.bins) {
+  if (spec_.kind == DescriptorKind::SPIN_SET)
+    good_values_.resize(3 * spec_.good.bins * spec_.good.bins);
   if (spec_.local() && spec_.dictionary) {
     good_values_.resize(3 * spec_.good.bins * spec_.good.bins);
     word_scratch_.resize(spec_.dictionary->words);
@@ -162,8 +192,11 @@ Describer::Describer(const DescriptorSpec& spec) : spec_(spec), good_scratch_(sp
 
 Result<void, GoodError> Describer::describe_words(PointsView points, std::span<float> out,
                                                   WordScratch& scratch) {
-  const VisualDictionary& d = *spec_.dictionary;
-  const SpinFeatureParams params{d.spin, d.keypoint_leaf, d.normal_radius};
+  const bool set = spec_.kind == DescriptorKind::SPIN_SET;
+  const SpinFeatureParams params =
+      set ? spec_.spin_set.features
+          : SpinFeatureParams{spec_.dictionary->spin, spec_.dictionary->keypoint_leaf,
+                              spec_.dictionary->normal_radius};
   auto computed = scratch.features.compute(points, params);
   if (!computed) {
     switch (computed.error()) {
@@ -176,6 +209,13 @@ Result<void, GoodError> Describer::describe_words(PointsView points, std::span<f
     }
   }
   const std::span<const float> images = scratch.features.images();
+  if (set) {
+    features_ = write_spin_set(images, spec_.spin_set.image_values(), spec_.spin_set.max_keypoints,
+                               out.first(spec_.length()));
+    if (features_ == 0) return err(GoodError::NO_FEATURES);
+    return {};
+  }
+  const VisualDictionary& d = *spec_.dictionary;
   if (spec_.kind == DescriptorKind::BOW || spec_.kind == DescriptorKind::LOCAL_LDA) {
     features_ = spec_.kind == DescriptorKind::BOW
                     ? bag_of_words(images, d.view(), word_scratch_, out)
@@ -209,12 +249,13 @@ Result<DescriptorInfo, GoodError> Describer::describe(PointsView points,
 Result<DescriptorInfo, GoodError> Describer::describe(PointsView points, std::span<float> out,
                                                       WordScratch& scratch) noexcept {
   features_ = 0;
-  if (!spec_.local()) {
+  if (!spec_.spin_features()) {
     auto good = compute_good(points, spec_.good, good_scratch_, out);
     if (!good) return err(good.error());
     return DescriptorInfo{good->length, good->frame, good->bbox, good->flags};
   }
-  if (!spec_.dictionary || out.size() < spec_.length()) return err(GoodError::OUTPUT_TOO_SMALL);
+  if ((spec_.local() && !spec_.dictionary) || out.size() < spec_.length())
+    return err(GoodError::OUTPUT_TOO_SMALL);
   // The frame and box come from GOOD (the grasp planner needs them whatever the representation).
   auto good = compute_good(points, spec_.good, good_scratch_, good_values_);
   if (!good) return err(good.error());

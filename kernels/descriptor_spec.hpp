@@ -19,6 +19,7 @@
 #include "core/result.hpp"
 #include "kernels/good.hpp"
 #include "kernels/spin_features.hpp"
+#include "kernels/spin_set.hpp"
 #include "kernels/visual_words.hpp"
 
 namespace orthoflow::kernels {
@@ -29,8 +30,9 @@ enum class DescriptorKind : std::uint8_t {
   BOW,   ///< bag of words: the shares of a view's spin images nearest each word of a dictionary
   LDA,   ///< topic histogram: theta of the view's words under the dictionary's topic model
   LOCAL_LDA,  ///< the view's word counts; the learner describes them in each category's topics
+  SPIN_SET,   ///< the view's spin images as a set (kernels/spin_set.hpp), compared by D(U, V)
 };
-/// @brief "good", "bow", "lda" or "local-lda".
+/// @brief "good", "bow", "lda", "local-lda" or "spin".
 [[nodiscard]] std::string_view to_string(DescriptorKind kind) noexcept;
 /// @brief The kind to_string() names @p name, or std::nullopt.
 [[nodiscard]] std::optional<DescriptorKind> descriptor_kind(std::string_view name) noexcept;
@@ -45,6 +47,8 @@ struct DescriptorSpec {
   std::shared_ptr<const VisualDictionary> dictionary;
   /// Kind LOCAL_LDA: the topics every category learns (the learner's, not the describer's).
   LocalTopics local_topics{};
+  /// Kind SPIN_SET: the spin images' parameters and the most images a set keeps.
+  SpinSetParams spin_set{};
 
   /// @brief A GOOD specification.
   [[nodiscard]] static DescriptorSpec make_good(std::size_t bins,
@@ -62,13 +66,22 @@ struct DescriptorSpec {
   /// @brief Word counts over @p dictionary, for Local LDA with @p topics per category.
   [[nodiscard]] static DescriptorSpec make_local_lda(
       std::shared_ptr<const VisualDictionary> dictionary, const LocalTopics& topics = {}) noexcept;
+  /// @brief A set of spin images (the thesis's instance-based approaches I and II).
+  [[nodiscard]] static DescriptorSpec make_spin_set(const SpinSetParams& params = {}) noexcept;
   /// @brief BOW, LDA or LOCAL_LDA: described through a dictionary's words.
-  [[nodiscard]] bool local() const noexcept { return kind != DescriptorKind::GOOD; }
+  [[nodiscard]] bool local() const noexcept {
+    return kind == DescriptorKind::BOW || kind == DescriptorKind::LDA ||
+           kind == DescriptorKind::LOCAL_LDA;
+  }
+  /// @brief Described from spin features: the local kinds and SPIN_SET.
+  [[nodiscard]] bool spin_features() const noexcept {
+    return local() || kind == DescriptorKind::SPIN_SET;
+  }
   /// @brief Values per descriptor (GOOD: 3 n^2; BOW and LOCAL_LDA: the dictionary's words; LDA:
-  /// its topics).
+  /// its topics; SPIN_SET: spin_set.length()).
   [[nodiscard]] std::size_t length() const noexcept;
-  /// @brief Every value is non-negative: a histogram share, or a word count (LOCAL_LDA), what a
-  /// naive Bayes learner needs.
+  /// @brief Every value is a non-negative share or count, what a naive Bayes learner needs: every
+  /// kind but SPIN_SET.
   [[nodiscard]] bool histogram() const noexcept;
   /// @brief Checks the parameters (bins in 1..GOOD_MAX_BINS, a finite non-negative threshold; BOW:
   /// a dictionary with words whose length fits its spin images, finite positive leaf and radius).

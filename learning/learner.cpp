@@ -32,6 +32,9 @@ const char* to_string(LearnError error) noexcept {
       return "two restored categories share an id or a label";
     case LearnError::NOT_LAST_VIEWS:
       return "those views are not the category's last views";
+    case LearnError::NOT_A_SPIN_SET:
+      return "not a set of spin images: the count is not a whole number from 1 to the set's "
+             "capacity, or a value after the last image is not zero";
     case LearnError::NOT_WORD_COUNTS:
       return "not a view's word counts: a value is not a whole number, or the view has no word or "
              "more words than the learner takes";

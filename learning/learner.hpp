@@ -61,6 +61,7 @@ enum class LearnError : std::uint8_t {
   UNKNOWN_LABEL,    ///< forget() of a label that was never taught
   DUPLICATE_ID,     ///< restore() got two categories with one id or one label
   NOT_LAST_VIEWS,   ///< retract(): the views are not the category's last ones (or more than it has)
+  NOT_A_SPIN_SET,   ///< SpinSetLearner: not a set descriptor (kernels/spin_set.hpp)
   NOT_WORD_COUNTS,  ///< LocalLdaLearner: a value is not a whole number, or a view has no word or
                     ///< more than max_words
 };
@@ -100,6 +101,10 @@ class AskScratch {
   static constexpr std::size_t DEFAULT_CHUNK = 1024;
   explicit AskScratch(std::size_t chunk = DEFAULT_CHUNK) : distances_(chunk == 0 ? 1 : chunk) {}
   [[nodiscard]] std::span<float> distances() noexcept { return distances_; }
+  /// @brief Grows the chunk to at least @p n distances (Learner::prepare(); allocates).
+  void reserve_distances(std::size_t n) {
+    if (distances_.size() < n) distances_.resize(n);
+  }
   /// @brief Hazard-slot hint (learning/snapshot_cell.hpp): the slot this thread used last.
   std::size_t slot_hint = 0;
   /// @brief LocalLdaLearner: a target's words, its topics in one category and the temporary copy

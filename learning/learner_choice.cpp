@@ -1,6 +1,7 @@
 #include "learning/learner_choice.hpp"
 
 #include "learning/local_lda_learner.hpp"
+#include "learning/spin_set_learner.hpp"
 
 namespace orthoflow::learning {
 
@@ -29,6 +30,16 @@ std::unique_ptr<Learner> make_learner(const kernels::DescriptorSpec& spec, Learn
     cfg.min_icd = instance.min_icd;
     cfg.count_scale = bayes.count_scale;
     return std::make_unique<LocalLdaLearner>(cfg);
+  }
+  if (spec.kind == kernels::DescriptorKind::SPIN_SET) {  // instance-based whatever @p kind says
+    SpinSetConfig cfg;
+    cfg.set = spec.spin_set;
+    cfg.approach = instance.approach;
+    cfg.normalise = instance.normalise;
+    cfg.classification_threshold = instance.classification_threshold;
+    cfg.default_icd = instance.default_icd;
+    cfg.min_icd = instance.min_icd;
+    return std::make_unique<SpinSetLearner>(cfg);
   }
   if (kind == LearnerKind::BAYES) {
     bayes.descriptor_length = length;

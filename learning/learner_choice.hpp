@@ -19,9 +19,10 @@ enum class LearnerKind : std::uint8_t { INSTANCE, BAYES };
 /// @brief A fresh learner for descriptors of @p spec: for LOCAL_LDA word counts a LocalLdaLearner
 /// (BAYES: the topic models' likelihood, or naive Bayes over topic histograms when @p
 /// topic_histogram_bayes; INSTANCE: @p instance's rule, plain nearest, NOCD approach I or II, its
-/// CT and ICDs), otherwise an InstanceLearner (chi-squared for LDA topic histograms, PIPELINE.md
-/// section 7; L2 otherwise) or a BayesLearner. The configurations'
-/// descriptor_length is set from the specification. @pre spec.validate() succeeded.
+/// CT and ICDs); for SPIN_SET sets a SpinSetLearner with @p instance's rule, CT and ICDs (naive
+/// Bayes has no form over sets: @p kind is not used); otherwise an InstanceLearner (chi-squared for
+/// LDA topic histograms, PIPELINE.md section 7; L2 otherwise) or a BayesLearner. The
+/// configurations' descriptor_length is set from the specification. @pre spec.validate() succeeded.
 [[nodiscard]] std::unique_ptr<Learner> make_learner(const kernels::DescriptorSpec& spec,
                                                     LearnerKind kind, InstanceConfig instance,
                                                     BayesConfig bayes,

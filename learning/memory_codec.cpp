@@ -225,6 +225,10 @@ std::optional<kernels::DescriptorSpec> decode_schema(std::string_view json, std:
         "descriptor \"" + kind_name + "\" is not one this build knows (good, bow, lda, local-lda)";
     return std::nullopt;
   }
+  if (named == kernels::DescriptorKind::SPIN_SET) {
+    why = "descriptor \"spin\": a store of spin-image sets is not one this build writes";
+    return std::nullopt;
+  }
   std::optional<kernels::VisualDictionary> dictionary;
   const bool local_lda = named == kernels::DescriptorKind::LOCAL_LDA;
   if (named != kernels::DescriptorKind::GOOD && !(dictionary = schema_dictionary(j, why)))

@@ -2,7 +2,10 @@
 // the instance-based (plain nearest neighbour) and naive Bayes learners on GOOD (675 values), the
 // bag of words (90 words) and LDA topics (30), and Local LDA on 90 words' counts with 30 topics per
 // category (nearest view in chi-squared, and the topic models' likelihood). A view has 330 words,
-// the spin images of a real bowl view (bench/RESULTS.md "bag of words").
+// the spin images of a real bowl view (bench/RESULTS.md "bag of words"). Sets of spin images
+// (approach I, D(T, O) to every view): 121 images of width 4 (45 values; the mean of synth26's
+// views at VS 1 cm) and 40 of width 8 (153 values; a mug at the thesis's approach II VS 4 cm, SL 10
+// cm).
 #include <benchmark/benchmark.h>
 
 #include <memory>
@@ -51,8 +54,24 @@ std::vector<float> view(std::size_t length, std::size_t c, std::mt19937& rng, bo
   return v;
 }
 
-void BM_ask(benchmark::State& state, ok::DescriptorSpec spec, ol::LearnerKind kind) {
+// A set of @p images spin images around category @p c's own pattern.
+std::vector<float> set_view(const ok::SpinSetParams& p, std::size_t images, std::size_t c,
+                            std::mt19937& rng) {
+  std::vector<float> v(p.length(), 0.0F);
+  std::uniform_real_distribution<float> u(0.0F, 1.0F);
+  v[0] = static_cast<float>(images);
+  for (std::size_t i = 0; i < images * p.image_values(); ++i)
+    v[1 + i] = 0.5F * u(rng) + (((i + c) % 7) == 0 ? 0.5F : 0.0F);
+  return v;
+}
+
+void BM_ask(benchmark::State& state, ok::DescriptorSpec spec, ol::LearnerKind kind,
+            std::size_t set_images = 0) {
   const bool counts = spec.kind == ok::DescriptorKind::LOCAL_LDA;
+  const auto make = [&](std::size_t c, std::mt19937& rng) {
+    return set_images > 0 ? set_view(spec.spin_set, set_images, c, rng)
+                          : view(spec.length(), c, rng, counts);
+  };
   ol::InstanceConfig instance;
   instance.normalise = false;
   auto learner = ol::make_learner(spec, kind, instance, ol::BayesConfig{});
@@ -62,7 +81,7 @@ void BM_ask(benchmark::State& state, ok::DescriptorSpec spec, ol::LearnerKind ki
   for (std::size_t c = 0; c < categories; ++c) {
     std::vector<float> batch;
     for (std::size_t v = 0; v < VIEWS_PER_CATEGORY; ++v) {
-      const auto x = view(length, c, rng, counts);
+      const auto x = make(c, rng);
       batch.insert(batch.end(), x.begin(), x.end());
     }
     if (!learner->teach("c" + std::to_string(c), ol::DescriptorBatch{batch, length})) {
@@ -72,7 +91,7 @@ void BM_ask(benchmark::State& state, ok::DescriptorSpec spec, ol::LearnerKind ki
   }
   ol::AskScratch scratch;
   learner->prepare(scratch);
-  const auto query = view(length, 3, rng, counts);
+  const auto query = make(3, rng);
   for (auto _ : state) {
     const ol::Prediction p = learner->ask(query, scratch);
     benchmark::DoNotOptimize(p.score);
@@ -84,6 +103,14 @@ ok::DescriptorSpec good() { return ok::DescriptorSpec::make_good(15); }
 ok::DescriptorSpec bow() { return ok::DescriptorSpec::make_bow(dictionary()); }
 ok::DescriptorSpec lda() { return ok::DescriptorSpec::make_lda(dictionary()); }
 ok::DescriptorSpec local_lda() { return ok::DescriptorSpec::make_local_lda(dictionary()); }
+ok::DescriptorSpec spin_vs1() { return ok::DescriptorSpec::make_spin_set(); }
+ok::DescriptorSpec spin_vs4() {
+  ok::SpinSetParams p;
+  p.features.spin.image_width = 8;
+  p.features.spin.support_length = 0.10F;
+  p.features.keypoint_leaf = 0.04F;
+  return ok::DescriptorSpec::make_spin_set(p);
+}
 
 }  // namespace
 
@@ -102,5 +129,15 @@ ORTHOFLOW_ASK_BENCH(instance_lda, lda, INSTANCE);
 ORTHOFLOW_ASK_BENCH(bayes_lda, lda, BAYES);
 ORTHOFLOW_ASK_BENCH(instance_local_lda, local_lda, INSTANCE);
 ORTHOFLOW_ASK_BENCH(likelihood_local_lda, local_lda, BAYES);
+BENCHMARK_CAPTURE(BM_ask, instance_spin_set_121x45, spin_vs1(), ol::LearnerKind::INSTANCE, 121)
+    ->Arg(10)
+    ->Arg(100)
+    ->Arg(1000)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_ask, instance_spin_set_40x153, spin_vs4(), ol::LearnerKind::INSTANCE, 40)
+    ->Arg(10)
+    ->Arg(100)
+    ->Arg(1000)
+    ->Unit(benchmark::kMillisecond);
 
 BENCHMARK_MAIN();

@@ -11,6 +11,7 @@
 #include "learning/bayes_learner.hpp"
 #include "learning/instance_learner.hpp"
 #include "learning/local_lda_learner.hpp"
+#include "learning/spin_set_learner.hpp"
 
 #include "tests/support/counting_new.hpp"  // the one TU of this binary that replaces operator new
 
@@ -42,7 +43,8 @@ std::uint64_t allocations_during_asks(Learner& learner, MakeView make, std::size
       const auto h = make(k + v * 31);
       views.insert(views.end(), h.begin(), h.end());
     }
-    EXPECT_TRUE(learner.teach("c" + std::to_string(k), DescriptorBatch{views, LENGTH}));
+    EXPECT_TRUE(learner.teach("c" + std::to_string(k),
+                              DescriptorBatch{views, views.size() / per_category}));
   }
   AskScratch scratch(16);  // smaller than a category: the chunked walk is exercised too
   learner.prepare(scratch);
@@ -94,6 +96,27 @@ TEST(LearnerAllocations, LocalLdaAskAllocatesNothing) {
       return v;
     };
     EXPECT_EQ(allocations_during_asks(learner, counts, 10, 50), 0U) << learner.kind();
+  }
+}
+
+// Sets of spin images: D(T, O) for every stored view, with the scratch's distances prepared for the
+// largest set (20 categories of 6 views of up to 16 images of width 2).
+TEST(LearnerAllocations, SpinSetAskAllocatesNothing) {
+  for (const NocdApproach approach : {NocdApproach::MIN_DISTANCE, NocdApproach::MEAN_DISTANCE}) {
+    SpinSetConfig cfg;
+    cfg.set.features.spin.image_width = 2;
+    cfg.set.max_keypoints = 16;
+    cfg.approach = approach;
+    SpinSetLearner learner(cfg);
+    const auto set = [&cfg](std::size_t seed) {
+      std::vector<float> v(cfg.set.length(), 0.0F);
+      const std::size_t n = 1 + seed % 16, dims = cfg.set.image_values();
+      v[0] = static_cast<float>(n);
+      for (std::size_t i = 0; i < n * dims; ++i)
+        v[1 + i] = static_cast<float>((seed * 13 + i * 7) % 11) / 11.0F;
+      return v;
+    };
+    EXPECT_EQ(allocations_during_asks(learner, set, 6, 50), 0U) << learner.kind();
   }
 }
 

@@ -1,0 +1,247 @@
+#include "learning/spin_set_learner.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "kernels/set_distance.hpp"
+#include "learning/detail/category_writer.hpp"
+#include "learning/detail/learner_common.hpp"
+#include "learning/snapshot_cell.hpp"
+
+namespace orthoflow::learning {
+
+/// One stored view: its images row after row (as D(U, .) reads a U) and as a structure-of-arrays
+/// matrix (as D(., V) reads a V), and the descriptor it came from (retract compares it).
+struct SetView {
+  std::size_t count = 0;
+  std::vector<float> rows;
+  std::vector<float> soa;  // image_values x count
+  [[nodiscard]] kernels::DescriptorMatrixView matrix(std::size_t dims) const noexcept {
+    return {soa, dims, count, count};
+  }
+};
+using SetViewPtr = std::shared_ptr<const SetView>;
+
+/// One category: its views (shared between snapshots) and the sum of D over its ordered pairs of
+/// distinct views, kept so that a teach adds only the new views' pairs.
+struct SetCategory {
+  CategoryId id = NO_CATEGORY;
+  Label label;
+  std::vector<SetViewPtr> views;
+  double ordered_sum = 0.0;
+};
+
+struct SetSnapshot {
+  std::vector<std::shared_ptr<const SetCategory>> categories;  // by id
+  std::vector<float> icd;                                      // parallel to categories
+  float mean_icd = 0.0F;
+  std::size_t views = 0;
+  std::size_t stored_floats = 0;
+  std::uint64_t generation = 0;
+  CategoryId next_id = 0;
+};
+
+struct SpinSetLearner::Cell : SnapshotCell<SetSnapshot> {
+  using SnapshotCell::SnapshotCell;
+};
+
+namespace {
+
+using CategoryPtr = std::shared_ptr<const SetCategory>;
+
+// The view of a descriptor that spin_set_count() accepted.
+SetViewPtr make_view(std::span<const float> descriptor, std::size_t count, std::size_t dims) {
+  auto v = std::make_shared<SetView>();
+  v->count = count;
+  v->rows.assign(descriptor.begin() + 1,
+                 descriptor.begin() + 1 + static_cast<std::ptrdiff_t>(count * dims));
+  v->soa.resize(count * dims);
+  for (std::size_t i = 0; i < count; ++i)
+    for (std::size_t d = 0; d < dims; ++d) v->soa[d * count + i] = v->rows[i * dims + d];
+  return v;
+}
+
+// Every view of @p views as a set, or NOT_A_SPIN_SET (validate_batch() ran before).
+Result<std::vector<SetViewPtr>, LearnError> sets_of(DescriptorBatch views, std::size_t dims) {
+  std::vector<SetViewPtr> out;
+  for (std::size_t v = 0; v < views.count(); ++v) {
+    const auto count = kernels::spin_set_count(views.view(v), dims);
+    if (!count) return err(LearnError::NOT_A_SPIN_SET);
+    out.push_back(make_view(views.view(v), *count, dims));
+  }
+  return out;
+}
+
+// D(U, V) with a scratch of V's size.
+double set_d(const SetView& u, const SetView& v, std::size_t dims, std::vector<float>& scratch) {
+  if (scratch.size() < v.count) scratch.resize(v.count);
+  return static_cast<double>(kernels::set_distance(u.rows, v.matrix(dims), scratch));
+}
+
+// A new category: @p base's views, then @p added, each adding D both ways to every earlier view.
+CategoryPtr extend(const SetCategory& base, std::span<const SetViewPtr> added, std::size_t dims) {
+  auto c = std::make_shared<SetCategory>(base);
+  std::vector<float> scratch;
+  for (const SetViewPtr& v : added) {
+    for (const SetViewPtr& u : c->views)
+      c->ordered_sum += set_d(*v, *u, dims, scratch) + set_d(*u, *v, dims, scratch);
+    c->views.push_back(v);
+  }
+  return c;
+}
+
+std::unique_ptr<SetSnapshot> finish(std::vector<CategoryPtr> categories, std::uint64_t generation,
+                                    CategoryId next_id, const SpinSetConfig& cfg) {
+  auto s = std::make_unique<SetSnapshot>();
+  s->categories = std::move(categories);
+  s->generation = generation;
+  s->next_id = next_id;
+  std::vector<PairSum> sums;
+  for (const CategoryPtr& c : s->categories) {
+    s->views += c->views.size();
+    for (const SetViewPtr& v : c->views) s->stored_floats += 2 * v->rows.size();
+    // category_icds() divides a sum over unordered pairs by n (n - 1) / 2: half the ordered sum.
+    sums.push_back(PairSum{c->views.size(), 0.5 * c->ordered_sum});
+  }
+  s->mean_icd = category_icds(sums, cfg.min_icd, cfg.default_icd, s->icd);
+  return s;
+}
+
+auto finisher(const SpinSetConfig& cfg) {
+  return [&cfg](std::vector<CategoryPtr> categories, std::uint64_t generation, CategoryId next_id) {
+    return finish(std::move(categories), generation, next_id, cfg);
+  };
+}
+
+}  // namespace
+
+SpinSetLearner::SpinSetLearner(const SpinSetConfig& cfg) : cfg_(cfg) {
+  OF_ENFORCE(cfg.set.valid(), "SpinSetConfig::set is not a valid spin-image set");
+  OF_ENFORCE(cfg.default_icd > 0.0F && std::isfinite(cfg.default_icd),
+             "SpinSetConfig::default_icd must be > 0");
+  OF_ENFORCE(cfg.min_icd > 0.0F && std::isfinite(cfg.min_icd),
+             "SpinSetConfig::min_icd must be > 0");
+  OF_ENFORCE(!std::isnan(cfg.classification_threshold),
+             "SpinSetConfig::classification_threshold is NaN");
+  cell_ = std::make_unique<Cell>(finish({}, 0, 0, cfg_));
+}
+
+SpinSetLearner::~SpinSetLearner() = default;
+
+Result<CategoryId, LearnError> SpinSetLearner::teach(std::string_view label,
+                                                     DescriptorBatch views) {
+  if (auto r = validate_label(label); !r) return err(r.error());
+  if (auto r = validate_batch(views, cfg_.set.length(), false); !r) return err(r.error());
+  auto sets = sets_of(views, cfg_.set.image_values());
+  if (!sets) return err(sets.error());
+  auto make = [&](const SetCategory* existing, CategoryId id) {
+    SetCategory fresh;
+    fresh.id = id;
+    fresh.label = Label::from(label);
+    return extend(existing == nullptr ? fresh : *existing, *sets, cfg_.set.image_values());
+  };
+  return upsert_category(writer_, *cell_, label, make, finisher(cfg_));
+}
+
+void SpinSetLearner::prepare(AskScratch& scratch) const {
+  scratch.reserve_distances(cfg_.set.max_keypoints);
+}
+
+Prediction SpinSetLearner::ask(std::span<const float> descriptor,
+                               AskScratch& scratch) const noexcept {
+  const auto snap = cell_->read(scratch.slot_hint);
+  RankedScores ranked(false);
+  const std::size_t dims = cfg_.set.image_values();
+  const auto count = descriptor.size() == cfg_.set.length()
+                         ? kernels::spin_set_count(descriptor, dims)
+                         : std::nullopt;
+  const std::span<float> buffer = scratch.distances();
+  if (!count || buffer.size() < cfg_.set.max_keypoints)
+    return RankedScores::wrong_length(snap->generation);
+  const std::span<const float> target = descriptor.subspan(1, *count * dims);
+  const bool mean = cfg_.normalise && cfg_.approach == NocdApproach::MEAN_DISTANCE;
+  for (std::size_t k = 0; k < snap->categories.size(); ++k) {
+    const SetCategory& c = *snap->categories[k];
+    float min_d = std::numeric_limits<float>::infinity();
+    double sum = 0.0;
+    for (const SetViewPtr& v : c.views) {
+      const float d = kernels::set_distance(target, v->matrix(dims), buffer);
+      min_d = std::isnan(d) ? d : std::min(min_d, d);  // NaN is never a smaller distance
+      sum += static_cast<double>(d);
+    }
+    const float o = mean ? static_cast<float>(sum / static_cast<double>(c.views.size())) : min_d;
+    float score = o;
+    if (cfg_.normalise) {
+      score = cfg_.approach == NocdApproach::MIN_DISTANCE
+                  ? o / snap->icd[k]
+                  : 2.0F * o / (snap->icd[k] + snap->mean_icd);
+    }
+    ranked.offer(score, c.id, c.label);
+  }
+  Prediction p = ranked.prediction(snap->generation);
+  p.unknown = p.category == NO_CATEGORY || !(p.score <= cfg_.classification_threshold);
+  if (p.unknown) p.category = NO_CATEGORY;
+  return p;
+}
+
+Result<void, LearnError> SpinSetLearner::forget(std::string_view label) {
+  return erase_category(writer_, *cell_, label, finisher(cfg_));
+}
+
+Result<void, LearnError> SpinSetLearner::retract(std::string_view label, DescriptorBatch views) {
+  if (auto r = validate_batch(views, cfg_.set.length(), false); !r) return err(r.error());
+  auto sets = sets_of(views, cfg_.set.image_values());
+  if (!sets) return err(sets.error());
+  const std::size_t dims = cfg_.set.image_values();
+  auto make = [&](const SetCategory& c) -> Result<CategoryPtr, LearnError> {
+    const std::size_t n = sets->size();
+    if (n > c.views.size()) return err(LearnError::NOT_LAST_VIEWS);
+    const std::size_t keep = c.views.size() - n;
+    for (std::size_t v = 0; v < n; ++v)
+      if (c.views[keep + v]->rows != (*sets)[v]->rows) return err(LearnError::NOT_LAST_VIEWS);
+    if (keep == 0) return CategoryPtr{};
+    SetCategory base;
+    base.id = c.id;
+    base.label = c.label;
+    return extend(base, std::span<const SetViewPtr>(c.views).first(keep), dims);
+  };
+  return shrink_category(writer_, *cell_, label, make, finisher(cfg_));
+}
+
+Result<void, LearnError> SpinSetLearner::restore(std::span<const RestoredCategory> categories,
+                                                 CategoryId next_id) {
+  if (auto r = validate_restored(categories, cfg_.set.length(), false); !r) return err(r.error());
+  std::vector<CategoryPtr> next;
+  for (const RestoredCategory& rc : categories) {
+    if (rc.views.count() == 0) return err(LearnError::NO_VIEWS);
+    auto sets = sets_of(rc.views, cfg_.set.image_values());
+    if (!sets) return err(sets.error());
+    SetCategory base;
+    base.id = rc.id;
+    base.label = Label::from(rc.label);
+    next.push_back(extend(base, *sets, cfg_.set.image_values()));
+    next_id = std::max(next_id, rc.id + 1);
+  }
+  replace_categories(writer_, *cell_, std::move(next), next_id, finisher(cfg_));
+  return {};
+}
+
+LearnerStats SpinSetLearner::stats() const noexcept {
+  std::size_t hint = 0;
+  const auto snap = cell_->read(hint);
+  return LearnerStats{snap->categories.size(), snap->views, snap->stored_floats, snap->generation,
+                      cell_->retired_pending()};
+}
+
+std::vector<CategorySummary> SpinSetLearner::categories() const {
+  std::size_t hint = 0;
+  const auto snap = cell_->read(hint);
+  std::vector<CategorySummary> out;
+  for (std::size_t k = 0; k < snap->categories.size(); ++k) {
+    const SetCategory& c = *snap->categories[k];
+    out.push_back(CategorySummary{c.id, c.label, c.views.size(), snap->icd[k]});
+  }
+  return out;
+}
+
+}  // namespace orthoflow::learning
