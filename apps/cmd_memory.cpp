@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "apps/commands.hpp"
+#include "apps/spin_set_options.hpp"
 #include "formats/pcd_io.hpp"
 #include "kernels/descriptor_spec.hpp"
 #include "learning/calibration.hpp"
@@ -30,6 +31,7 @@ struct MemoryOptions {
   std::optional<float> ct;
   std::string representation = "good";
   std::string dictionary;
+  kernels::SpinSetParams spin{};  // --spin-*
   std::string label;
   std::vector<std::string> files;
   std::string file;
@@ -47,7 +49,11 @@ learning::MemoryConfig config_of(const MemoryOptions& o) {
       o.bins, o.mode == "reference" ? kernels::GoodMode::REFERENCE : kernels::GoodMode::INVARIANT);
   // A bag-of-words store: with --dictionary, those words (a new store takes them; an existing one
   // must have them); without, the store's own.
-  if (o.representation != "good" || !o.dictionary.empty()) {
+  if (o.representation == "spin") {  // sets of spin images: the instance learner, no dictionary
+    const kernels::GoodConfig good = cfg.descriptor.good;
+    cfg.descriptor = kernels::DescriptorSpec::make_spin_set(o.spin);
+    cfg.descriptor.good = good;
+  } else if (o.representation != "good" || !o.dictionary.empty()) {
     std::shared_ptr<const kernels::VisualDictionary> words;
     if (!o.dictionary.empty()) {
       auto d = learning::load_dictionary(o.dictionary);
@@ -222,10 +228,11 @@ void add_memory_command(CLI::App& app) {
   cmd->add_option("--bins", o->bins, "GOOD bins per side; must match the store (default 15)")
       ->check(CLI::Range(std::size_t{1}, kernels::GOOD_MAX_BINS));
   cmd->add_option("--representation", o->representation,
-                  "good, bow (a bag of words), lda (its topics) or local-lda (word counts, topics "
-                  "learned per category); a new store of these needs --dictionary, an existing "
-                  "one uses its own")
-      ->check(CLI::IsMember({"good", "bow", "lda", "local-lda"}));
+                  "good, spin (sets of spin images, instance-based), bow (a bag of words), lda "
+                  "(its topics) or local-lda (word counts, topics learned per category); a new "
+                  "store of the last three needs --dictionary, an existing one uses its own")
+      ->check(CLI::IsMember({"good", "spin", "bow", "lda", "local-lda"}));
+  add_spin_set_options(cmd, o->spin);
   cmd->add_option(
       "--dictionary", o->dictionary,
       "bow, lda: the visual words (`orthoflow dictionary build`); implies bow unless lda");

@@ -102,6 +102,15 @@ std::string encode_schema(const kernels::DescriptorSpec& spec) {
     j["keypoint_leaf"] = d.keypoint_leaf;
     j["normal_radius"] = d.normal_radius;
   }
+  if (spec.kind == kernels::DescriptorKind::SPIN_SET) {
+    const kernels::SpinSetParams& p = spec.spin_set;
+    j["spin_set"] = {{"max_keypoints", p.max_keypoints},
+                     {"image_width", p.features.spin.image_width},
+                     {"support_length", p.features.spin.support_length},
+                     {"support_angle_cos", p.features.spin.support_angle_cos},
+                     {"keypoint_leaf", p.features.keypoint_leaf},
+                     {"normal_radius", p.features.normal_radius}};
+  }
   if (spec.kind == kernels::DescriptorKind::LOCAL_LDA) {
     const kernels::LocalTopics& t = spec.local_topics;
     j["local_topics"] = {{"topics", t.topics},
@@ -196,6 +205,40 @@ bool schema_local_topics(const nlohmann::json& j, kernels::LocalTopics& t, std::
   return true;
 }
 
+/// The set a "spin" schema names, or false with @p why.
+bool schema_spin_set(const nlohmann::json& j, kernels::SpinSetParams& p, std::string& why) {
+  const auto o = j.find("spin_set");
+  bool ok = o != j.end() && o->is_object();
+  for (const char* n : {"max_keypoints", "image_width"})
+    ok = ok && o->contains(n) && (*o)[n].is_number_unsigned();
+  for (const char* n : {"support_length", "support_angle_cos", "keypoint_leaf", "normal_radius"})
+    ok = ok && o->contains(n) && (*o)[n].is_number();
+  if (!ok) {
+    why =
+        "a \"spin\" schema needs \"spin_set\" with unsigned \"max_keypoints\" and "
+        "\"image_width\", and numbers \"support_length\", \"support_angle_cos\", "
+        "\"keypoint_leaf\" and \"normal_radius\"";
+    return false;
+  }
+  const auto clamp = [](std::uint64_t v) {
+    return static_cast<std::uint32_t>(std::min<std::uint64_t>(v, UINT32_MAX));
+  };
+  p.max_keypoints = clamp((*o)["max_keypoints"].get<std::uint64_t>());
+  p.features.spin.image_width = clamp((*o)["image_width"].get<std::uint64_t>());
+  p.features.spin.support_length = (*o)["support_length"].get<float>();
+  p.features.spin.support_angle_cos = (*o)["support_angle_cos"].get<float>();
+  p.features.keypoint_leaf = (*o)["keypoint_leaf"].get<float>();
+  p.features.normal_radius = (*o)["normal_radius"].get<float>();
+  if (!p.valid()) {  // the learner's preconditions: a store never hands it others
+    why = "\"spin_set\" out of range: image width 1.." +
+          std::to_string(kernels::MAX_SPIN_IMAGE_WIDTH) + ", 1.." +
+          std::to_string(kernels::MAX_SET_KEYPOINTS) +
+          " keypoints, lengths finite and > 0, the support angle's cosine in [0, 1]";
+    return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 std::optional<kernels::DescriptorSpec> decode_schema(std::string_view json, std::uint32_t& version,
@@ -221,17 +264,18 @@ std::optional<kernels::DescriptorSpec> decode_schema(std::string_view json, std:
   const std::string kind_name = kind != j.end() ? kind->get<std::string>() : "good";
   const auto named = kernels::descriptor_kind(kind_name);
   if (!named) {
-    why =
-        "descriptor \"" + kind_name + "\" is not one this build knows (good, bow, lda, local-lda)";
+    why = "descriptor \"" + kind_name +
+          "\" is not one this build knows (good, bow, lda, local-lda, spin)";
     return std::nullopt;
   }
-  if (named == kernels::DescriptorKind::SPIN_SET) {
-    why = "descriptor \"spin\": a store of spin-image sets is not one this build writes";
+  kernels::SpinSetParams set;
+  const bool set_kind = named == kernels::DescriptorKind::SPIN_SET;
+  if (set_kind && !schema_spin_set(j, set, why))
     return std::nullopt;
-  }
   std::optional<kernels::VisualDictionary> dictionary;
   const bool local_lda = named == kernels::DescriptorKind::LOCAL_LDA;
-  if (named != kernels::DescriptorKind::GOOD && !(dictionary = schema_dictionary(j, why)))
+  const bool over_words = named != kernels::DescriptorKind::GOOD && !set_kind;
+  if (over_words && !(dictionary = schema_dictionary(j, why)))
     return std::nullopt;
   kernels::LocalTopics topics;
   if (local_lda && !schema_local_topics(j, topics, why)) return std::nullopt;
@@ -253,6 +297,10 @@ std::optional<kernels::DescriptorSpec> decode_schema(std::string_view json, std:
       bins->get<std::size_t>(),
       m == "invariant" ? kernels::GoodMode::INVARIANT : kernels::GoodMode::REFERENCE);
   spec.good.threshold = threshold->get<float>();
+  if (set_kind) {
+    spec.kind = *named;
+    spec.spin_set = set;
+  }
   if (dictionary) {
     spec.kind = *named;
     spec.local_topics = topics;

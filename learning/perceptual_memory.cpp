@@ -247,10 +247,6 @@ Result<PerceptualMemory, MemoryError> PerceptualMemory::open(const std::filesyst
                                                              const MemoryConfig& cfg,
                                                              OpenMode mode) {
   // A bag of words without its dictionary opens a store with the store's own (check_schema).
-  if (cfg.descriptor.kind == kernels::DescriptorKind::SPIN_SET)
-    return err(memory_error(Code::OPEN_FAILED, dir,
-                            "the perceptual memory does not store spin-image sets (yet): teach "
-                            "them to a learner directly, or use good, bow, lda or local-lda"));
   const bool adopt = cfg.descriptor.local() && !cfg.descriptor.dictionary;
   if (auto valid = cfg.descriptor.validate(); !valid && !adopt)
     return err(memory_error(Code::OPEN_FAILED, dir, valid.error()));

@@ -1,5 +1,6 @@
 // Fuzzes decode_schema (learning/detail/memory_codec.hpp): the schema record a perceptual memory's
-// store and its export files carry (GOOD, bag of words, LDA, Local LDA with its topics). No input
+// store and its export files carry (GOOD, bag of words, LDA, Local LDA with its topics, sets of
+// spin images). No input
 // may crash, leak or hit UB; a refusal says why; an accepted schema encodes to one that decodes to
 // the same specification.
 #include <cstdint>
