@@ -1,17 +1,20 @@
-// `orthoflow dictionary build --from DIR... --out FILE [--words 70] [--image-width 4]
+// `orthoflow dictionary build --from DIR... | --scenes DIR... [--graph FILE|tabletop] --out FILE
+// [--words 70] [--image-width 4]
 // [--support-length 0.05] [--keypoint-leaf 0.01] [--normal-radius 0.02] [--seed 1]
 // [--iterations 100] [--topics K [--alpha 1] [--beta 0.1] [--gibbs-iterations 30]] [--threads N]`
 // and `orthoflow dictionary show FILE [--json]`: the dictionary
 // of visual words of the bag-of-words representation (learning/dictionary.hpp,
 // docs/SPIN_IMAGES.md). `build` is the thesis's exploration stage: every object view (*.pcd) under
-// the directories, labelled or not, is described by its spin images at its keypoints, and k-means
-// makes the pool into words. The same files, parameters and seed give the same file, whatever the
-// threads.
+// the --from directories, labelled or not, and every object the product's segmentation finds in the
+// frames under --scenes (chapter 3's unsupervised object discovery: what the robot sees before
+// anyone teaches it), is described by its spin images at its keypoints, and k-means makes the pool
+// into words. The same files, parameters and seed give the same file, whatever the threads.
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -21,7 +24,10 @@
 #include <vector>
 
 #include "apps/commands.hpp"
+#include "apps/graph_segmentation.hpp"
 #include "formats/pcd_io.hpp"
+#include "kernels/pinhole_regrid.hpp"
+#include "kernels/segmentation_chain.hpp"
 #include "kernels/spin_features.hpp"
 #include "learning/dictionary.hpp"
 #include "learning/topic_training.hpp"
@@ -31,6 +37,8 @@ namespace {
 
 struct DictionaryOptions {
   std::vector<std::string> from;
+  std::vector<std::string> scenes;
+  std::string graph = "tabletop";
   std::string out;
   std::size_t words = 70;
   std::uint32_t image_width = 4;
@@ -74,9 +82,70 @@ std::vector<std::filesystem::path> views_under(const std::vector<std::string>& r
   return out;
 }
 
+/// The objects the product's segmentation (the graph's preprocess, table and objects nodes) finds
+/// in every frame under @p roots, in frame order and candidate order: their finite points.
+std::vector<kernels::PointCloud> objects_in_scenes(const std::vector<std::string>& roots,
+                                                   const std::string& graph, std::size_t& frames) {
+  auto seg = segmentation_of_graph_arg(graph);
+  if (!seg) fail(seg.error(), EXIT_BAD_INPUT);
+  const auto files = views_under(roots);
+  if (files.empty()) fail("no *.pcd frame under the given --scenes", EXIT_BAD_INPUT);
+  frames = files.size();
+  std::vector<kernels::PointCloud> objects;
+  std::unique_ptr<kernels::SegmentationChain> chain;
+  std::size_t chain_points = 0;
+  for (const std::filesystem::path& file : files) {
+    auto cloud = formats::read_pcd(file);
+    if (!cloud) fail(file.string() + ": " + cloud.error().to_string(), EXIT_BAD_INPUT);
+    if (!cloud->organized()) {
+      if (auto grid = kernels::organize_if_pinhole(*cloud); !grid)
+        fail(file.string() + ": not a camera frame (" +
+                 std::string(kernels::to_string(grid.error())) + ")",
+             EXIT_BAD_INPUT);
+    }
+    if (!chain || cloud->size() > chain_points) {
+      chain_points = cloud->size();
+      chain =
+          std::make_unique<kernels::SegmentationChain>(chain_points, seg->stages, seg->candidates);
+    }
+    auto result = chain->run(cloud->view());
+    if (!result) fail(file.string() + ": " + result.error().to_string(), EXIT_BAD_INPUT);
+    const std::size_t first = objects.size();
+    objects.resize(first + result->candidates.size());
+    std::vector<std::vector<std::size_t>> members(result->candidates.size());
+    const auto points = cloud->points();
+    for (std::size_t i = 0; i < result->labels.size(); ++i) {
+      const std::int32_t c = result->labels[i];
+      if (c < 0 || static_cast<std::size_t>(c) >= result->candidate_of.size()) continue;
+      const std::int32_t k = result->candidate_of[static_cast<std::size_t>(c)];
+      if (k >= 0 && std::isfinite(points.x[i]) && std::isfinite(points.y[i]) &&
+          std::isfinite(points.z[i]))
+        members[static_cast<std::size_t>(k)].push_back(i);
+    }
+    for (std::size_t k = 0; k < members.size(); ++k) {
+      kernels::PointCloud& o = objects[first + k];
+      o.resize_unorganized(members[k].size());
+      for (std::size_t n = 0; n < members[k].size(); ++n) {
+        o.x()[n] = points.x[members[k][n]];
+        o.y()[n] = points.y[members[k][n]];
+        o.z()[n] = points.z[members[k][n]];
+      }
+    }
+  }
+  return objects;
+}
+
 void run_build(const DictionaryOptions& o) {
-  const auto files = views_under(o.from);
-  if (files.empty()) fail("no *.pcd object view under the given directories", EXIT_BAD_INPUT);
+  if (o.from.empty() && o.scenes.empty()) fail("build needs --from or --scenes", EXIT_USAGE);
+  const auto files = o.from.empty() ? std::vector<std::filesystem::path>{} : views_under(o.from);
+  if (!o.from.empty() && files.empty())
+    fail("no *.pcd object view under the given directories", EXIT_BAD_INPUT);
+  std::size_t frames = 0;
+  const std::vector<kernels::PointCloud> found = o.scenes.empty()
+                                                     ? std::vector<kernels::PointCloud>{}
+                                                     : objects_in_scenes(o.scenes, o.graph, frames);
+  if (!o.scenes.empty() && found.empty())
+    fail("the segmentation found no object in the --scenes frames", EXIT_BAD_INPUT);
   kernels::SpinFeatureParams params;
   params.spin.image_width = o.image_width;
   params.spin.support_length = o.support_length;
@@ -86,19 +155,29 @@ void run_build(const DictionaryOptions& o) {
   if (o.threads > 0) threads.emplace(tbb::global_control::max_allowed_parallelism, o.threads);
   // Each view's images in its own slot, then joined in file order: the pool does not depend on
   // the threads.
-  std::vector<std::vector<float>> images(files.size());
-  std::vector<std::string> errors(files.size());
+  // The views first, then the objects found in the scenes.
+  const std::size_t total = files.size() + found.size();
+  std::vector<std::vector<float>> images(total);
+  std::vector<std::string> errors(total);
   tbb::enumerable_thread_specific<kernels::SpinFeatures> scratch;
-  tbb::parallel_for(std::size_t{0}, files.size(), [&](std::size_t i) {
-    auto cloud = formats::read_pcd(files[i]);
-    if (!cloud) {
-      errors[i] = files[i].string() + ": " + cloud.error().to_string();
-      return;
+  tbb::parallel_for(std::size_t{0}, total, [&](std::size_t i) {
+    std::optional<kernels::PointCloud> read;
+    if (i < files.size()) {
+      auto cloud = formats::read_pcd(files[i]);
+      if (!cloud) {
+        errors[i] = files[i].string() + ": " + cloud.error().to_string();
+        return;
+      }
+      read.emplace(std::move(*cloud));
     }
+    const kernels::PointCloud& cloud = read ? *read : found[i - files.size()];
+    const std::string name =
+        i < files.size() ? files[i].string()
+                         : "object " + std::to_string(i - files.size()) + " found in the scenes";
     kernels::SpinFeatures& features = scratch.local();
-    auto k = features.compute(cloud->points(), params);
+    auto k = features.compute(cloud.points(), params);
     if (!k) {
-      errors[i] = files[i].string() + ": " + kernels::to_string(k.error());
+      errors[i] = name + ": " + kernels::to_string(k.error());
       return;
     }
     images[i].assign(features.images().begin(), features.images().end());
@@ -111,8 +190,17 @@ void run_build(const DictionaryOptions& o) {
   km.k = o.words;
   km.seed = o.seed;
   km.max_iterations = o.iterations;
-  std::string provenance = std::to_string(files.size()) + " views under";
-  for (const std::string& root : o.from) provenance += " " + root;
+  std::string provenance;
+  if (!files.empty()) {
+    provenance = std::to_string(files.size()) + " views under";
+    for (const std::string& root : o.from) provenance += " " + root;
+  }
+  if (!found.empty()) {
+    if (!provenance.empty()) provenance += "; ";
+    provenance += std::to_string(found.size()) + " objects segmented (" + o.graph + ") from " +
+                  std::to_string(frames) + " frames under";
+    for (const std::string& root : o.scenes) provenance += " " + root;
+  }
   auto d = learning::build_dictionary(pool, params, km, provenance);
   if (!d) fail(d.error(), EXIT_USAGE);
   if (o.topics > 0) {  // the topic layer: LDA over the same views' words
@@ -167,8 +255,15 @@ void add_dictionary_command(CLI::App& app) {
       "dictionary", "the visual words of the bag-of-words representation (docs/SPIN_IMAGES.md)");
   cmd->require_subcommand(1);
   CLI::App* build = cmd->add_subcommand(
-      "build", "k-means over the spin images of every object view (*.pcd) under DIR...");
-  build->add_option("--from", o->from, "directories (or files) of object views")->required();
+      "build",
+      "k-means over the spin images of every object view (*.pcd) under --from DIR... and of "
+      "every object segmented from the frames under --scenes DIR...");
+  build->add_option("--from", o->from, "directories (or files) of object views");
+  build->add_option("--scenes", o->scenes,
+                    "directories (or files) of camera frames: the objects the segmentation finds "
+                    "in them (the exploration of thesis chapter 3)");
+  build->add_option("--graph", o->graph,
+                    "--scenes: the segmentation of this graph file ('tabletop': the embedded one)");
   build->add_option("--out", o->out, "the dictionary file to write")->required();
   build->add_option("--words", o->words, "dictionary size DS (thesis: 70)")
       ->check(CLI::Range(1, 65536));
