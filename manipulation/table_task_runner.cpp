@@ -113,6 +113,7 @@ Result<void, std::string> TableTaskRunner::start(std::span<const std::string> kn
     radii_.push_back(m.radius_m);
   }
   occupied_ = std::move(plan.occupied);
+  packed_ = plan.packed;
   state_ = State::MOVING;
   return {};
 }
@@ -202,7 +203,7 @@ bool TableTaskRunner::arm_hides(const Vector3d& base_point, double radius_m) con
 }
 
 bool TableTaskRunner::spots_swap(std::size_t a, std::size_t b) const {
-  if (options_.task != TableTaskKind::CLEAR_TABLE) return true;  // the user's places: one size
+  if (!packed_) return true;  // the grid's spots (or the user's places): room for any object
   const Vector2d at_a = moves_[a].to, at_b = moves_[b].to;
   std::vector<Footprint> others = occupied_;
   for (std::size_t k = 0; k < moves_.size(); ++k)  // every other place given (a retry repeats one)

@@ -8,8 +8,8 @@
 /// - for each move, finds the object again (by track, else nearby), plans its grasp
 ///   (grasp_planner.hpp) and searches a pick-and-place job (pick_place_job.hpp) whose every move
 ///   keeps clear of the other objects: grasps x lift heights x the spots of the moves still to come
-///   (spots swap when each object fits the other's place), with a 2 cm planning margin first, then
-///   without;
+///   (spots swap; packed places only when each object fits the other's), with a 2 cm planning
+///   margin first, then without;
 /// - runs the job with the execution manager (execution_manager.hpp) every arm cycle, feeding it
 ///   the target (not when the hand or the arm hides it: a cut view is no evidence) and the other
 ///   objects as obstacles;
@@ -184,8 +184,9 @@ class TableTaskRunner {
   [[nodiscard]] const SeenObject* current_target() const;
   [[nodiscard]] bool is_target(const SeenObject& o, const SeenObject* t) const;
   [[nodiscard]] bool placing() const noexcept;
-  /// True if moves @p a and @p b may swap places: clear_table's places are sized by footprint, so
-  /// each object must fit the other's place beside everything else placed or to be placed.
+  /// True if moves @p a and @p b may swap places: always on the grid's spots; when clear_table's
+  /// places are packed by footprint, each object must fit the other's place beside everything else
+  /// placed or to be placed.
   [[nodiscard]] bool spots_swap(std::size_t a, std::size_t b) const;
   [[nodiscard]] bool arm_hides(const Eigen::Vector3d& base_point, double radius_m) const noexcept;
 
@@ -204,6 +205,7 @@ class TableTaskRunner {
   std::vector<Eigen::Vector3d> planned_;
   std::vector<double> radii_;        ///< each move's footprint (its place was chosen for it)
   std::vector<Footprint> occupied_;  ///< clear_table: what stood in the area and stays
+  bool packed_ = false;              ///< clear_table's places are packed by footprint
   std::string stopped_;
   std::size_t move_ = 0;
   std::int64_t move_start_ns_ = 0;

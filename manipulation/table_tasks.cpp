@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 namespace orthoflow::manipulation {
 
@@ -11,6 +12,41 @@ Eigen::Vector2d xy(const Eigen::Vector3d& p) { return {p.x(), p.y()}; }
 
 bool listed(const std::vector<std::string>& names, const std::string& label) {
   return std::find(names.begin(), names.end(), label) != names.end();
+}
+
+Footprint footprint(const TableObject& o) {
+  return Footprint{xy(o.centre), std::max(o.radius_m, 0.0)};
+}
+
+// The grid's spots, row by row from the area's min corner, each half a spacing in from the edges; a
+// spot is taken when anything stands within three quarters of a spacing of it. Every object's move
+// to the next free spot, or nullopt when the spots run out first.
+std::optional<std::vector<TaskMove>> grid_places(std::span<const TableObject* const> to_move,
+                                                 std::span<const Footprint> occupied,
+                                                 const ClearTableOptions& options) {
+  std::vector<Eigen::Vector2d> spots;
+  const double s = options.spacing_m;
+  if (!(s > 0.0) || !std::isfinite(s)) return std::nullopt;
+  const Eigen::Vector2d size = options.area.max - options.area.min;
+  if (!size.allFinite() || (size.array() < s).any()) return std::nullopt;
+  for (double y = options.area.min.y() + s / 2; y <= options.area.max.y() - s / 2 + 1e-9; y += s)
+    for (double x = options.area.min.x() + s / 2; x <= options.area.max.x() - s / 2 + 1e-9; x += s)
+      spots.emplace_back(x, y);
+  std::vector<Eigen::Vector2d> standing;
+  for (const Footprint& f : occupied) standing.push_back(f.centre);
+  std::vector<TaskMove> moves;
+  std::size_t next = 0;
+  for (const TableObject* o : to_move) {
+    while (next < spots.size() &&
+           std::any_of(standing.begin(), standing.end(), [&](const Eigen::Vector2d& p) {
+             return (p - spots[next]).norm() < 0.75 * s;
+           }))
+      ++next;
+    if (next == spots.size()) return std::nullopt;
+    moves.push_back({o->track, o->label, spots[next], footprint(*o).radius_m});
+    standing.push_back(spots[next]);
+  }
+  return moves;
 }
 
 }  // namespace
@@ -51,9 +87,6 @@ bool fits_in_area(const TableArea& area, const Footprint& f, std::span<const Foo
 TaskPlan plan_clear_table(std::span<const TableObject> objects, const ClearTableOptions& options) {
   TaskPlan plan;
   std::vector<const TableObject*> to_move;
-  const auto footprint = [](const TableObject& o) {
-    return Footprint{xy(o.centre), std::max(o.radius_m, 0.0)};
-  };
   for (const TableObject& o : objects) {
     const bool in_area = options.area.contains(xy(o.centre));
     if (o.label.empty()) {
@@ -73,6 +106,13 @@ TaskPlan plan_clear_table(std::span<const TableObject> objects, const ClearTable
     const double db = (xy(b->centre) - options.arm_base).norm();
     return da != db ? da < db : a->track < b->track;
   });
+  // The roomy grid first (every spot a spacing from the next, whatever the objects); packed by
+  // footprint only when the grid has no spot for every object.
+  if (auto spots = grid_places(to_move, plan.occupied, options)) {
+    plan.moves = std::move(*spots);
+    return plan;
+  }
+  plan.packed = true;
   // Each object's place: the first of a fine grid, row by row (+x) from the area's min corner,
   // where its footprint fits beside everything that stands there or was given a place before it.
   // At most 1000 places along a side: a bounded search whatever the options.

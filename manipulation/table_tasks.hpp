@@ -4,9 +4,9 @@
 /// in which order, from the labels the learner gives. Which joints move them is the pick-and-place
 /// job's (pick_place_job.hpp), and the execution manager runs each job.
 /// - clear_table: every recognised object except the categories marked as table items goes to the
-///   placing area, nearest to the arm's base first, each to the first place there that its
-///   footprint fits: inside the area and a gap clear of every other footprint (spots sized by each
-///   object, not one grid for all).
+///   placing area, nearest to the arm's base first: to the next free spot of a roomy grid when it
+///   has a spot for every object; else each to the first place its footprint fits, inside the area
+///   and a gap clear of every other footprint (packed by footprint).
 /// - serve_a_meal: the objects of the named categories, in the order named, go to the user's place,
 ///   side by side along the table's x axis.
 /// An object the learner calls Unknown is never moved (the robot does not know what it is); every
@@ -69,6 +69,8 @@ struct TaskPlan {
   std::vector<TaskStay> stays;
   /// clear_table: what stands in the placing area and stays (its room is taken).
   std::vector<Footprint> occupied;
+  /// clear_table: the places are packed by footprint (the grid had no spot for every object).
+  bool packed = false;
 };
 
 /// @brief A rectangle on the table (base frame x, y; min <= max).
@@ -83,10 +85,13 @@ struct TableArea {
 struct ClearTableOptions {
   TableArea area;                        ///< the placing area
   std::vector<std::string> table_items;  ///< categories that stay (e.g. "plate")
-  /// The room between two footprints: the hand opens 2 cm wider than what it holds, and its fingers
-  /// are about 1.5 cm thick on either side.
+  /// The roomy grid: spots this far apart (and half of it in from the edges), taken when anything
+  /// stands within three quarters of it. Used whenever it has a spot for every object to move.
+  double spacing_m = 0.15;
+  /// Packed: the room between two footprints (the hand opens 2 cm wider than what it holds, and its
+  /// fingers are about 1.5 cm thick on either side).
   double gap_m = 0.05;
-  /// Places are tried on a grid this fine, row by row (+x) from the area's min corner.
+  /// Packed: places are tried on a grid this fine, row by row (+x) from the area's min corner.
   double step_m = 0.01;
   Eigen::Vector2d arm_base = Eigen::Vector2d::Zero();  ///< "nearest first" is measured from here
 };
