@@ -27,7 +27,8 @@ std::string Variant::name() const {
            std::to_string(dictionary ? dictionary->words : 0);
   }
   if (representation == kernels::DescriptorKind::SPIN_SET) {
-    return n + "/spin/" + std::to_string(spin_set.max_keypoints);
+    return n + "/spin/" + std::to_string(spin_set.max_keypoints) + "x" +
+           std::to_string(spin_set.image_values());
   }
   n += mode == kernels::GoodMode::INVARIANT ? "/invariant/" : "/reference/";
   return n + std::to_string(bins);

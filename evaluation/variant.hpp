@@ -37,7 +37,8 @@ struct Variant {
   /// @brief The descriptor specification of this variant.
   [[nodiscard]] kernels::DescriptorSpec spec() const;
   /// @brief "instance-nn/invariant/15", "bayes/reference/5", "instance-nn/bow/70", "bayes/lda/30",
-  /// "bayes/local-lda/30x90", "instance-nocd1/spin/128", ...
+  /// "bayes/local-lda/30x90", "instance-nocd1/spin/128x153" (images x values),
+  /// ...
   [[nodiscard]] std::string name() const;
   /// @brief The descriptor parameters of this variant with perturbation @p p of @p amount_m.
   [[nodiscard]] ViewDescription descriptor(Perturbation p = Perturbation::NONE,

@@ -103,14 +103,12 @@ ok::DescriptorSpec good() { return ok::DescriptorSpec::make_good(15); }
 ok::DescriptorSpec bow() { return ok::DescriptorSpec::make_bow(dictionary()); }
 ok::DescriptorSpec lda() { return ok::DescriptorSpec::make_lda(dictionary()); }
 ok::DescriptorSpec local_lda() { return ok::DescriptorSpec::make_local_lda(dictionary()); }
-ok::DescriptorSpec spin_vs1() { return ok::DescriptorSpec::make_spin_set(); }
-ok::DescriptorSpec spin_vs4() {
+ok::DescriptorSpec spin_vs1() {
   ok::SpinSetParams p;
-  p.features.spin.image_width = 8;
-  p.features.spin.support_length = 0.10F;
-  p.features.keypoint_leaf = 0.04F;
+  p.features = ok::SpinFeatureParams{};  // the bag of words' IW 4, SL 5 cm, VS 1 cm
   return ok::DescriptorSpec::make_spin_set(p);
 }
+ok::DescriptorSpec spin_vs4() { return ok::DescriptorSpec::make_spin_set(); }  // the thesis's
 
 }  // namespace
 

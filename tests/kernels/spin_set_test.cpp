@@ -68,9 +68,9 @@ TEST(SpinSet, WhatIsNotASetIsRefused) {
 TEST(SpinSet, TheSpecificationChecksItsParameters) {
   SpinSetParams p;
   EXPECT_TRUE(p.valid());
-  EXPECT_EQ(p.length(), 1U + 128U * 45U) << "IW 4: 5 x 9 values an image";
+  EXPECT_EQ(p.length(), 1U + 128U * 153U) << "IW 8: 9 x 17 values an image";
   const DescriptorSpec spec = DescriptorSpec::make_spin_set(p);
-  EXPECT_EQ(spec.describe(), "spin keypoints=128 iw=4 sl=0.05 sa=0 vs=0.01 nr=0.02");
+  EXPECT_EQ(spec.describe(), "spin keypoints=128 iw=8 sl=0.1 sa=0 vs=0.04 nr=0.02");
   EXPECT_EQ(descriptor_kind("spin"), DescriptorKind::SPIN_SET);
   EXPECT_TRUE(spec.spin_features());
   EXPECT_FALSE(spec.local()) << "no dictionary";
@@ -106,6 +106,7 @@ TEST(SpinSet, TheDescriberWritesAViewsSet) {
       }
   SpinSetParams p;
   p.max_keypoints = 64;
+  p.features = SpinFeatureParams{};  // VS 1 cm: a keypoint every centimetre
   Describer describer(DescriptorSpec::make_spin_set(p));
   std::vector<float> out(p.length(), -1.0F);
   auto described = describer.describe(cloud.points(), out);

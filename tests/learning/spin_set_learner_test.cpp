@@ -152,7 +152,7 @@ TEST(SpinSetLearner, MakeLearnerGivesSetsTheSetLearnerWhateverTheKind) {
   const kernels::DescriptorSpec spec = kernels::DescriptorSpec::make_spin_set(params);
   ASSERT_TRUE(spec.validate());
   EXPECT_FALSE(spec.histogram());
-  EXPECT_EQ(spec.length(), 1U + 3U * 45U);
+  EXPECT_EQ(spec.length(), 1U + 3U * 153U);
   for (const LearnerKind kind : {LearnerKind::INSTANCE, LearnerKind::BAYES}) {
     const auto learner = make_learner(spec, kind, InstanceConfig{}, BayesConfig{});
     EXPECT_STREQ(learner->kind(), "instance-spin-set");
