@@ -128,12 +128,7 @@ float ocd(std::span<const float> query, const InstanceCategory& c, bool mean,
 
 InstanceLearner::InstanceLearner(const InstanceConfig& cfg) : cfg_(cfg) {
   OF_ENFORCE(cfg.descriptor_length > 0, "InstanceConfig::descriptor_length must be positive");
-  OF_ENFORCE(cfg.default_icd > 0.0F && std::isfinite(cfg.default_icd),
-             "InstanceConfig::default_icd must be > 0");
-  OF_ENFORCE(cfg.min_icd > 0.0F && std::isfinite(cfg.min_icd),
-             "InstanceConfig::min_icd must be > 0");
-  OF_ENFORCE(!std::isnan(cfg.classification_threshold),
-             "InstanceConfig::classification_threshold is NaN");
+  enforce_icd_config(cfg.default_icd, cfg.min_icd, cfg.classification_threshold, "InstanceConfig");
   cell_ = std::make_unique<Cell>(finish({}, 0, 0, cfg_));
 }
 
@@ -162,18 +157,9 @@ Prediction InstanceLearner::ask(std::span<const float> descriptor,
   for (std::size_t k = 0; k < snap->categories.size(); ++k) {
     const InstanceCategory& c = *snap->categories[k];
     const float o = ocd(descriptor, c, mean, cfg_.metric, scratch.distances());
-    float score = o;
-    if (cfg_.normalise) {
-      score = cfg_.approach == NocdApproach::MIN_DISTANCE
-                  ? o / snap->icd[k]
-                  : 2.0F * o / (snap->icd[k] + snap->mean_icd);
-    }
-    ranked.offer(score, c.id, c.label);
+    ranked.offer(nocd_score(o, snap->icd[k], snap->mean_icd, cfg_.normalise, mean), c.id, c.label);
   }
-  Prediction p = ranked.prediction(snap->generation);
-  p.unknown = p.category == NO_CATEGORY || !(p.score <= cfg_.classification_threshold);
-  if (p.unknown) { p.category = NO_CATEGORY; }
-  return p;
+  return with_threshold(ranked.prediction(snap->generation), cfg_.classification_threshold);
 }
 
 Result<void, LearnError> InstanceLearner::forget(std::string_view label) {

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <string>
 
 namespace orthoflow::learning {
 
@@ -94,6 +95,13 @@ float category_icds(std::span<const PairSum> categories, float min_icd, float de
   }
   return categories.empty() ? default_icd
                             : static_cast<float>(all / static_cast<double>(categories.size()));
+}
+
+void enforce_icd_config(float default_icd, float min_icd, float ct, const char* who) {
+  OF_ENFORCE(
+      default_icd > 0.0F && std::isfinite(default_icd) && min_icd > 0.0F && std::isfinite(min_icd),
+      (std::string(who) + ": default_icd and min_icd must be finite and > 0").c_str());
+  OF_ENFORCE(!std::isnan(ct), (std::string(who) + ": the classification threshold is NaN").c_str());
 }
 
 Result<void, LearnError> validate_restored(std::span<const RestoredCategory> categories,

@@ -245,10 +245,7 @@ LocalLdaLearner::LocalLdaLearner(const LocalLdaConfig& cfg) : cfg_(cfg) {
              "LocalLdaConfig: 1..MAX_LOCAL_TOPICS topics, finite alpha and beta > 0, at most "
              "MAX_GIBBS_SWEEPS sweeps");
   OF_ENFORCE(cfg.max_words > 0, "LocalLdaConfig::max_words must be positive");
-  OF_ENFORCE(!std::isnan(cfg.classification_threshold), "LocalLdaConfig: CT is NaN");
-  OF_ENFORCE(cfg.default_icd > 0.0F && std::isfinite(cfg.default_icd) && cfg.min_icd > 0.0F &&
-                 std::isfinite(cfg.min_icd),
-             "LocalLdaConfig: ICDs must be > 0");
+  enforce_icd_config(cfg.default_icd, cfg.min_icd, cfg.classification_threshold, "LocalLdaConfig");
   OF_ENFORCE(cfg.count_scale > 0.0F && std::isfinite(cfg.count_scale),
              "LocalLdaConfig::count_scale must be > 0");
   cell_ = std::make_unique<Cell>(finisher(cfg_)({}, 0, 0));
@@ -325,11 +322,7 @@ Prediction LocalLdaLearner::ask(std::span<const float> descriptor,
     ranked.offer(static_cast<float>(score), c.id, c.label);
   }
   Prediction p = ranked.prediction(snap->generation);
-  if (!bayes) {
-    p.unknown = p.category == NO_CATEGORY || !(p.score <= cfg_.classification_threshold);
-    if (p.unknown) p.category = NO_CATEGORY;
-  }
-  return p;
+  return bayes ? p : with_threshold(p, cfg_.classification_threshold);
 }
 
 Result<void, LearnError> LocalLdaLearner::forget(std::string_view label) {

@@ -270,13 +270,11 @@ std::optional<kernels::DescriptorSpec> decode_schema(std::string_view json, std:
   }
   kernels::SpinSetParams set;
   const bool set_kind = named == kernels::DescriptorKind::SPIN_SET;
-  if (set_kind && !schema_spin_set(j, set, why))
-    return std::nullopt;
+  if (set_kind && !schema_spin_set(j, set, why)) return std::nullopt;
   std::optional<kernels::VisualDictionary> dictionary;
   const bool local_lda = named == kernels::DescriptorKind::LOCAL_LDA;
   const bool over_words = named != kernels::DescriptorKind::GOOD && !set_kind;
-  if (over_words && !(dictionary = schema_dictionary(j, why)))
-    return std::nullopt;
+  if (over_words && !(dictionary = schema_dictionary(j, why))) return std::nullopt;
   kernels::LocalTopics topics;
   if (local_lda && !schema_local_topics(j, topics, why)) return std::nullopt;
   const std::string m = mode->get<std::string>();

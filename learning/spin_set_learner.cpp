@@ -117,12 +117,7 @@ auto finisher(const SpinSetConfig& cfg) {
 
 SpinSetLearner::SpinSetLearner(const SpinSetConfig& cfg) : cfg_(cfg) {
   OF_ENFORCE(cfg.set.valid(), "SpinSetConfig::set is not a valid spin-image set");
-  OF_ENFORCE(cfg.default_icd > 0.0F && std::isfinite(cfg.default_icd),
-             "SpinSetConfig::default_icd must be > 0");
-  OF_ENFORCE(cfg.min_icd > 0.0F && std::isfinite(cfg.min_icd),
-             "SpinSetConfig::min_icd must be > 0");
-  OF_ENFORCE(!std::isnan(cfg.classification_threshold),
-             "SpinSetConfig::classification_threshold is NaN");
+  enforce_icd_config(cfg.default_icd, cfg.min_icd, cfg.classification_threshold, "SpinSetConfig");
   cell_ = std::make_unique<Cell>(finish({}, 0, 0, cfg_));
 }
 
@@ -170,18 +165,9 @@ Prediction SpinSetLearner::ask(std::span<const float> descriptor,
       sum += static_cast<double>(d);
     }
     const float o = mean ? static_cast<float>(sum / static_cast<double>(c.views.size())) : min_d;
-    float score = o;
-    if (cfg_.normalise) {
-      score = cfg_.approach == NocdApproach::MIN_DISTANCE
-                  ? o / snap->icd[k]
-                  : 2.0F * o / (snap->icd[k] + snap->mean_icd);
-    }
-    ranked.offer(score, c.id, c.label);
+    ranked.offer(nocd_score(o, snap->icd[k], snap->mean_icd, cfg_.normalise, mean), c.id, c.label);
   }
-  Prediction p = ranked.prediction(snap->generation);
-  p.unknown = p.category == NO_CATEGORY || !(p.score <= cfg_.classification_threshold);
-  if (p.unknown) p.category = NO_CATEGORY;
-  return p;
+  return with_threshold(ranked.prediction(snap->generation), cfg_.classification_threshold);
 }
 
 Result<void, LearnError> SpinSetLearner::forget(std::string_view label) {

@@ -69,6 +69,26 @@ struct PairSum {
 float category_icds(std::span<const PairSum> categories, float min_icd, float default_icd,
                     std::vector<float>& icd);
 
+/// @brief The instance-style decision value of an OCD (thesis chapter 5): the OCD itself when not
+/// @p normalise (plain nearest), approach I OCD / ICD, approach II (@p mean_approach)
+/// 2 OCD / (ICD + mean ICD).
+[[nodiscard]] inline float nocd_score(float ocd, float icd, float mean_icd, bool normalise,
+                                      bool mean_approach) noexcept {
+  if (!normalise) return ocd;
+  return mean_approach ? 2.0F * ocd / (icd + mean_icd) : ocd / icd;
+}
+
+/// @brief The instance-style Unknown rule: nothing ranked, or the best score above @p ct (or NaN).
+[[nodiscard]] inline Prediction with_threshold(Prediction p, float ct) noexcept {
+  p.unknown = p.category == NO_CATEGORY || !(p.score <= ct);
+  if (p.unknown) p.category = NO_CATEGORY;
+  return p;
+}
+
+/// @brief OF_ENFORCEs what every ICD-using learner requires: finite default_icd and min_icd > 0,
+/// and a CT that is not NaN. @p who names the configuration in the message.
+void enforce_icd_config(float default_icd, float min_icd, float ct, const char* who);
+
 /// @brief Checks restored categories: labels, views (when @p need_views or present), and that no id
 /// or label appears twice (DUPLICATE_ID).
 [[nodiscard]] Result<void, LearnError> validate_restored(
