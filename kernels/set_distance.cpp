@@ -19,9 +19,14 @@ float set_distance_with(std::span<const float> u, DescriptorMatrixView v, std::s
   const std::size_t nu = u.size() / v.dims;
   if (nu == 0) return 0.0F;
   if (v.count == 0) return std::numeric_limits<float>::infinity();
+  // Spare columns up to the stride (when the data and the scratch hold them) are computed too, so
+  // the kernel stays in its SIMD body; only the first count are compared.
+  DescriptorMatrixView computed = v;
+  if (v.stride > v.count && scratch.size() >= v.stride && v.data.size() >= v.dims * v.stride)
+    computed.count = v.stride;
   double sum = 0.0;
   for (std::size_t i = 0; i < nu; ++i) {
-    rows(u.subspan(i * v.dims, v.dims), v, Metric::L2, scratch);
+    rows(u.subspan(i * v.dims, v.dims), computed, Metric::L2, scratch);
     float best = scratch[0];
     for (std::size_t j = 0; j < v.count; ++j) {
       const float d = scratch[j];

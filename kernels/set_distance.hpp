@@ -13,7 +13,10 @@ namespace orthoflow::kernels {
 
 /// @brief D(U, V): @p u holds |U| descriptors of v.dims values each, one after another (row-major,
 /// as spin_images() writes them); @p v is the stored set as a structure-of-arrays matrix.
-/// @p scratch receives one row of distances (size >= v.count).
+/// @p scratch receives one row of distances (size >= v.count). Columns count..stride (spare, e.g.
+/// zero padding to the SIMD width) are computed too when @p scratch and v.data hold them (size >=
+/// v.stride, and >= v.dims x v.stride), and never compared: a set padded to a multiple of the lane
+/// count keeps the kernel out of its scalar tail.
 /// @return D(U, V); 0 when U is empty; +infinity when V is empty and U is not; NaN when a value of
 /// either set is NaN (never a silently smaller distance).
 /// @pre u.size() is a multiple of v.dims (v.dims > 0). @note No allocation; thread-safe;

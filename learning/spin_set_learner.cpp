@@ -14,10 +14,11 @@ namespace orthoflow::learning {
 /// matrix (as D(., V) reads a V), and the descriptor it came from (retract compares it).
 struct SetView {
   std::size_t count = 0;
+  std::size_t stride = 0;  // count rounded up to COLUMN_PAD: zero columns keep D in its SIMD body
   std::vector<float> rows;
-  std::vector<float> soa;  // image_values x count
+  std::vector<float> soa;  // image_values x stride
   [[nodiscard]] kernels::DescriptorMatrixView matrix(std::size_t dims) const noexcept {
-    return {soa, dims, count, count};
+    return {soa, dims, count, stride};
   }
 };
 using SetViewPtr = std::shared_ptr<const SetView>;
@@ -49,15 +50,24 @@ namespace {
 
 using CategoryPtr = std::shared_ptr<const SetCategory>;
 
+// kernels::distances runs SIMD across a set's columns (16 lanes with AVX-512) and finishes with a
+// scalar tail; a set of 40 images would spend most of its time there (bench/RESULTS.md "ask per
+// representation"). Its columns are padded to a multiple of 16 with zeros, which D never compares.
+constexpr std::size_t COLUMN_PAD = 16;
+constexpr std::size_t padded(std::size_t n) noexcept {
+  return (n + COLUMN_PAD - 1) / COLUMN_PAD * COLUMN_PAD;
+}
+
 // The view of a descriptor that spin_set_count() accepted.
 SetViewPtr make_view(std::span<const float> descriptor, std::size_t count, std::size_t dims) {
   auto v = std::make_shared<SetView>();
   v->count = count;
   v->rows.assign(descriptor.begin() + 1,
                  descriptor.begin() + 1 + static_cast<std::ptrdiff_t>(count * dims));
-  v->soa.resize(count * dims);
+  v->stride = padded(count);
+  v->soa.assign(v->stride * dims, 0.0F);
   for (std::size_t i = 0; i < count; ++i)
-    for (std::size_t d = 0; d < dims; ++d) v->soa[d * count + i] = v->rows[i * dims + d];
+    for (std::size_t d = 0; d < dims; ++d) v->soa[d * v->stride + i] = v->rows[i * dims + d];
   return v;
 }
 
@@ -74,7 +84,7 @@ Result<std::vector<SetViewPtr>, LearnError> sets_of(DescriptorBatch views, std::
 
 // D(U, V) with a scratch of V's size.
 double set_d(const SetView& u, const SetView& v, std::size_t dims, std::vector<float>& scratch) {
-  if (scratch.size() < v.count) scratch.resize(v.count);
+  if (scratch.size() < v.stride) scratch.resize(v.stride);
   return static_cast<double>(kernels::set_distance(u.rows, v.matrix(dims), scratch));
 }
 
@@ -99,7 +109,7 @@ std::unique_ptr<SetSnapshot> finish(std::vector<CategoryPtr> categories, std::ui
   std::vector<PairSum> sums;
   for (const CategoryPtr& c : s->categories) {
     s->views += c->views.size();
-    for (const SetViewPtr& v : c->views) s->stored_floats += 2 * v->rows.size();
+    for (const SetViewPtr& v : c->views) s->stored_floats += v->rows.size() + v->soa.size();
     // category_icds() divides a sum over unordered pairs by n (n - 1) / 2: half the ordered sum.
     sums.push_back(PairSum{c->views.size(), 0.5 * c->ordered_sum});
   }
@@ -139,7 +149,7 @@ Result<CategoryId, LearnError> SpinSetLearner::teach(std::string_view label,
 }
 
 void SpinSetLearner::prepare(AskScratch& scratch) const {
-  scratch.reserve_distances(cfg_.set.max_keypoints);
+  scratch.reserve_distances(padded(cfg_.set.max_keypoints));
 }
 
 Prediction SpinSetLearner::ask(std::span<const float> descriptor,

@@ -75,4 +75,34 @@ TEST(SetDistance, TheKernelEqualsTheScalarTwinWithinTolerance) {
   }
 }
 
+// V stored with spare columns up to a stride of 16 (zeros, or NaN: never compared): the same D as
+// without them (within the kernel's tolerance: the spare columns move columns out of the scalar
+// tail), and exactly the scalar twin's result on the padded view.
+TEST(SetDistance, SpareColumnsUpToTheStrideAreNeverCompared) {
+  std::mt19937 rng(12);
+  std::uniform_real_distribution<float> value(0.0F, 0.1F);
+  for (const std::size_t dims : {1U, 45U, 153U}) {
+    for (const std::size_t nv : {1U, 7U, 16U, 17U, 40U}) {
+      const std::size_t stride = (nv + 15) / 16 * 16;
+      std::vector<float> a(5 * dims), b(nv * dims);
+      for (float& x : a) x = value(rng);
+      for (float& x : b) x = value(rng);
+      const Set u(a, dims), v(b, dims);
+      for (const float spare : {0.0F, std::numeric_limits<float>::quiet_NaN()}) {
+        std::vector<float> padded(dims * stride, spare);
+        for (std::size_t k = 0; k < dims; ++k)
+          for (std::size_t j = 0; j < nv; ++j) padded[k * stride + j] = v.soa[k * nv + j];
+        const ok::DescriptorMatrixView pv{padded, dims, nv, stride};
+        std::vector<float> scratch(stride), short_scratch(nv);
+        const float twin = ok::set_distance_scalar(u.rows, v.matrix(), scratch);
+        EXPECT_NEAR(ok::set_distance(u.rows, pv, scratch), twin, 1e-5F * twin) << dims << " " << nv;
+        EXPECT_NEAR(ok::set_distance(u.rows, pv, short_scratch), twin, 1e-5F * twin)
+            << "a scratch of count: the spare columns are skipped";
+        EXPECT_EQ(ok::set_distance_scalar(u.rows, pv, scratch), twin)
+            << "the twin, column by column";
+      }
+    }
+  }
+}
+
 }  // namespace
