@@ -42,6 +42,18 @@ static dds_qos_t* qos(int reliable, int depth) {
   return q;
 }
 
+/* A command written before the bridge's command reader has matched this writer (discovery runs
+ * per endpoint, and over a lossy link the objects can match first) is never delivered: volatile
+ * samples go to the readers matched when they are written. So the command waits until its writer
+ * and the acknowledgement reader have each matched the bridge. */
+static int command_matched(dds_entity_t w_cmd, dds_entity_t r_ack) {
+  dds_publication_matched_status_t pub;
+  dds_subscription_matched_status_t sub;
+  return dds_get_publication_matched_status(w_cmd, &pub) == DDS_RETCODE_OK &&
+         dds_get_subscription_matched_status(r_ack, &sub) == DDS_RETCODE_OK &&
+         pub.current_count > 0 && sub.current_count > 0;
+}
+
 int main(int argc, char** argv) {
   const char* graph = "tabletop";
   const char* teach = NULL;
@@ -136,7 +148,8 @@ int main(int argc, char** argv) {
                                o->pose.orientation.z * o->pose.orientation.z +
                                o->pose.orientation.w * o->pose.orientation.w);
         if (fabs(qn - 1.0) > 1e-6) printf("bad quaternion: track %" PRIu64 "\n", o->track_id);
-        if (want_command && !sent && o->track_id != 0 && o->track_id < 0xffffffffULL) {
+        if (want_command && !sent && o->track_id != 0 && o->track_id < 0xffffffffULL &&
+            command_matched(w_cmd, r_ack)) {
           orthoflow_msgs_msg_dds__LearningCommand_ c;
           memset(&c, 0, sizeof c);
           c.client = client;
