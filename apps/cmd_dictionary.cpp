@@ -26,6 +26,7 @@
 #include "apps/commands.hpp"
 #include "apps/graph_segmentation.hpp"
 #include "formats/pcd_io.hpp"
+#include "kernels/frame_labels.hpp"
 #include "kernels/pinhole_regrid.hpp"
 #include "kernels/segmentation_chain.hpp"
 #include "kernels/spin_features.hpp"
@@ -94,6 +95,7 @@ std::vector<kernels::PointCloud> objects_in_scenes(const std::vector<std::string
   std::vector<kernels::PointCloud> objects;
   std::unique_ptr<kernels::SegmentationChain> chain;
   std::size_t chain_points = 0;
+  std::vector<std::uint32_t> labels;
   for (const std::filesystem::path& file : files) {
     auto cloud = formats::read_pcd(file);
     if (!cloud) fail(file.string() + ": " + cloud.error().to_string(), EXIT_BAD_INPUT);
@@ -110,18 +112,23 @@ std::vector<kernels::PointCloud> objects_in_scenes(const std::vector<std::string
     }
     auto result = chain->run(cloud->view());
     if (!result) fail(file.string() + ": " + result.error().to_string(), EXIT_BAD_INPUT);
+    // Per-point labels need the organized chain (a voxel-grid chain labels voxels, not points).
+    if (!result->organized)
+      fail(file.string() + ": the graph's segmentation is not the organized chain", EXIT_BAD_INPUT);
+    // The one point-to-object rule (kernels::frame_labels, as `segment --labels-out` writes it).
+    labels.resize(cloud->size());
+    kernels::frame_labels(cloud->points(), result->plane.plane, seg->stages.ransac.tau,
+                          seg->stages.roi, result->labels, result->candidate_of, labels);
     const std::size_t first = objects.size();
-    objects.resize(first + result->candidates.size());
     std::vector<std::vector<std::size_t>> members(result->candidates.size());
     const auto points = cloud->points();
-    for (std::size_t i = 0; i < result->labels.size(); ++i) {
-      const std::int32_t c = result->labels[i];
-      if (c < 0 || static_cast<std::size_t>(c) >= result->candidate_of.size()) continue;
-      const std::int32_t k = result->candidate_of[static_cast<std::size_t>(c)];
-      if (k >= 0 && std::isfinite(points.x[i]) && std::isfinite(points.y[i]) &&
-          std::isfinite(points.z[i]))
-        members[static_cast<std::size_t>(k)].push_back(i);
+    for (std::size_t i = 0; i < labels.size(); ++i) {
+      const std::size_t k = labels[i] - kernels::FIRST_OBJECT_LABEL;  // wraps for 0 and 1
+      if (labels[i] >= kernels::FIRST_OBJECT_LABEL && k < members.size() &&
+          std::isfinite(points.x[i]) && std::isfinite(points.y[i]) && std::isfinite(points.z[i]))
+        members[k].push_back(i);
     }
+    objects.resize(first + members.size());
     for (std::size_t k = 0; k < members.size(); ++k) {
       kernels::PointCloud& o = objects[first + k];
       o.resize_unorganized(members[k].size());
