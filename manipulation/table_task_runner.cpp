@@ -114,6 +114,7 @@ Result<void, std::string> TableTaskRunner::start(std::span<const std::string> kn
   }
   occupied_ = std::move(plan.occupied);
   packed_ = plan.packed;
+  packed_gap_m_ = plan.gap_m;
   state_ = State::MOVING;
   return {};
 }
@@ -209,11 +210,10 @@ bool TableTaskRunner::spots_swap(std::size_t a, std::size_t b) const {
   for (std::size_t k = 0; k < moves_.size(); ++k)  // every other place given (a retry repeats one)
     if (moves_[k].to != at_a && moves_[k].to != at_b) others.push_back({moves_[k].to, radii_[k]});
   const Footprint a_at_b{at_b, radii_[a]}, b_at_a{at_a, radii_[b]};
-  const double gap = ClearTableOptions{}.gap_m;  // as start() planned
   others.push_back(b_at_a);
-  if (!fits_in_area(options_.area, a_at_b, others, gap)) return false;
+  if (!fits_in_area(options_.area, a_at_b, others, packed_gap_m_)) return false;
   others.back() = a_at_b;
-  return fits_in_area(options_.area, b_at_a, others, gap);
+  return fits_in_area(options_.area, b_at_a, others, packed_gap_m_);
 }
 
 std::size_t TableTaskRunner::add_spheres(const SeenObject& o, std::size_t used) {

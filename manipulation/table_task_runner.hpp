@@ -206,6 +206,7 @@ class TableTaskRunner {
   std::vector<double> radii_;        ///< each move's footprint (its place was chosen for it)
   std::vector<Footprint> occupied_;  ///< clear_table: what stood in the area and stays
   bool packed_ = false;              ///< clear_table's places are packed by footprint
+  double packed_gap_m_ = 0.0;        ///< and the gap the plan kept between them
   std::string stopped_;
   std::size_t move_ = 0;
   std::int64_t move_start_ns_ = 0;

@@ -113,6 +113,7 @@ TaskPlan plan_clear_table(std::span<const TableObject> objects, const ClearTable
     return plan;
   }
   plan.packed = true;
+  plan.gap_m = options.gap_m;
   // Each object's place: the first of a fine grid, row by row (+x) from the area's min corner,
   // where its footprint fits beside everything that stands there or was given a place before it.
   // At most 1000 places along a side: a bounded search whatever the options.

@@ -71,6 +71,7 @@ struct TaskPlan {
   std::vector<Footprint> occupied;
   /// clear_table: the places are packed by footprint (the grid had no spot for every object).
   bool packed = false;
+  double gap_m = 0.0;  ///< packed: the room kept between footprints (ClearTableOptions::gap_m)
 };
 
 /// @brief A rectangle on the table (base frame x, y; min <= max).
