@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "apps/commands.hpp"
@@ -20,6 +21,7 @@
 #include "apps/graph_run.hpp"
 #include "apps/run_ui.hpp"
 #include "apps/scene_snapshot_png.hpp"
+#include "apps/spin_set_options.hpp"
 #include "engine/engine.hpp"
 #include "engine/graph.hpp"
 #include "engine/ipc_runtime.hpp"
@@ -53,7 +55,7 @@ struct RunOptions {
   // a few views of one still object, whose ICD is near zero, which makes NOCD explode for every
   // other instance (docs/TABLETOP.md measures it). NOCD (--approach 1|2) suits memories of many
   // instances.
-  float ct = graphs::DEFAULT_NN_THRESHOLD;
+  std::optional<float> ct;  // default: graphs::default_nn_threshold(the representation)
   std::string approach = "nn";
   std::string json_out;
   std::string labels_out;
@@ -70,9 +72,10 @@ struct RunOptions {
   std::string robot_frames;   // --robot-frames FILE: the robot-body filter in front of preprocess
   std::string arm_state_topic = engine::ARM_STATE_TOPIC;
   double arm_state_age_ms = 50.0;
-  std::string exclude_zones;           // --exclude-zones: C_instructor capsules, camera frame
-  std::string dictionary;              // --dictionary FILE: the describe node's bag of words
-  std::string representation = "bow";  // with --dictionary: bow, lda or local-lda
+  std::string exclude_zones;   // --exclude-zones: C_instructor capsules, camera frame
+  std::string dictionary;      // --dictionary FILE: the describe node's bag of words
+  std::string representation;  // good; spin; with --dictionary: bow (its default), lda, local-lda
+  kernels::SpinSetParams spin{};  // --spin-*
 };
 
 [[noreturn]] void fail(const std::string& message, int code) {
@@ -128,6 +131,38 @@ void add_frames_publisher(engine::GraphSpec& spec) {
   spec.nodes.push_back(std::move(publish));
 }
 
+// --representation and --dictionary: the describe node's descriptor (docs/SPIN_IMAGES.md). A set
+// of spin images needs more room per object than the graph's blocks have: the pool grows to hold
+// the frames it held before and the sets.
+void choose_representation(engine::GraphSpec& spec, const RunOptions& o) {
+  const std::string kind =
+      o.representation.empty() ? (o.dictionary.empty() ? "" : "bow") : o.representation;
+  if (kind.empty() || kind == "good") {
+    if (!o.dictionary.empty()) fail("--dictionary: GOOD has no dictionary", EXIT_USAGE);
+    if (kind.empty()) return;  // the graph's own describe node
+  }
+  const bool words = kind == "bow" || kind == "lda" || kind == "local-lda";
+  if (words && o.dictionary.empty())
+    fail("--representation " + kind + " needs --dictionary FILE", EXIT_USAGE);
+  if (!words && !o.dictionary.empty())
+    fail("--representation " + kind + " has no dictionary (drop --dictionary)", EXIT_USAGE);
+  bool found = false;
+  for (engine::NodeSpec& node : spec.nodes) {
+    if (node.kind != "describe") continue;
+    engine::ParamMap params;  // the graph's GOOD parameters stay for good; others start afresh
+    if (kind == "good") params = node.params;
+    params.assign("descriptor", kind);
+    if (words) params.assign("dictionary", o.dictionary);
+    if (kind == "spin") graphs::assign_spin_set(params, o.spin);
+    if (node.params.has("max_object_points"))
+      params.assign("max_object_points", *node.params.text("max_object_points", ""));
+    node.params = std::move(params);
+    found = true;
+  }
+  if (!found) fail("--representation: the graph has no describe node", EXIT_USAGE);
+  graphs::fit_pool_to_descriptors(spec);
+}
+
 graphs::LearningSettings learning_settings(const engine::GraphSpec& spec, const RunOptions& o) {
   graphs::LearningSettings settings;
   // The learner reads descriptors of the describe node's specification (and a store must have it
@@ -137,7 +172,9 @@ graphs::LearningSettings learning_settings(const engine::GraphSpec& spec, const 
   settings.memory.descriptor = *descriptor;
   settings.memory.learner =
       o.learner == "bayes" ? learning::LearnerKind::BAYES : learning::LearnerKind::INSTANCE;
-  settings.memory.instance.classification_threshold = o.ct;
+  settings.memory.instance.classification_threshold =
+      o.ct.value_or(o.approach == "nn" ? graphs::default_nn_threshold(*descriptor)
+                                       : graphs::DEFAULT_NN_THRESHOLD);
   settings.memory.instance.normalise = o.approach != "nn";
   settings.memory.instance.approach = o.approach == "2" ? learning::NocdApproach::MEAN_DISTANCE
                                                         : learning::NocdApproach::MIN_DISTANCE;
@@ -272,16 +309,7 @@ void run(const RunOptions& o) {
   if (!spec) fail(engine::to_string(spec.error()), EXIT_BAD_INPUT);
   override_source(*spec, o);
   apply_rate(*spec, o.rate);
-  if (!o.dictionary.empty()) {  // the bag of words instead of GOOD (docs/SPIN_IMAGES.md)
-    bool found = false;
-    for (engine::NodeSpec& node : spec->nodes) {
-      if (node.kind != "describe") continue;
-      node.params.assign("descriptor", o.representation);
-      node.params.assign("dictionary", o.dictionary);
-      found = true;
-    }
-    if (!found) fail("--dictionary: the graph has no describe node", EXIT_USAGE);
-  }
+  choose_representation(*spec, o);
   if (!o.robot_frames.empty() || !o.exclude_zones.empty()) {
     engine::ParamMap body;
     if (o.robot_frames.empty()) {
@@ -422,15 +450,20 @@ void add_run_command(CLI::App& app) {
                   "describe objects by the bag of words over this dictionary "
                   "(`orthoflow dictionary build`) instead of GOOD; a --db store must have it");
   cmd->add_option("--representation", o->representation,
-                  "with --dictionary: bow (the bag of words), lda (its topics; a dictionary built "
-                  "with --topics) or local-lda (word counts; topics learned per category)")
-      ->check(CLI::IsMember({"bow", "lda", "local-lda"}));
+                  "the describe node's descriptor: good, spin (the set of a view's spin images, "
+                  "instance learner; --spin-*), or with --dictionary: bow (the bag of words, the "
+                  "default with --dictionary), lda (its topics; a dictionary built with --topics) "
+                  "or local-lda (word counts; topics learned per category)")
+      ->check(CLI::IsMember({"good", "spin", "bow", "lda", "local-lda"}));
+  add_spin_set_options(cmd, o->spin);
   cmd->add_option("--db", o->db,
                   "perceptual memory directory (LevelDB); default: learn in memory only");
   cmd->add_option("--learner", o->learner, "instance or bayes")
       ->check(CLI::IsMember({"instance", "bayes"}));
-  cmd->add_option("--ct", o->ct,
-                  "classification threshold (L2 distance for nn, NOCD for 1|2; docs/TABLETOP.md)")
+  cmd->add_option(
+         "--ct", o->ct,
+         "classification threshold (nn: the L2 distance, default 0.3, or with spin the set "
+         "distance, default 0.15; 1|2: NOCD, default 0.3; docs/TABLETOP.md)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--approach", o->approach,
                   "instance learner: 1 (NOCD, min), 2 (NOCD, mean) or nn (plain nearest neighbour, "

@@ -52,7 +52,7 @@ std::optional<GraphError> make_nodes(Graph& graph, const NodeRegistry& registry)
           spec, Code::UNKNOWN_KIND, node.line,
           "node '" + node.name + "': unknown kind '" + node.kind + "' (known: " + known + ")");
     }
-    const NodeContext context{node.name, graph.pool.get(), graph.max_in_flight, graph.mode};
+    const NodeContext context{node.name, graph.pool.get(), graph.max_in_flight, graph.mode, &spec};
     auto node_result = (*factory)(node.params, context);
     if (!node_result) {
       return error_at(spec, Code::BAD_PARAMETER, node.line,

@@ -11,6 +11,8 @@
 
 namespace orthoflow::engine {
 
+struct GraphSpec;
+
 /// @brief One port of a node kind. Two ports connect only if their `type` strings are equal.
 struct PortSpec {
   std::string name;
@@ -30,6 +32,9 @@ struct NodeContext {
   memory_pool::BlockPool* pool = nullptr;  ///< the graph's frame pool
   std::size_t max_in_flight = 1;           ///< frames that can be in flight at once (limiter size)
   BuildMode mode = BuildMode::RUN;         ///< CHECK: validate only, connect to nothing
+  /// The whole graph, for kinds whose layout depends on another node's parameters (the tabletop
+  /// frame block's descriptor room follows the describe node's). Null when a node is made alone.
+  const GraphSpec* graph = nullptr;
 };
 
 /// @brief Where a node puts its results during process(). Implemented by the engine.

@@ -18,7 +18,7 @@ struct Layout {
   std::size_t state = 0, voxels = 0, hull = 0, objects = 0, descriptors = 0, end = 0;
 };
 
-Layout layout(std::size_t capacity) noexcept {
+Layout layout(std::size_t capacity, std::size_t room) noexcept {
   const std::size_t floats = align_up(capacity * sizeof(float));
   Layout l;
   // the raw frame with every optional field (rgb and label), as frame_payload lays it out
@@ -28,7 +28,7 @@ Layout layout(std::size_t capacity) noexcept {
   l.hull = l.voxels + 3 * floats;
   l.objects = l.hull + 2 * align_up(MAX_HULL * sizeof(double));
   l.descriptors = l.objects + 3 * floats;
-  l.end = l.descriptors + align_up(MAX_OBJECTS * MAX_DESCRIPTOR * sizeof(float));
+  l.end = l.descriptors + align_up(MAX_OBJECTS * room * sizeof(float));
   return l;
 }
 
@@ -45,15 +45,24 @@ kernels::PointsSpan xyz_at(std::byte* base, std::size_t offset, std::size_t capa
 
 }  // namespace
 
-std::size_t FrameBlock::bytes_for(std::size_t capacity) noexcept { return layout(capacity).end; }
+std::size_t FrameBlock::room_in(std::size_t block_bytes, std::size_t capacity) noexcept {
+  const std::size_t start = layout(capacity, 0).descriptors;
+  if (block_bytes <= start) return 0;
+  return (block_bytes - start) / (MAX_OBJECTS * sizeof(float)) / DESCRIPTOR_ALIGN *
+         DESCRIPTOR_ALIGN;
+}
 
-std::size_t FrameBlock::capacity_for(std::size_t block_bytes) noexcept {
+std::size_t FrameBlock::bytes_for(std::size_t capacity, std::size_t room) noexcept {
+  return layout(capacity, room).end;
+}
+
+std::size_t FrameBlock::capacity_for(std::size_t block_bytes, std::size_t room) noexcept {
   // bytes_for is increasing in capacity: binary search the largest fitting value
   std::size_t lo = 0;
   std::size_t hi = block_bytes / (8 * sizeof(float)) + 1;
   while (lo < hi) {
     const std::size_t mid = lo + (hi - lo + 1) / 2;
-    if (bytes_for(mid) <= block_bytes) {
+    if (bytes_for(mid, room) <= block_bytes) {
       lo = mid;
     } else {
       hi = mid - 1;
@@ -63,8 +72,8 @@ std::size_t FrameBlock::capacity_for(std::size_t block_bytes) noexcept {
 }
 
 FrameBlock::FrameBlock(std::span<std::byte> block, std::size_t capacity) noexcept
-    : capacity_(capacity) {
-  const Layout l = layout(capacity);
+    : capacity_(capacity), room_(room_in(block.size(), capacity)) {
+  const Layout l = layout(capacity, room_);
   std::byte* base = block.data();
   raw_ = block.first(l.state);
   // FrameState is an implicit-lifetime aggregate of trivially copyable parts; the block outlives
@@ -74,7 +83,7 @@ FrameBlock::FrameBlock(std::span<std::byte> block, std::size_t capacity) noexcep
   hull_u_ = at<double>(base, l.hull, MAX_HULL);
   hull_v_ = at<double>(base, l.hull + align_up(MAX_HULL * sizeof(double)), MAX_HULL);
   object_points_ = xyz_at(base, l.objects, capacity);
-  descriptors_ = at<float>(base, l.descriptors, MAX_OBJECTS * MAX_DESCRIPTOR);
+  descriptors_ = at<float>(base, l.descriptors, MAX_OBJECTS * room_);
 }
 
 Result<engine::FrameView, engine::FrameError> FrameBlock::frame() const noexcept {
@@ -93,7 +102,7 @@ kernels::PointsView FrameBlock::object_view(std::size_t i) const noexcept {
 }
 
 std::span<float> FrameBlock::descriptor(std::size_t i) const noexcept {
-  return descriptors_.subspan(i * MAX_DESCRIPTOR, MAX_DESCRIPTOR);
+  return descriptors_.subspan(i * room_, room_);
 }
 
 }  // namespace orthoflow::graphs

@@ -6,7 +6,10 @@
 /// stages and nothing is allocated). Regions, each 64-byte aligned:
 ///   raw frame | FrameState (counts, plane, objects, truth) | voxel centroids | hull | object
 ///   points | descriptors.
-/// Capacity (points per frame) follows from the pool's block size: capacity_for(block_bytes).
+/// Capacity (points per frame) follows from the pool's block size and the descriptor room the graph
+/// needs per object: capacity_for(block_bytes, room). The descriptors region is the rest of the
+/// block, split evenly among MAX_OBJECTS objects in whole DESCRIPTOR_ALIGN steps, so a block
+/// sized for a larger room (a set of spin images) gives every object that room.
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -26,7 +29,16 @@ namespace orthoflow::graphs {
 inline constexpr std::size_t MAX_OBJECTS = 64;    ///< candidate objects kept per frame
 inline constexpr std::size_t MAX_HULL = 2048;     ///< support-polygon vertices kept
 inline constexpr std::size_t MAX_GOOD_BINS = 20;  ///< descriptor room: 3 * 20^2 floats per object
+/// The least descriptor room per object: GOOD's largest, and every histogram (bag of words,
+/// topics).
 inline constexpr std::size_t MAX_DESCRIPTOR = 3 * MAX_GOOD_BINS * MAX_GOOD_BINS;
+inline constexpr std::size_t DESCRIPTOR_ALIGN = 16;  ///< rooms are whole steps of 16 floats
+/// @brief The room (floats per object) for descriptors of @p length values: at least
+/// MAX_DESCRIPTOR, rounded up to DESCRIPTOR_ALIGN.
+[[nodiscard]] constexpr std::size_t descriptor_room_for(std::size_t length) noexcept {
+  const std::size_t n = length < MAX_DESCRIPTOR ? MAX_DESCRIPTOR : length;
+  return (n + DESCRIPTOR_ALIGN - 1) / DESCRIPTOR_ALIGN * DESCRIPTOR_ALIGN;
+}
 inline constexpr std::size_t MAX_TRUTH = 64;  ///< ground-truth objects a source can describe
 
 /// @brief Fixed-capacity text (labels, categories, node names): copying never allocates.
@@ -132,12 +144,19 @@ struct FrameState {
 /// @brief Typed view of one pool block. Cheap to make (pointer arithmetic only).
 class FrameBlock {
  public:
-  /// @brief Block bytes needed for frames of up to @p capacity points.
-  [[nodiscard]] static std::size_t bytes_for(std::size_t capacity) noexcept;
-  /// @brief Largest capacity a block of @p block_bytes holds (0 if not even one point).
-  [[nodiscard]] static std::size_t capacity_for(std::size_t block_bytes) noexcept;
+  /// @brief Block bytes needed for frames of up to @p capacity points with @p room descriptor
+  /// floats per object (@pre a multiple of DESCRIPTOR_ALIGN: descriptor_room_for()).
+  [[nodiscard]] static std::size_t bytes_for(std::size_t capacity,
+                                             std::size_t room = MAX_DESCRIPTOR) noexcept;
+  /// @brief Largest capacity a block of @p block_bytes holds with @p room descriptor floats per
+  /// object (0 if not even one point).
+  [[nodiscard]] static std::size_t capacity_for(std::size_t block_bytes,
+                                                std::size_t room = MAX_DESCRIPTOR) noexcept;
+  /// @brief Descriptor floats per object a block of @p block_bytes holding @p capacity points
+  /// leaves after the other regions (a multiple of DESCRIPTOR_ALIGN).
+  [[nodiscard]] static std::size_t room_in(std::size_t block_bytes, std::size_t capacity) noexcept;
   /// @brief Views @p block. @pre block.size() >= bytes_for(capacity), 64-byte aligned (pool blocks
-  /// are).
+  /// are). Every object's descriptor room is what the block holds after the other regions.
   FrameBlock(std::span<std::byte> block, std::size_t capacity) noexcept;
 
   /// @brief Where a source writes the raw frame (engine::write_frame / layout_frame).
@@ -153,9 +172,12 @@ class FrameBlock {
   [[nodiscard]] kernels::PointsSpan object_points() const noexcept { return object_points_; }
   /// @brief Points of object @p i (after the objects stage).
   [[nodiscard]] kernels::PointsView object_view(std::size_t i) const noexcept;
-  /// @brief Descriptor room of object @p i (MAX_DESCRIPTOR floats).
+  /// @brief Descriptor room of object @p i (descriptor_room() floats).
   [[nodiscard]] std::span<float> descriptor(std::size_t i) const noexcept;
   [[nodiscard]] std::size_t capacity() const noexcept { return capacity_; }
+  /// @brief Descriptor floats per object (a multiple of DESCRIPTOR_ALIGN; MAX_DESCRIPTOR for a
+  /// block of exactly bytes_for(capacity)).
+  [[nodiscard]] std::size_t descriptor_room() const noexcept { return room_; }
 
  private:
   std::span<std::byte> raw_;
@@ -165,6 +187,7 @@ class FrameBlock {
   kernels::PointsSpan object_points_;
   std::span<float> descriptors_;
   std::size_t capacity_ = 0;
+  std::size_t room_ = 0;
 };
 
 }  // namespace orthoflow::graphs

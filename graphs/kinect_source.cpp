@@ -86,8 +86,7 @@ NodeResult make_kinect(const ParamMap& params, const engine::NodeContext& contex
   take(params.number("sim_drop_rate", 0.0, 0.0, 0.5), drop_rate, e);
   if (!e.empty()) return err(e);
   if (*capacity < kinect::DEPTH_PIXELS)
-    return err("kinect_source: pool blocks hold " + std::to_string(*capacity) +
-               " points, a 640x480 frame needs 307200 (raise pool block_bytes)");
+    return err(full_frame_too_large("kinect_source", *capacity, context));
   kinect::DeviceOptions options;
   options.camera.serial = serial;
   std::unique_ptr<drivers::UsbTransport> transport;

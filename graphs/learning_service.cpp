@@ -13,7 +13,7 @@ using Outcome = LearningAck::Outcome;
 }  // namespace
 
 /// A durable teach or forget waiting for the background writer; fixed size so queueing never
-/// allocates.
+/// allocates. Its views wait in the service's job_values_, at values_at.
 struct LearningService::Job {
   enum class Kind : std::uint8_t { TEACH, FORGET, UNDO };
   Kind kind = Kind::TEACH;
@@ -22,8 +22,13 @@ struct LearningService::Job {
   std::int64_t stamp_ns = 0;
   std::size_t views = 0;
   LearningAck ack;  // sent after the write (sequence 0: nobody to tell)
-  std::array<float, MAX_TEACH_VIEWS * MAX_DESCRIPTOR> values{};
+  std::size_t values_at = 0;
 };
+
+float default_nn_threshold(const kernels::DescriptorSpec& spec) noexcept {
+  return spec.kind == kernels::DescriptorKind::SPIN_SET ? DEFAULT_SPIN_NN_THRESHOLD
+                                                        : DEFAULT_NN_THRESHOLD;
+}
 
 learning::MemoryConfig live_session_memory_config() noexcept {
   learning::MemoryConfig cfg;
@@ -41,13 +46,12 @@ Result<std::unique_ptr<LearningService>, std::string> LearningService::open(
   if (auto valid = cfg.descriptor.validate(); !valid) return err("learning: " + valid.error());
   s->spec_ = cfg.descriptor;
   const std::size_t length = cfg.descriptor.length();
-  if (length > MAX_DESCRIPTOR)
-    return err("learning: " + cfg.descriptor.describe() + " does not fit the frame block");
   s->history_ = std::make_unique<LessonHistory>(MAX_UNDO_LESSONS, MAX_TEACH_VIEWS * length);
   if (settings.db) {
     auto memory = learning::PerceptualMemory::open(*settings.db, cfg);
     if (!memory) return err("learning: " + memory.error().to_string());
     s->memory_ = std::make_unique<learning::PerceptualMemory>(std::move(*memory));
+    s->job_values_.assign(JOBS * MAX_TEACH_VIEWS * length, 0.0F);
     s->worker_ = std::thread([raw = s.get()] { raw->worker_loop(); });
   } else {
     s->learner_ = learning::make_learner(cfg.descriptor, cfg.learner, cfg.instance, cfg.bayes);
@@ -106,7 +110,7 @@ LearningAck LearningService::teach(std::string_view label, std::span<const float
   job->stamp_ns = stamp_ns;
   job->views = count;
   job->ack = ack;
-  std::copy_n(views.begin(), count * length, job->values.begin());
+  std::copy_n(views.begin(), count * length, claim_values(*job).begin());
   jobs_.publish();
   ack.outcome = Outcome::STORED;  // on its way: the writer acknowledges after the synced write
   return ack;
@@ -126,6 +130,7 @@ LearningAck LearningService::forget(std::string_view label, LearningAck ack) noe
   job->label.assign(label);
   job->views = 0;
   job->ack = ack;
+  claim_values(*job);
   jobs_.publish();
   ack.outcome = Outcome::STORED;
   return ack;
@@ -149,11 +154,23 @@ LearningAck LearningService::undo(LearningAck ack) noexcept {
   job->label.assign(lesson.label);
   job->views = ack.views;
   job->ack = ack;
-  std::copy(lesson.values.begin(), lesson.values.end(), job->values.begin());
+  std::copy(lesson.values.begin(), lesson.values.end(), claim_values(*job).begin());
   jobs_.publish();
   history_->pop();
   ack.outcome = Outcome::STORED;
   return ack;
+}
+
+// Every ring slot has its own room in job_values_: the n-th job claimed sits in slot n % JOBS.
+std::span<float> LearningService::claim_values(Job& job) noexcept {
+  job.values_at = (jobs_claimed_++ % JOBS) * MAX_TEACH_VIEWS * descriptor_length();
+  return std::span<float>(job_values_)
+      .subspan(job.values_at, MAX_TEACH_VIEWS * descriptor_length());
+}
+
+std::span<const float> LearningService::values_of(const Job& job) const noexcept {
+  return std::span<const float>(job_values_)
+      .subspan(job.values_at, MAX_TEACH_VIEWS * descriptor_length());
 }
 
 // One durable write, then its acknowledgement (only now is the lesson on disk and visible to asks).
@@ -161,7 +178,7 @@ void LearningService::run_job(const Job& job) noexcept {
   LearningAck ack = job.ack;
   const std::size_t length = descriptor_length();
   if (job.kind == Job::Kind::UNDO) {
-    const std::span<const float> values(job.values.data(), job.views * length);
+    const auto values = values_of(job).first(job.views * length);
     auto undone = memory_->retract(job.label.view(), {values, length});
     const bool failed = !undone && undone.error().code == learning::MemoryError::Code::WRITE_FAILED;
     finish(ack, undone.has_value(), failed ? Outcome::WRITE_FAILED : Outcome::NOTHING_TO_UNDO);
@@ -175,10 +192,10 @@ void LearningService::run_job(const Job& job) noexcept {
     return;
   }
   std::vector<learning::ViewRecord> records(job.views);  // the writer thread may allocate
+  const auto values = values_of(job);
   for (std::size_t v = 0; v < job.views; ++v) {
-    records[v].descriptor.assign(
-        job.values.begin() + static_cast<std::ptrdiff_t>(v * length),
-        job.values.begin() + static_cast<std::ptrdiff_t>((v + 1) * length));
+    const auto view = values.subspan(v * length, length);
+    records[v].descriptor.assign(view.begin(), view.end());
     records[v].track_id = job.track_id;
     records[v].stamp_ns = job.stamp_ns;
   }

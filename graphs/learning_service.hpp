@@ -36,6 +36,12 @@ namespace orthoflow::graphs {
 /// distance. A category taught from a few views of one still object has an ICD near zero, which
 /// makes the thesis's NOCD explode for every other instance; docs/TABLETOP.md has the measurements.
 inline constexpr float DEFAULT_NN_THRESHOLD = 0.3F;
+/// @brief The same for sets of spin images: Unknown beyond this set distance D(T, O). On the
+/// embedded session's seeds 1-3 every taught category's views, new instances included, were within
+/// 0.114 of their category and the never-taught plate 0.201 or more from any (docs/TABLETOP.md).
+inline constexpr float DEFAULT_SPIN_NN_THRESHOLD = 0.15F;
+/// @brief DEFAULT_SPIN_NN_THRESHOLD for a set of spin images, else DEFAULT_NN_THRESHOLD.
+[[nodiscard]] float default_nn_threshold(const kernels::DescriptorSpec& spec) noexcept;
 /// @brief Senders that can be connected at once.
 inline constexpr std::size_t MAX_LEARNING_CLIENTS = 8;
 /// @brief Views one teach stores at most (a track's key views and its current view).
@@ -138,6 +144,9 @@ class LearningService {
   LearningService();
   void worker_loop() noexcept;
   void run_job(const Job& job) noexcept;
+  /// The recognise node: the views' room of the job just claimed (before publish).
+  std::span<float> claim_values(Job& job) noexcept;
+  [[nodiscard]] std::span<const float> values_of(const Job& job) const noexcept;
   std::uint64_t enqueue(LearningCommand command) noexcept;
   void disconnect(std::uint32_t slot) noexcept;
   LearningAck finish(LearningAck ack, bool ok, LearningAck::Outcome failure) noexcept;
@@ -150,6 +159,9 @@ class LearningService {
   core::SpscRing<LearningCommand> commands_{64};
   std::array<ClientSlot, MAX_LEARNING_CLIENTS> clients_{};
   core::SpscRing<Job> jobs_;  // recognise node -> durable writer
+  /// Durable: room for MAX_TEACH_VIEWS views of every job slot (sized once by open()).
+  std::vector<float> job_values_;
+  std::size_t jobs_claimed_ = 0;  // the recognise node's
   std::atomic<bool> stop_{false};
   std::atomic<std::uint64_t> teaches_{0}, refused_{0}, commands_dropped_{0}, acks_dropped_{0};
   std::thread worker_;

@@ -27,6 +27,11 @@ inline const engine::PortSpec OBJECT_OUT{"out", "object", false};
 /// small for even a tiny frame (start-up only).
 [[nodiscard]] Result<std::size_t, std::string> frame_capacity(const engine::NodeContext& context);
 
+/// @brief A source's error when the pool's blocks hold @p capacity points, fewer than a 640x480
+/// frame: the block_bytes the graph needs, with its descriptor room (start-up only).
+[[nodiscard]] std::string full_frame_too_large(std::string_view kind, std::size_t capacity,
+                                               const engine::NodeContext& context);
+
 /// @brief The frame block a message carries. @pre message.payload holds a block of the graph's
 /// pool.
 [[nodiscard]] inline FrameBlock block_of(const engine::Message& message,

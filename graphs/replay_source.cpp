@@ -144,8 +144,7 @@ NodeResult make_replay(const ParamMap& params, const engine::NodeContext& contex
   if (pace != "recorded" && pace != "max")
     return err("replay_source: pace must be recorded or max, not '" + pace + "'");
   if (*capacity < kinect::DEPTH_PIXELS)
-    return err("replay_source: pool blocks hold " + std::to_string(*capacity) +
-               " points, a 640x480 frame needs 307200 (raise pool block_bytes)");
+    return err(full_frame_too_large("replay_source", *capacity, context));
   auto index = formats::read_fakenect_index(dir);
   if (!index) return err("replay_source: " + index.error().to_string());
   std::vector<formats::FakenectEntry> depth;

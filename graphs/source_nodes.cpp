@@ -124,8 +124,7 @@ NodeResult make_synthetic(const ParamMap& params, const engine::NodeContext& con
   take(params.integer("objects", 0, 0, simulation::MAX_SCENE_OBJECTS), objects, e);
   if (!e.empty()) return err(e);
   if (*capacity < 640 * 480)
-    return err("synthetic_source: pool blocks hold " + std::to_string(*capacity) +
-               " points, a 640x480 frame needs 307200 (raise pool block_bytes)");
+    return err(full_frame_too_large("synthetic_source", *capacity, context));
   auto script = objects == 0 ? make_session_script(frames, seed)
                              : simulation::make_sequence_script(static_cast<std::uint32_t>(objects),
                                                                 frames, seed);

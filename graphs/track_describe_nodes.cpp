@@ -101,7 +101,7 @@ class Describe final : public engine::Node {
   Describe(std::size_t capacity, const kernels::DescriptorSpec& spec, std::size_t slots,
            std::size_t max_object_points)
       : capacity_(capacity), describers_(slots * MAX_OBJECTS, kernels::Describer(spec)) {
-    if (spec.local()) {  // bow, lda or local-lda: spin features first
+    if (spec.spin_features()) {  // spin, bow, lda or local-lda: spin features first
       // More scratches than the arena can run at once: hardware threads, and never fewer than 4.
       const std::size_t workers = std::max<std::size_t>(4, std::thread::hardware_concurrency());
       pool_ = std::make_unique<FeaturePool>(workers + 1, max_object_points, spec);
@@ -114,8 +114,8 @@ class Describe final : public engine::Node {
   bool stateful() const noexcept override { return false; }
 
   // Runs concurrently for different objects: each (slot, object) has its own describer and its own
-  // record and descriptor region in the block, so no two calls touch the same memory; a bag of
-  // words takes a spin-feature scratch of the pool for the call.
+  // record and descriptor region in the block, so no two calls touch the same memory; a set of
+  // spin images or a bag of words takes a spin-feature scratch of the pool for the call.
   void process(const Message& in, Emitter& out) noexcept override {
     if (in.object_count > 0 && in.object_index < MAX_OBJECTS) {
       const FrameBlock block = block_of(in, capacity_);
@@ -173,6 +173,14 @@ NodeResult make_describe(const ParamMap& params, const engine::NodeContext& cont
   if (!spec) return err(spec.error());
   auto max_points = parse_max_object_points(params);
   if (!max_points) return err(max_points.error());
+  const std::size_t block_bytes = context.pool == nullptr ? 0 : context.pool->block_bytes();
+  if (const std::size_t room = FrameBlock::room_in(block_bytes, *capacity); spec->length() > room)
+    return err(
+        spec->describe() + ": " + std::to_string(spec->length()) +
+        " floats per object do not fit the frame block's " + std::to_string(room) +
+        " (raise pool block_bytes to " +
+        std::to_string(FrameBlock::bytes_for(*capacity, descriptor_room_for(spec->length()))) +
+        ")");
   return std::unique_ptr<engine::Node>(
       new Describe(*capacity, *spec, context.max_in_flight, *max_points));
 }
@@ -186,8 +194,10 @@ void add_track_describe_nodes(engine::NodeRegistry& registry) {
       "lost_timeout_s, moving_speed (m/s), static_frames",
       make_track);
   registry.add("describe",
-               "per object, in parallel: descriptor and object frame: descriptor (good), bins, "
-               "mode, threshold",
+               "per object, in parallel: descriptor and object frame: descriptor (good, spin, bow, "
+               "lda, local-lda), bins, mode, threshold; spin: spin_keypoints, spin_width, "
+               "spin_support (m), spin_leaf (m); bow, lda, local-lda: dictionary, local_topics; "
+               "max_object_points",
                make_describe);
 }
 

@@ -45,6 +45,42 @@ TEST(FrameBlock, RegionsAreAlignedAndDisjoint) {
                                         engine::FRAME_FIELD_RGB | engine::FRAME_FIELD_LABEL));
 }
 
+TEST(FrameBlock, ABlockSizedForALargerRoomGivesEveryObjectThatRoom) {
+  EXPECT_EQ(descriptor_room_for(0), MAX_DESCRIPTOR);
+  EXPECT_EQ(descriptor_room_for(MAX_DESCRIPTOR), MAX_DESCRIPTOR);
+  EXPECT_EQ(descriptor_room_for(MAX_DESCRIPTOR + 1), MAX_DESCRIPTOR + DESCRIPTOR_ALIGN);
+  const std::size_t set = 1 + 128 * 153;  // a set of 128 spin images of width 8: 19,585 floats
+  const std::size_t room = descriptor_room_for(set);
+  EXPECT_EQ(room, 19'600U);
+  const std::size_t capacity = 1000;
+  const std::size_t bytes = FrameBlock::bytes_for(capacity, room);
+  EXPECT_EQ(bytes - FrameBlock::bytes_for(capacity), MAX_OBJECTS * (room - MAX_DESCRIPTOR) * 4);
+  EXPECT_EQ(FrameBlock::room_in(bytes, capacity), room);
+  EXPECT_EQ(FrameBlock::room_in(bytes - 1, capacity), room - DESCRIPTOR_ALIGN);
+  EXPECT_EQ(FrameBlock::room_in(FrameBlock::bytes_for(capacity), capacity), MAX_DESCRIPTOR);
+  EXPECT_EQ(FrameBlock::room_in(100, capacity), 0U);  // not even the other regions
+  EXPECT_GE(FrameBlock::capacity_for(bytes, room), capacity);
+  EXPECT_LT(FrameBlock::capacity_for(bytes, room), FrameBlock::capacity_for(bytes));
+  struct alignas(64) Line {
+    std::byte b[64];
+  };
+  std::vector<Line> lines(bytes / 64);
+  auto* memory = reinterpret_cast<std::byte*>(lines.data());
+  const FrameBlock block({memory, bytes}, capacity);
+  EXPECT_EQ(block.descriptor_room(), room);
+  const auto last = block.descriptor(MAX_OBJECTS - 1);
+  EXPECT_EQ(last.size(), room);
+  EXPECT_EQ(reinterpret_cast<const std::byte*>(last.data() + last.size()), memory + bytes);
+  EXPECT_EQ(block.descriptor(1).data(), block.descriptor(0).data() + room);
+  // the regions before the descriptors do not move with the room
+  std::vector<Line> small(FrameBlock::bytes_for(capacity) / 64);
+  const FrameBlock good({reinterpret_cast<std::byte*>(small.data()), small.size() * 64}, capacity);
+  EXPECT_EQ(good.descriptor_room(), MAX_DESCRIPTOR);
+  EXPECT_EQ(reinterpret_cast<const std::byte*>(block.descriptor(0).data()) - memory,
+            reinterpret_cast<const std::byte*>(good.descriptor(0).data()) -
+                reinterpret_cast<const std::byte*>(small.data()));
+}
+
 TEST(FrameError, TheFirstErrorAFrameMeetsIsTheOneItReports) {
   FrameError e;
   EXPECT_TRUE(e.empty());

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <functional>
@@ -225,6 +226,68 @@ TEST(LearningChannel, SecondThreadTeachesCorrectsAndForgetsDurably) {
   (*learning)->flush();
   EXPECT_EQ((*learning)->learner().stats().categories, 0U);
   learning->reset();
+  std::filesystem::remove_all(dir);
+}
+
+// Lessons of sets of spin images (19,585 floats a view, far past GOOD's room) through the durable
+// writer: more lessons than the writer's 16 job slots, so every slot's room is used again; every
+// value reaches the store in order, and an undo takes back exactly the last lesson.
+TEST(LearningChannel, DurableLessonsOfSpinSetsReachTheStoreValueForValue) {
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("orthoflow_spin_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  LearningSettings settings;
+  settings.db = dir;
+  settings.memory.descriptor = kernels::DescriptorSpec::make_spin_set();
+  const std::size_t length = settings.memory.descriptor.length();
+  const std::size_t images = kernels::SpinSetParams{}.image_values();
+  ASSERT_EQ(length, 19'585U);
+  auto learning = LearningService::open(settings);
+  ASSERT_TRUE(learning) << learning.error();
+  // Lesson l, view v: a set of (l + v) % 5 + 1 images whose values name the lesson and the view.
+  auto lesson = [&](std::size_t l) {
+    std::vector<float> views(MAX_TEACH_VIEWS * length, 0.0F);
+    for (std::size_t v = 0; v < MAX_TEACH_VIEWS; ++v) {
+      float* set = views.data() + v * length;
+      const std::size_t n = (l + v) % 5 + 1;
+      set[0] = static_cast<float>(n);
+      for (std::size_t i = 0; i < n * images; ++i)
+        set[1 + i] = static_cast<float>(l * 1000 + v * 10 + i % 7 + 1) * 1e-4F;
+    }
+    return views;
+  };
+  constexpr std::size_t LESSONS = 20;
+  for (std::size_t l = 0; l < LESSONS; ++l) {
+    const auto views = lesson(l);
+    LearningAck ack = (*learning)->teach(l % 2 == 0 ? "even" : "odd", views, 1, 0, {});
+    EXPECT_EQ(ack.outcome, Outcome::STORED) << l;
+    EXPECT_EQ(ack.views, MAX_TEACH_VIEWS);
+    (*learning)->flush();  // the ring holds 16: wait so that none is refused BUSY
+  }
+  const LearningAck undone = (*learning)->undo({});
+  EXPECT_EQ(undone.outcome, Outcome::STORED);
+  EXPECT_EQ(undone.label.view(), "odd");
+  (*learning)->flush();
+  EXPECT_EQ((*learning)->learner().stats().views, (LESSONS - 1) * MAX_TEACH_VIEWS);
+  learning->reset();
+  auto memory = learning::PerceptualMemory::open(dir, settings.memory);
+  ASSERT_TRUE(memory) << memory.error().to_string();
+  for (const auto& entry : memory->list()) {
+    auto stored = memory->views_of(entry.id);
+    ASSERT_TRUE(stored);
+    const std::size_t parity = entry.label == "even" ? 0 : 1;
+    const std::size_t lessons = entry.label == "even" ? LESSONS / 2 : LESSONS / 2 - 1;
+    ASSERT_EQ(stored->size(), lessons * MAX_TEACH_VIEWS) << entry.label;
+    for (std::size_t k = 0; k < lessons; ++k) {
+      const auto views = lesson(2 * k + parity);
+      for (std::size_t v = 0; v < MAX_TEACH_VIEWS; ++v) {
+        const auto& got = (*stored)[k * MAX_TEACH_VIEWS + v].descriptor;
+        ASSERT_EQ(got.size(), length);
+        EXPECT_TRUE(std::equal(got.begin(), got.end(), views.begin() + v * length))
+            << entry.label << " lesson " << k << " view " << v;
+      }
+    }
+  }
   std::filesystem::remove_all(dir);
 }
 

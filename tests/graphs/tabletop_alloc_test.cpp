@@ -254,6 +254,49 @@ TEST(TabletopAllocations, WithLocalLdaNothingIsAllocatedPerFrame) {
   expect_no_allocation_over_words("local-lda");
 }
 
+// Every object described by its set of spin images (the thesis's sets, up to 128 images: 19,585
+// floats, in a frame block grown for them) and asked by the set learner: nothing allocated per
+// frame either.
+TEST(TabletopAllocations, WithSetsOfSpinImagesNothingIsAllocatedPerFrame) {
+  auto spec = test::tabletop_spec({{"source", {{"objects", "5"}, {"frames", "60"}}},
+                                   {"recognise", {{"instructor", "0"}}},
+                                   {"describe", {{"descriptor", "spin"}}}});
+  fit_pool_to_descriptors(spec);
+  auto descriptor = descriptor_of_graph(spec);
+  ASSERT_TRUE(descriptor) << descriptor.error();
+  ASSERT_EQ(descriptor->kind, kernels::DescriptorKind::SPIN_SET);
+  const std::size_t length = descriptor->length();
+  const std::size_t images = descriptor->spin_set.image_values();
+  LearningSettings settings;
+  settings.memory.descriptor = *descriptor;
+  auto learning = LearningService::open(settings);
+  ASSERT_TRUE(learning) << learning.error();
+  for (const char* label : {"thing", "other"}) {  // sets of 3 images each
+    std::vector<float> set(length, 0.0F);
+    set[0] = 3.0F;
+    for (std::size_t i = 0; i < 3 * images; ++i)
+      set[1 + i] = static_cast<float>((i + label[0]) % 9) / 64.0F;
+    ASSERT_TRUE((*learning)->teach(label, set, 0, 0, {}).ok());
+  }
+  auto json = LineWriter::open("/dev/null");
+  ASSERT_TRUE(json);
+  SessionLog log(std::move(*json));
+  const auto registry = make_tabletop_registry(**learning, log);
+  auto graph = engine::build_graph(spec, registry);
+  ASSERT_TRUE(graph) << engine::to_string(graph.error());
+  engine::Engine engine(**graph, {2});
+  std::atomic<bool> stop{false};
+  std::thread arm = count_after_warm_up(log, stop);
+  engine.run({});
+  g_counting.store(false);
+  stop.store(true);
+  arm.join();
+  EXPECT_EQ(log.summary().frames, 60U);
+  EXPECT_GT(log.summary().object_views, 100U);
+  EXPECT_GT(log.summary().recognitions, 100U) << "the objects were described and asked as sets";
+  EXPECT_EQ(g_allocations.load(), 0U);
+}
+
 TEST(LabelsWriterAllocations, OfferingAFrameAllocatesNothing) {
   // --labels-out on the frame path: copying a frame into a writer cloud and labelling it allocates
   // nothing (the writer thread's encoding does, off the frame path, and is not counted here).

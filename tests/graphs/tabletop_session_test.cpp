@@ -13,6 +13,7 @@
 #include <string>
 
 #include "formats/pcd_io.hpp"
+#include "graphs/descriptor_params.hpp"
 #include "tabletop_run.hpp"
 #include "tests/support/unorganized_copy.hpp"
 
@@ -37,7 +38,9 @@ SessionRun run_graph(const test::Overrides& overrides, int threads, LearningServ
     EXPECT_TRUE(json);
     SessionLog log(std::move(*json));
     const auto registry = make_tabletop_registry(learning, log);
-    auto graph = engine::build_graph(test::tabletop_spec(overrides), registry);
+    auto spec = test::tabletop_spec(overrides);
+    fit_pool_to_descriptors(spec);  // what `orthoflow run --representation spin` does
+    auto graph = engine::build_graph(spec, registry);
     EXPECT_TRUE(graph) << engine::to_string(graph.error());
     engine::Engine engine(**graph, {threads});
     engine.run({});
@@ -91,6 +94,40 @@ TEST(TabletopSession, TracksTeachesAndRecognises) {
     }
   }
   EXPECT_GE(plates, 45);  // the plate is on the table for the last 50 frames
+}
+
+// The same session with every object described by its set of spin images (the thesis's sets: IW 8,
+// SL 10 cm, VS 4 cm, up to 128 images), asked by the plain nearest set with Unknown beyond
+// DEFAULT_SPIN_NN_THRESHOLD: the sets travel in the frame block, the track's key views and the
+// lessons.
+TEST(TabletopSession, SetsOfSpinImagesTeachAndRecogniseInTheGraph) {
+  LearningSettings settings;
+  settings.memory.descriptor = kernels::DescriptorSpec::make_spin_set();
+  settings.memory.instance.classification_threshold =
+      default_nn_threshold(settings.memory.descriptor);
+  auto learning = LearningService::open(settings);
+  ASSERT_TRUE(learning) << learning.error();
+  const auto r = run_graph({{"source", {{"frames", "90"}}}, {"describe", {{"descriptor", "spin"}}}},
+                           2, **learning);
+  const SessionSummary& s = r.summary;
+  ASSERT_EQ(s.frames, 90U);
+  EXPECT_EQ(s.taught, (std::vector<std::string>{"bowl", "bottle", "mug"}));
+  EXPECT_EQ(s.teaches, 9U);
+  EXPECT_GE((*learning)->learner().stats().views, 9U);  // a lesson stores the key views too
+  EXPECT_GT(s.new_instances.asked, 60U);
+  EXPECT_GT(s.new_instances.rate(), 0.9);
+  EXPECT_GT(s.after_teaching.rate(), 0.9);
+  EXPECT_GT(s.before_teaching.rate(), 0.95);
+  int plates = 0;
+  for (const auto& f : r.frames) {
+    for (const auto& o : f["objects"]) {
+      if (o["truth"] != "plate") continue;
+      ++plates;
+      EXPECT_TRUE(o["unknown"].get<bool>()) << f["frame"];
+      EXPECT_GT(o["frame"].size(), 0U) << "the object frame is there for grasping";
+    }
+  }
+  EXPECT_GE(plates, 45);
 }
 
 TEST(TabletopSession, SameOutputWhateverTheThreadCount) {
