@@ -180,6 +180,29 @@ TEST(TabletopAllocations, WithTheRobotBodyFilterNothingIsAllocatedPerFrame) {
   EXPECT_EQ(g_allocations.load(), 0U);
 }
 
+// Runs @p spec (60 frames of 5 objects) with @p learning and counts allocations after warm-up.
+void expect_frames_allocate_nothing(const engine::GraphSpec& spec, LearningService& learning,
+                                    const char* described) {
+  auto json = LineWriter::open("/dev/null");
+  ASSERT_TRUE(json);
+  SessionLog log(std::move(*json));
+  const auto registry = make_tabletop_registry(learning, log);
+  auto graph = engine::build_graph(spec, registry);
+  ASSERT_TRUE(graph) << engine::to_string(graph.error());
+  engine::Engine engine(**graph, {2});
+  std::atomic<bool> stop{false};
+  std::thread arm = count_after_warm_up(log, stop);
+  engine.run({});
+  g_counting.store(false);
+  stop.store(true);
+  arm.join();
+  EXPECT_EQ(log.summary().frames, 60U);
+  EXPECT_GT(log.summary().object_views, 100U);
+  EXPECT_GT(log.summary().recognitions, 100U)
+      << "the objects were described and asked " << described;
+  EXPECT_EQ(g_allocations.load(), 0U);
+}
+
 // The same graph describing objects by the bag of words (describe: descriptor bow, a dictionary
 // file): the spin-feature scratch of the describe node's pool is reserved once, so keypoints,
 // normals, spin images and words allocate nothing per frame either; the learner asks in words.
@@ -223,23 +246,7 @@ void expect_no_allocation_over_words(const std::string& kind) {
       (*learning)->teach("thing", std::span<const float>(views).first(length), 0, 0, {}).ok());
   ASSERT_TRUE(
       (*learning)->teach("other", std::span<const float>(views).last(length), 0, 0, {}).ok());
-  auto json = LineWriter::open("/dev/null");
-  ASSERT_TRUE(json);
-  SessionLog log(std::move(*json));
-  const auto registry = make_tabletop_registry(**learning, log);
-  auto graph = engine::build_graph(spec, registry);
-  ASSERT_TRUE(graph) << engine::to_string(graph.error());
-  engine::Engine engine(**graph, {2});
-  std::atomic<bool> stop{false};
-  std::thread arm = count_after_warm_up(log, stop);
-  engine.run({});
-  g_counting.store(false);
-  stop.store(true);
-  arm.join();
-  EXPECT_EQ(log.summary().frames, 60U);
-  EXPECT_GT(log.summary().object_views, 100U);
-  EXPECT_GT(log.summary().recognitions, 100U) << "the objects were described and asked in words";
-  EXPECT_EQ(g_allocations.load(), 0U);
+  expect_frames_allocate_nothing(spec, **learning, "in words");
 }
 
 TEST(TabletopAllocations, WithTheBagOfWordsNothingIsAllocatedPerFrame) {
@@ -278,23 +285,7 @@ TEST(TabletopAllocations, WithSetsOfSpinImagesNothingIsAllocatedPerFrame) {
       set[1 + i] = static_cast<float>((i + label[0]) % 9) / 64.0F;
     ASSERT_TRUE((*learning)->teach(label, set, 0, 0, {}).ok());
   }
-  auto json = LineWriter::open("/dev/null");
-  ASSERT_TRUE(json);
-  SessionLog log(std::move(*json));
-  const auto registry = make_tabletop_registry(**learning, log);
-  auto graph = engine::build_graph(spec, registry);
-  ASSERT_TRUE(graph) << engine::to_string(graph.error());
-  engine::Engine engine(**graph, {2});
-  std::atomic<bool> stop{false};
-  std::thread arm = count_after_warm_up(log, stop);
-  engine.run({});
-  g_counting.store(false);
-  stop.store(true);
-  arm.join();
-  EXPECT_EQ(log.summary().frames, 60U);
-  EXPECT_GT(log.summary().object_views, 100U);
-  EXPECT_GT(log.summary().recognitions, 100U) << "the objects were described and asked as sets";
-  EXPECT_EQ(g_allocations.load(), 0U);
+  expect_frames_allocate_nothing(spec, **learning, "as sets");
 }
 
 TEST(LabelsWriterAllocations, OfferingAFrameAllocatesNothing) {
