@@ -4,6 +4,8 @@
 #include <cmath>
 #include <numeric>
 
+#include "core/fnv.hpp"
+
 namespace orthoflow::kernels {
 
 bool TopicModel::consistent() const noexcept {
@@ -49,13 +51,8 @@ std::uint32_t draw_topic(std::uint32_t w, std::span<std::uint32_t> word_topic,
 }
 
 std::uint64_t document_seed(std::uint64_t model_seed, std::span<const std::uint32_t> doc) noexcept {
-  std::uint64_t h = 1469598103934665603ULL ^ model_seed;
-  for (const std::uint32_t w : doc) {
-    for (int i = 0; i < 4; ++i) {
-      h ^= (w >> (8 * i)) & 0xFFU;
-      h *= 1099511628211ULL;
-    }
-  }
+  std::uint64_t h = 1469598103934665603ULL ^ model_seed;  // the dictionary ids' basis
+  for (const std::uint32_t w : doc) h = core::fnv1a_value(h, w);
   return h;
 }
 

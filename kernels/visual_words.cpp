@@ -6,20 +6,17 @@
 #include <cstdio>
 
 #include "core/assert.hpp"
+#include "core/fnv.hpp"
 
 namespace orthoflow::kernels {
 
 namespace {
 
-constexpr std::uint64_t FNV_OFFSET = 1469598103934665603ULL;
-constexpr std::uint64_t FNV_PRIME = 1099511628211ULL;
+// The basis dictionary ids have been made with since the first dictionary file (not FNV-1a's own,
+// core::FNV_OFFSET: a digit short); kept so that stored ids stay valid.
+constexpr std::uint64_t ID_BASIS = 1469598103934665603ULL;
 
-void mix(std::uint64_t& h, std::uint64_t v) noexcept {
-  for (int i = 0; i < 8; ++i) {
-    h ^= (v >> (8 * i)) & 0xFFU;
-    h *= FNV_PRIME;
-  }
-}
+void mix(std::uint64_t& h, std::uint64_t v) noexcept { h = core::fnv1a_value(h, v); }
 
 /// The exact squared distance of the twin: double, in dimension order.
 double exact_distance(std::span<const float> f, DescriptorMatrixView w, std::size_t j) noexcept {
@@ -38,7 +35,7 @@ bool all_finite(std::span<const float> f) noexcept {
 }  // namespace
 
 std::uint64_t dictionary_id(const VisualDictionary& d) noexcept {
-  std::uint64_t h = FNV_OFFSET;
+  std::uint64_t h = ID_BASIS;
   mix(h, d.words);
   mix(h, d.dims);
   for (const float v : d.data) mix(h, std::bit_cast<std::uint32_t>(v));

@@ -4,6 +4,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "core/fnv.hpp"
 #include "core/input_limit.hpp"
 #include "learning/detail/memory_state.hpp"
 #include "learning/detail/store_dir.hpp"
@@ -74,7 +75,6 @@ struct ImportGroup {
   std::vector<ViewRecord> views;
 };
 
-constexpr std::uint64_t FNV_OFFSET = 0xcbf29ce484222325ULL;
 constexpr std::size_t MAX_LINE_BYTES = 1 << 20;  // a view line is ~15 KB at 20 bins
 
 // std::getline with bounds: a line longer than MAX_LINE_BYTES, or more than core::max_input_bytes()
@@ -95,8 +95,7 @@ LineRead read_line(std::istream& in, std::string& line, std::size_t& total) {
 
 // FNV-1a over @p text and a newline: the digest of an export file, line by line.
 std::uint64_t fnv1a(std::string_view text, std::uint64_t h) {
-  for (const char c : text) h = (h ^ static_cast<unsigned char>(c)) * 0x100000001b3ULL;
-  return (h ^ static_cast<unsigned char>('\n')) * 0x100000001b3ULL;
+  return core::fnv1a(core::fnv1a(h, text), static_cast<std::uint8_t>('\n'));
 }
 
 // The export header says how many views and categories follow; a file with fewer (cut short) or
@@ -207,7 +206,7 @@ Result<std::size_t, MemoryError> PerceptualMemory::import_from(const std::filesy
   // is refused the second time.
   std::vector<ImportGroup> groups;
   std::size_t count = 0;
-  std::uint64_t digest = fnv1a(line, FNV_OFFSET);
+  std::uint64_t digest = fnv1a(line, core::FNV_OFFSET);
   LineRead got = LineRead::LINE;
   for (std::size_t number = 2; (got = read_line(in, line, total)) == LineRead::LINE; ++number) {
     digest = fnv1a(line, digest);

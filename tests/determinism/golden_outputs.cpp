@@ -13,6 +13,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "core/fnv.hpp"
 #include "formats/pcd_io.hpp"
 #include "kernels/good.hpp"
 #include "kernels/segmentation_chain.hpp"
@@ -30,9 +31,9 @@ namespace ok = orthoflow::kernels;
 
 template <class T>
 std::string fnv1a64(std::span<const T> values) {
-  std::uint64_t h = 0xcbf29ce484222325ULL;
-  const auto* bytes = reinterpret_cast<const unsigned char*>(values.data());
-  for (std::size_t i = 0; i < values.size_bytes(); ++i) { h = (h ^ bytes[i]) * 0x100000001b3ULL; }
+  std::uint64_t h = orthoflow::core::FNV_OFFSET;
+  const auto* bytes = reinterpret_cast<const std::uint8_t*>(values.data());
+  for (std::size_t i = 0; i < values.size_bytes(); ++i) h = orthoflow::core::fnv1a(h, bytes[i]);
   char text[17];
   std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(h));
   return text;
