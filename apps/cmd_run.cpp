@@ -137,6 +137,8 @@ void add_frames_publisher(engine::GraphSpec& spec) {
 void choose_representation(engine::GraphSpec& spec, const RunOptions& o) {
   const std::string kind =
       o.representation.empty() ? (o.dictionary.empty() ? "" : "bow") : o.representation;
+  if (kind != "spin" && !(o.spin == kernels::SpinSetParams{}))
+    fail("--spin-* set the spin images of --representation spin only", EXIT_USAGE);
   if (kind.empty() || kind == "good") {
     if (!o.dictionary.empty()) fail("--dictionary: GOOD has no dictionary", EXIT_USAGE);
     if (kind.empty()) return;  // the graph's own describe node
