@@ -23,6 +23,7 @@
 #include "apps/scene_snapshot_png.hpp"
 #include "apps/spin_set_options.hpp"
 #include "engine/engine.hpp"
+#include "engine/frame_payload.hpp"
 #include "engine/graph.hpp"
 #include "engine/ipc_runtime.hpp"
 #include "engine/object_list_payload.hpp"
@@ -127,6 +128,13 @@ void add_frames_publisher(engine::GraphSpec& spec) {
   publish.kind = "ipc_publish";
   publish.params.assign("topic", topics->frames.str());
   publish.params.assign("type", "frame");
+  // The largest frame the blocks hold (every optional field), not the whole block: the block's
+  // results, a set of spin images' 19,600 floats per object among them, never leave the process.
+  const std::size_t capacity =
+      graphs::FrameBlock::capacity_for(spec.block_bytes, graphs::descriptor_room(&spec));
+  publish.params.assign("max_bytes", std::to_string(engine::frame_payload_bytes(
+                                         static_cast<std::uint32_t>(capacity), 1,
+                                         engine::FRAME_FIELD_RGB | engine::FRAME_FIELD_LABEL)));
   spec.edges.push_back(engine::EdgeSpec{output->name, "out", publish.name, "in", 0});
   spec.nodes.push_back(std::move(publish));
 }
