@@ -51,6 +51,12 @@ class SpscRing {
     return head - tail_.load(std::memory_order_acquire) == capacity_ ? nullptr
                                                                      : &slots_[head % capacity_];
   }
+  /// @brief The slot (0 .. capacity - 1) of an element claim() or peek() returned, so that a caller
+  /// can keep storage of its own per slot beside the ring (a slot's element and its storage are
+  /// then owned by the same side at the same time).
+  [[nodiscard]] std::size_t slot_of(const T* element) const noexcept {
+    return static_cast<std::size_t>(element - slots_.get());
+  }
   /// @brief Producer: publishes the slot claim() returned. @pre claim() returned non-null since the
   /// last publish.
   void publish() noexcept {

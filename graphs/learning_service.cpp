@@ -13,7 +13,7 @@ using Outcome = LearningAck::Outcome;
 }  // namespace
 
 /// A durable teach or forget waiting for the background writer; fixed size so queueing never
-/// allocates. Its views wait in the service's job_values_, at values_at.
+/// allocates. Its views wait in the service's job_values_, in its ring slot's room (job_values()).
 struct LearningService::Job {
   enum class Kind : std::uint8_t { TEACH, FORGET, UNDO };
   Kind kind = Kind::TEACH;
@@ -22,7 +22,6 @@ struct LearningService::Job {
   std::int64_t stamp_ns = 0;
   std::size_t views = 0;
   LearningAck ack;  // sent after the write (sequence 0: nobody to tell)
-  std::size_t values_at = 0;
 };
 
 float default_nn_threshold(const kernels::DescriptorSpec& spec) noexcept {
@@ -110,7 +109,7 @@ LearningAck LearningService::teach(std::string_view label, std::span<const float
   job->stamp_ns = stamp_ns;
   job->views = count;
   job->ack = ack;
-  std::copy_n(views.begin(), count * length, claim_values(*job).begin());
+  std::copy_n(views.begin(), count * length, job_values(*job).begin());
   jobs_.publish();
   ack.outcome = Outcome::STORED;  // on its way: the writer acknowledges after the synced write
   return ack;
@@ -130,7 +129,6 @@ LearningAck LearningService::forget(std::string_view label, LearningAck ack) noe
   job->label.assign(label);
   job->views = 0;
   job->ack = ack;
-  claim_values(*job);
   jobs_.publish();
   ack.outcome = Outcome::STORED;
   return ack;
@@ -154,23 +152,17 @@ LearningAck LearningService::undo(LearningAck ack) noexcept {
   job->label.assign(lesson.label);
   job->views = ack.views;
   job->ack = ack;
-  std::copy(lesson.values.begin(), lesson.values.end(), claim_values(*job).begin());
+  std::copy(lesson.values.begin(), lesson.values.end(), job_values(*job).begin());
   jobs_.publish();
   history_->pop();
   ack.outcome = Outcome::STORED;
   return ack;
 }
 
-// Every ring slot has its own room in job_values_: the n-th job claimed sits in slot n % JOBS.
-std::span<float> LearningService::claim_values(Job& job) noexcept {
-  job.values_at = (jobs_claimed_++ % JOBS) * MAX_TEACH_VIEWS * descriptor_length();
-  return std::span<float>(job_values_)
-      .subspan(job.values_at, MAX_TEACH_VIEWS * descriptor_length());
-}
-
-std::span<const float> LearningService::values_of(const Job& job) const noexcept {
-  return std::span<const float>(job_values_)
-      .subspan(job.values_at, MAX_TEACH_VIEWS * descriptor_length());
+// Every ring slot has its own room in job_values_; whoever holds the slot's job holds the room.
+std::span<float> LearningService::job_values(const Job& job) noexcept {
+  const std::size_t room = MAX_TEACH_VIEWS * descriptor_length();
+  return std::span<float>(job_values_).subspan(jobs_.slot_of(&job) * room, room);
 }
 
 // One durable write, then its acknowledgement (only now is the lesson on disk and visible to asks).
@@ -178,7 +170,7 @@ void LearningService::run_job(const Job& job) noexcept {
   LearningAck ack = job.ack;
   const std::size_t length = descriptor_length();
   if (job.kind == Job::Kind::UNDO) {
-    const auto values = values_of(job).first(job.views * length);
+    const auto values = job_values(job).first(job.views * length);
     auto undone = memory_->retract(job.label.view(), {values, length});
     const bool failed = !undone && undone.error().code == learning::MemoryError::Code::WRITE_FAILED;
     finish(ack, undone.has_value(), failed ? Outcome::WRITE_FAILED : Outcome::NOTHING_TO_UNDO);
@@ -192,7 +184,7 @@ void LearningService::run_job(const Job& job) noexcept {
     return;
   }
   std::vector<learning::ViewRecord> records(job.views);  // the writer thread may allocate
-  const auto values = values_of(job);
+  const auto values = job_values(job);
   for (std::size_t v = 0; v < job.views; ++v) {
     const auto view = values.subspan(v * length, length);
     records[v].descriptor.assign(view.begin(), view.end());

@@ -144,9 +144,9 @@ class LearningService {
   LearningService();
   void worker_loop() noexcept;
   void run_job(const Job& job) noexcept;
-  /// The recognise node: the views' room of the job just claimed (before publish).
-  std::span<float> claim_values(Job& job) noexcept;
-  [[nodiscard]] std::span<const float> values_of(const Job& job) const noexcept;
+  /// The views' room of @p job's ring slot (the recognise node fills it before publish, the
+  /// writer reads it before release).
+  [[nodiscard]] std::span<float> job_values(const Job& job) noexcept;
   std::uint64_t enqueue(LearningCommand command) noexcept;
   void disconnect(std::uint32_t slot) noexcept;
   LearningAck finish(LearningAck ack, bool ok, LearningAck::Outcome failure) noexcept;
@@ -161,7 +161,6 @@ class LearningService {
   core::SpscRing<Job> jobs_;  // recognise node -> durable writer
   /// Durable: room for MAX_TEACH_VIEWS views of every job slot (sized once by open()).
   std::vector<float> job_values_;
-  std::size_t jobs_claimed_ = 0;  // the recognise node's
   std::atomic<bool> stop_{false};
   std::atomic<std::uint64_t> teaches_{0}, refused_{0}, commands_dropped_{0}, acks_dropped_{0};
   std::thread worker_;

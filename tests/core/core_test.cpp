@@ -168,6 +168,18 @@ TEST(SpscRing, ReadableSplitsAtTheWrapAndClaimFillsInPlace) {
   EXPECT_EQ(*ring.peek(), 42);
 }
 
+TEST(SpscRing, SlotOfNamesTheSlotEachEndHolds) {
+  SpscRing<int> ring(3);
+  for (std::size_t n = 0; n < 7; ++n) {  // past two wraps: the n-th claim holds slot n % 3
+    int* claimed = ring.claim();
+    ASSERT_NE(claimed, nullptr);
+    EXPECT_EQ(ring.slot_of(claimed), n % 3);
+    ring.publish();
+    EXPECT_EQ(ring.slot_of(ring.peek()), n % 3);  // the consumer sees the same slot
+    ring.release(1);
+  }
+}
+
 TEST(SpscRing, TwoThreadsKeepOrderAndLoseNothing) {
   SpscRing<std::uint64_t> ring(64);
   constexpr std::uint64_t N = 200000;
