@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "apps/commands.hpp"
-#include "drivers/jaco_arm.hpp"
-#include "drivers/usb_transport.hpp"
+#include "drivers/jaco/jaco_arm.hpp"
+#include "drivers/usb/usb_transport.hpp"
 
 namespace orthoflow::apps::arm_cli {
 

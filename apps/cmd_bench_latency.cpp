@@ -31,8 +31,8 @@
 #include "engine/graph.hpp"
 #include "engine/histogram.hpp"
 #include "evaluation/line_plot.hpp"
-#include "graphs/descriptor_params.hpp"
 #include "graphs/embedded_graphs.hpp"
+#include "graphs/nodes/descriptor_params.hpp"
 #include "graphs/tabletop.hpp"
 #include "kernels/simd_arch.hpp"
 

@@ -24,13 +24,13 @@
 
 #include "apps/calibrate_target.hpp"
 #include "apps/commands.hpp"
-#include "drivers/jaco_kinematics.hpp"
+#include "drivers/jaco/jaco_kinematics.hpp"
 #include "formats/pcd_io.hpp"
-#include "graphs/table_task_session.hpp"
+#include "graphs/sessions/table_task_session.hpp"
 #include "kernels/sphere_target.hpp"
 #include "manipulation/arm_body.hpp"
 #include "manipulation/robot_frames.hpp"
-#include "simulation/synthetic_scene.hpp"
+#include "simulation/world/synthetic_scene.hpp"
 
 namespace orthoflow::apps {
 namespace {

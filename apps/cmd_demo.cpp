@@ -1,9 +1,9 @@
 // `orthoflow demo clear-table|serve-a-meal`: the whole closed loop of issue 21 on the simulators
-// (graphs/table_task_session.hpp): a seeded table, a person teaching every object's category, the
-// task planned from the learner's labels, and the simulated JACO moving each object under the
-// execution manager while the tabletop graph watches. Prints per move the label, the grasp, every
-// operator's time and the outcome; --scenes N runs N seeds and sums them up; --pictures DIR writes
-// the world from above as PNG frames; --json for machines.
+// (graphs/sessions/table_task_session.hpp): a seeded table, a person teaching every object's
+// category, the task planned from the learner's labels, and the simulated JACO moving each object
+// under the execution manager while the tabletop graph watches. Prints per move the label, the
+// grasp, every operator's time and the outcome; --scenes N runs N seeds and sums them up;
+// --pictures DIR writes the world from above as PNG frames; --json for machines.
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -16,7 +16,7 @@
 
 #include "apps/commands.hpp"
 #include "apps/demo_picture.hpp"
-#include "graphs/table_task_session.hpp"
+#include "graphs/sessions/table_task_session.hpp"
 
 namespace orthoflow::apps {
 namespace {

@@ -1,8 +1,9 @@
 // `orthoflow kinect list | info | stream | tilt | led | accel`: the Kinect v1 through orthoflow's
 // own driver, for people at the robot. `--sim` runs the same commands on the simulated Kinect
-// (simulation/sim_usb_transport.hpp: the documented protocol; `stream` is paced to the wall clock,
-// the motor runs on simulated time, so `tilt --wait` returns at once), so they can be tried, and
-// are tested, on machines without USB. Each --sim run starts a fresh simulator: the head is level.
+// (simulation/devices/sim_usb_transport.hpp: the documented protocol; `stream` is paced to the wall
+// clock, the motor runs on simulated time, so `tilt --wait` returns at once), so they can be tried,
+// and are tested, on machines without USB. Each --sim run starts a fresh simulator: the head is
+// level.
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -15,12 +16,12 @@
 
 #include "apps/commands.hpp"
 #include "apps/kinect_cli.hpp"
-#include "drivers/kinect_camera.hpp"
-#include "drivers/kinect_depth.hpp"
-#include "drivers/kinect_device.hpp"
-#include "drivers/kinect_motor.hpp"
-#include "drivers/libusb_transport.hpp"
-#include "simulation/sim_usb_transport.hpp"
+#include "drivers/kinect/kinect_camera.hpp"
+#include "drivers/kinect/kinect_depth.hpp"
+#include "drivers/kinect/kinect_device.hpp"
+#include "drivers/kinect/kinect_motor.hpp"
+#include "drivers/usb/libusb_transport.hpp"
+#include "simulation/devices/sim_usb_transport.hpp"
 
 namespace orthoflow::apps {
 namespace kinect_cli {
@@ -31,14 +32,12 @@ namespace kinect_cli {
 }
 std::unique_ptr<drivers::UsbTransport> make_transport(const KinectArgs& a) {
   if (a.sim) {
-    auto sim = std::make_unique<simulation::SimUsbTransport>();
-    simulation::SimKinectConfig config;
-    config.model = a.sim_model == "1473"  ? simulation::KinectModel::K1473
-                   : a.sim_model == "k4w" ? simulation::KinectModel::K4W
-                                          : simulation::KinectModel::K1414;
-    config.faults.packets.drop_rate = a.sim_drop;
-    sim->add_kinect(std::move(config));
-    return sim;
+    simulation::SimKinectHostOptions sim;
+    sim.model = a.sim_model == "1473"  ? simulation::KinectModel::K1473
+                : a.sim_model == "k4w" ? simulation::KinectModel::K4W
+                                       : simulation::KinectModel::K1414;
+    sim.drop_rate = a.sim_drop;
+    return simulation::make_sim_kinect_host(sim);
   }
   auto usb = drivers::LibusbTransport::create();
   if (!usb.has_value()) fail("cannot start libusb: " + drivers::to_string(usb.error()));

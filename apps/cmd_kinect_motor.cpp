@@ -1,10 +1,10 @@
 // `orthoflow kinect tilt DEGREES [--wait] | led MODE | accel`: the motor, LED and accelerometer
-// through orthoflow's driver (drivers/kinect_motor.hpp: the 1414 motor function, or on a 1473 /
-// K4W the running audio firmware); --sim runs them on the simulated Kinect.
-// `orthoflow kinect firmware [--file PATH]`: uploads the audio firmware of a 1473 / K4W
-// (drivers/kinect_audio.hpp). Without --file, audios.bin is searched in libfreenect's order. The
-// file is not redistributable and not shipped. With --sim the simulated Kinect (--sim-model 1473
-// or k4w) accepts any image with a valid header, so --file must name a synthetic image; the
+// through orthoflow's driver (drivers/kinect/kinect_motor.hpp: the 1414 motor function, or on a
+// 1473 / K4W the running audio firmware); --sim runs them on the simulated Kinect. `orthoflow
+// kinect firmware [--file PATH]`: uploads the audio firmware of a 1473 / K4W
+// (drivers/kinect/kinect_audio.hpp). Without --file, audios.bin is searched in libfreenect's order.
+// The file is not redistributable and not shipped. With --sim the simulated Kinect (--sim-model
+// 1473 or k4w) accepts any image with a valid header, so --file must name a synthetic image; the
 // simulated upload lives only as long as the command (a later `kinect tilt --sim` starts afresh).
 #include <chrono>
 #include <cmath>
@@ -16,16 +16,16 @@
 #include <string>
 
 #include "apps/kinect_cli.hpp"
-#include "drivers/kinect_audio.hpp"
-#include "drivers/kinect_camera.hpp"
-#include "drivers/kinect_motor.hpp"
+#include "drivers/kinect/kinect_audio.hpp"
+#include "drivers/kinect/kinect_camera.hpp"
+#include "drivers/kinect/kinect_motor.hpp"
 
 namespace orthoflow::apps::kinect_cli {
 namespace {
 
 namespace kinect = drivers::kinect;
 
-// ---- kinect tilt | led | accel: the 1414 motor function (drivers/kinect_motor.hpp) ----
+// ---- kinect tilt | led | accel: the 1414 motor function (drivers/kinect/kinect_motor.hpp) ----
 
 kinect::CameraInfo find_camera(drivers::UsbTransport& t, const KinectArgs& a) {
   auto cameras = kinect::list_cameras(t);
@@ -106,7 +106,7 @@ void run_accel(const KinectArgs& a) {
   print_state(state.value(), a.json);
 }
 
-// ---- kinect firmware: the 1473 / K4W audio firmware upload (drivers/kinect_audio.hpp) ----
+// ---- kinect firmware: the 1473 / K4W audio firmware upload (drivers/kinect/kinect_audio.hpp) ----
 
 std::string find_firmware_file(const std::string& given) {
   if (!given.empty()) return given;

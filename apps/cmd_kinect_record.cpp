@@ -15,9 +15,9 @@
 
 #include "apps/commands.hpp"
 #include "apps/kinect_cli.hpp"
-#include "drivers/kinect_device.hpp"
+#include "drivers/kinect/kinect_device.hpp"
 #include "formats/fakenect.hpp"
-#include "graphs/fakenect_calibration.hpp"
+#include "graphs/nodes/fakenect_calibration.hpp"
 #include "kernels/bayer_demosaic.hpp"
 
 namespace orthoflow::apps {

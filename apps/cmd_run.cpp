@@ -1,303 +1,51 @@
 // `orthoflow run`: the tabletop graph end to end on the embedded synthetic session (or a source
 // given on the command line), with learning, and a summary of what it saw, learned and how fast.
+// This file holds the options and the run loop; the graph and learning settings the options make
+// are in cmd_run_graph.cpp, the summary and the outputs in cmd_run_summary.cpp (apps/run_cli.hpp).
 #include <unistd.h>
 
-#include <algorithm>
 #include <atomic>
-#include <cerrno>
-#include <cmath>
 #include <csignal>
-#include <cstdio>
 #include <cstdlib>
-#include <cstring>
-#include <filesystem>
 #include <iostream>
 #include <memory>
-#include <optional>
 #include <string>
 
 #include "apps/commands.hpp"
 #include "apps/graph_overrides.hpp"
 #include "apps/graph_run.hpp"
+#include "apps/run_cli.hpp"
 #include "apps/run_ui.hpp"
-#include "apps/scene_snapshot_png.hpp"
 #include "apps/spin_set_options.hpp"
 #include "engine/engine.hpp"
-#include "engine/frame_payload.hpp"
 #include "engine/graph.hpp"
 #include "engine/ipc_runtime.hpp"
-#include "engine/object_list_payload.hpp"
-#include "graphs/arm_world_feed.hpp"
-#include "graphs/body_filter_node.hpp"
-#include "graphs/descriptor_params.hpp"
+#include "graphs/channels/learning_payloads.hpp"
 #include "graphs/embedded_graphs.hpp"
-#include "graphs/frame_block.hpp"
-#include "graphs/labels_writer.hpp"
-#include "graphs/learning_ipc_bridge.hpp"
-#include "graphs/learning_payloads.hpp"
+#include "graphs/nodes/body_filter_node.hpp"
+#include "graphs/nodes/labels_writer.hpp"
+#include "graphs/nodes/world_source.hpp"
+#include "graphs/services/learning_ipc_bridge.hpp"
+#include "graphs/sessions/arm_world_feed.hpp"
 #include "graphs/tabletop.hpp"
-#include "graphs/world_source.hpp"
 
 namespace orthoflow::apps {
 
-namespace {
-
-std::atomic<bool> g_run_stop{false};
-extern "C" void on_run_signal(int /*signal*/) { g_run_stop.store(true, std::memory_order_relaxed); }
-
-struct RunOptions {
-  std::string graph;   // empty: the embedded tabletop graph
-  std::string source;  // synthetic:SEED | pcd:DIR | kinect[:SERIAL] | kinect-sim[:SEED]
-  std::uint64_t frames = 0;
-  std::string rate;  // empty: the graph's period (30 Hz for tabletop.yaml)
-  std::string db;
-  std::string learner = "instance";
-  // Plain nearest neighbour with an absolute L2 threshold: in a live session a category starts from
-  // a few views of one still object, whose ICD is near zero, which makes NOCD explode for every
-  // other instance (docs/TABLETOP.md measures it). NOCD (--approach 1|2) suits memories of many
-  // instances.
-  std::optional<float> ct;  // default: graphs::default_nn_threshold(the representation)
-  std::string approach = "nn";
-  std::string json_out;
-  std::string labels_out;
-  std::string snapshot;
-  std::string telemetry_json;
-  bool publish_frames = false;   // every frame to orthoflow/<graph>/frames over iceoryx
-  bool publish_objects = false;  // every frame's objects to orthoflow/<graph>/objects over iceoryx
-  bool ipc_learning =
-      false;  // learning commands in, acks and status out over iceoryx (and objects)
-  std::string on_bad_frame = "skip";  // skip: count and report; fail: also exit 2
-  int threads = 0;
-  std::string ui;             // --ui [ADDR:]PORT: the web view beside the graph (empty: off)
-  std::string ui_token_file;  // --ui-token-file FILE
-  std::string robot_frames;   // --robot-frames FILE: the robot-body filter in front of preprocess
-  std::string arm_state_topic = engine::ARM_STATE_TOPIC;
-  double arm_state_age_ms = 50.0;
-  std::string exclude_zones;   // --exclude-zones: C_instructor capsules, camera frame
-  std::string dictionary;      // --dictionary FILE: the describe node's bag of words
-  std::string representation;  // good; spin; with --dictionary: bow (its default), lda, local-lda
-  kernels::SpinSetParams spin{};  // --spin-*
-};
+namespace run_cli {
 
 [[noreturn]] void fail(const std::string& message, int code) {
   std::cerr << "run: " << message << "\n";
   throw CLI::RuntimeError(code);
 }
 
-// Applies --source and --frames to the graph's source node (apps/graph_overrides.hpp).
-void override_source(engine::GraphSpec& spec, const RunOptions& o) {
-  if (auto ok = apply_source(spec, o.source, o.frames); !ok) fail(ok.error(), EXIT_USAGE);
-}
+}  // namespace run_cli
 
-// --publish-objects: an ipc_publish node on the objects_output node's objects port, topic
-// orthoflow/<graph>/objects (the graph then needs a running RouDi, like every IPC graph).
-void add_objects_publisher(engine::GraphSpec& spec) {
-  const auto output =
-      std::find_if(spec.nodes.begin(), spec.nodes.end(),
-                   [](const engine::NodeSpec& n) { return n.kind == "objects_output"; });
-  if (output == spec.nodes.end())
-    fail("--publish-objects needs a graph with an objects_output node", EXIT_USAGE);
-  engine::NodeSpec publish;
-  publish.name = "publish_objects";
-  publish.kind = "ipc_publish";
-  const auto topics = graphs::graph_topics(spec.name);
-  if (!topics)
-    fail("--publish-objects: graph name '" + spec.name + "': " + topics.error(), EXIT_USAGE);
-  publish.params.assign("topic", topics->objects.str());
-  publish.params.assign("type", "objects");
-  publish.params.assign("max_bytes", std::to_string(sizeof(engine::ObjectListPayload)));
-  spec.edges.push_back(engine::EdgeSpec{output->name, "objects", publish.name, "in", 0});
-  spec.nodes.push_back(std::move(publish));
-}
+namespace {
 
-// --publish-frames: an ipc_publish node on the objects_output node's out port (each frame as it
-// leaves the graph, with its objects decided), topic orthoflow/<graph>/frames: what `orthoflow
-// bridge dds --frames` reads. RouDi needs a pool of the graph's block size
-// (config/roudi_frames.toml).
-void add_frames_publisher(engine::GraphSpec& spec) {
-  const auto output =
-      std::find_if(spec.nodes.begin(), spec.nodes.end(),
-                   [](const engine::NodeSpec& n) { return n.kind == "objects_output"; });
-  if (output == spec.nodes.end())
-    fail("--publish-frames needs a graph with an objects_output node", EXIT_USAGE);
-  const auto topics = graphs::graph_topics(spec.name);
-  if (!topics)
-    fail("--publish-frames: graph name '" + spec.name + "': " + topics.error(), EXIT_USAGE);
-  engine::NodeSpec publish;
-  publish.name = "publish_frames";
-  publish.kind = "ipc_publish";
-  publish.params.assign("topic", topics->frames.str());
-  publish.params.assign("type", "frame");
-  // The largest frame the blocks hold (every optional field), not the whole block: the block's
-  // results, a set of spin images' 19,600 floats per object among them, never leave the process.
-  const std::size_t capacity =
-      graphs::FrameBlock::capacity_for(spec.block_bytes, graphs::descriptor_room(&spec));
-  publish.params.assign("max_bytes", std::to_string(engine::frame_payload_bytes(
-                                         static_cast<std::uint32_t>(capacity), 1,
-                                         engine::FRAME_FIELD_RGB | engine::FRAME_FIELD_LABEL)));
-  spec.edges.push_back(engine::EdgeSpec{output->name, "out", publish.name, "in", 0});
-  spec.nodes.push_back(std::move(publish));
-}
+using namespace run_cli;
 
-// --representation and --dictionary: the describe node's descriptor (docs/SPIN_IMAGES.md). A set
-// of spin images needs more room per object than the graph's blocks have: the pool grows to hold
-// the frames it held before and the sets.
-void choose_representation(engine::GraphSpec& spec, const RunOptions& o) {
-  const std::string kind =
-      o.representation.empty() ? (o.dictionary.empty() ? "" : "bow") : o.representation;
-  if (kind != "spin" && !(o.spin == kernels::SpinSetParams{}))
-    fail("--spin-* set the spin images of --representation spin only", EXIT_USAGE);
-  if (kind.empty() || kind == "good") {
-    if (!o.dictionary.empty()) fail("--dictionary: GOOD has no dictionary", EXIT_USAGE);
-    if (kind.empty()) return;  // the graph's own describe node
-  }
-  const bool words = kind == "bow" || kind == "lda" || kind == "local-lda";
-  if (words && o.dictionary.empty())
-    fail("--representation " + kind + " needs --dictionary FILE", EXIT_USAGE);
-  if (!words && !o.dictionary.empty())
-    fail("--representation " + kind + " has no dictionary (drop --dictionary)", EXIT_USAGE);
-  bool found = false;
-  for (engine::NodeSpec& node : spec.nodes) {
-    if (node.kind != "describe") continue;
-    engine::ParamMap params;  // the graph's GOOD parameters stay for good; others start afresh
-    if (kind == "good") params = node.params;
-    params.assign("descriptor", kind);
-    if (words) params.assign("dictionary", o.dictionary);
-    if (kind == "spin") graphs::assign_spin_set(params, o.spin);
-    if (node.params.has("max_object_points"))
-      params.assign("max_object_points", *node.params.text("max_object_points", ""));
-    node.params = std::move(params);
-    found = true;
-  }
-  if (!found) fail("--representation: the graph has no describe node", EXIT_USAGE);
-  graphs::fit_pool_to_descriptors(spec);
-}
-
-graphs::LearningSettings learning_settings(const engine::GraphSpec& spec, const RunOptions& o) {
-  graphs::LearningSettings settings;
-  // The learner reads descriptors of the describe node's specification (and a store must have it
-  // too).
-  auto descriptor = graphs::descriptor_of_graph(spec);
-  if (!descriptor) fail(descriptor.error(), EXIT_BAD_INPUT);
-  settings.memory.descriptor = *descriptor;
-  settings.memory.learner =
-      o.learner == "bayes" ? learning::LearnerKind::BAYES : learning::LearnerKind::INSTANCE;
-  settings.memory.instance.classification_threshold =
-      o.ct.value_or(o.approach == "nn" ? graphs::default_nn_threshold(*descriptor)
-                                       : graphs::DEFAULT_NN_THRESHOLD);
-  settings.memory.instance.normalise = o.approach != "nn";
-  settings.memory.instance.approach = o.approach == "2" ? learning::NocdApproach::MEAN_DISTANCE
-                                                        : learning::NocdApproach::MIN_DISTANCE;
-  if (!o.db.empty()) settings.db = o.db;
-  return settings;
-}
-
-std::string percent(const graphs::Score& s) {
-  char text[64];
-  std::snprintf(text, sizeof text, "%5.1f%% (%llu/%llu)", 100.0 * s.rate(),
-                static_cast<unsigned long long>(s.right), static_cast<unsigned long long>(s.asked));
-  return text;
-}
-
-void print_summary(const graphs::SessionSummary& s, const engine::GraphStats& stats,
-                   const graphs::LearningService& l) {
-  if (s.frames == 0 && stats.frames_done.load() > 0) {  // e.g. graphs/example_pipeline.yaml
-    std::cout << "frames:      " << stats.frames_done.load() << " processed, "
-              << stats.total_drops()
-              << " dropped (the graph has no session_log node: no tabletop summary)\n";
-    return;
-  }
-  std::cout << "frames:      " << s.frames << " processed, " << stats.total_drops() << " dropped ("
-            << stats.source_drops.load() << " at the source), " << s.frames_with_table
-            << " with a table, " << stats.deadline_misses.load() << " over the period, "
-            << s.frames_with_error << " with an error\n";
-  std::cout << "objects:     " << s.object_views << " object views, " << s.tracks_started
-            << " tracks, " << s.key_views << " key views\n";
-  std::cout << "recognition: " << s.recognitions << " answers; " << l.teaches() << " lessons";
-  if (!s.taught.empty()) {
-    std::cout << " (";
-    for (std::size_t i = 0; i < s.taught.size(); ++i) std::cout << (i ? ", " : "") << s.taught[i];
-    std::cout << ")";
-  }
-  std::cout << "\n";
-  if (s.before_teaching.asked + s.after_teaching.asked > 0) {
-    std::cout << "accuracy against the ground truth:\n"
-              << "  category not taught yet (Unknown is right): " << percent(s.before_teaching)
-              << "\n"
-              << "  category taught (its label is right):        " << percent(s.after_teaching)
-              << "\n"
-              << "    on instances never taught themselves:      " << percent(s.new_instances)
-              << "\n";
-  }
-}
-
-// A file the run will write at the end: its directory (and the file, if it exists) must be
-// writable.
-void check_output_path(const std::string& path, const char* flag) {
-  if (path.empty()) return;
-  const std::filesystem::path p(path);
-  const std::filesystem::path dir = p.has_parent_path() ? p.parent_path() : ".";
-  const bool ok = std::filesystem::exists(p) ? ::access(p.c_str(), W_OK) == 0
-                                             : ::access(dir.c_str(), W_OK) == 0;
-  if (!ok)
-    fail(std::string(flag) + ": cannot write '" + path + "': " + std::strerror(errno),
-         EXIT_FAILURE_GENERIC);
-}
-
-/// --labels-out: what was written; a failed write is an error (exit 1), frames the writer had to
-/// drop (every buffer still being written, or an unorganized frame) are reported.
-void report_labels(graphs::LabelsWriter& labels, const RunOptions& o) {
-  labels.flush();
-  std::cout << "labels: " << labels.written() << " frame(s) written to " << o.labels_out;
-  if (labels.dropped() > 0) {
-    std::cout << ", " << labels.dropped()
-              << " dropped (the writer was busy, or the frame was unorganized)";
-  }
-  std::cout << "\n";
-  if (const std::string e = labels.first_error(); !e.empty()) {
-    fail("--labels-out: " + e, EXIT_FAILURE_GENERIC);
-  }
-}
-
-// After the run: every output the user asked for was written whole, or the exit is non-zero; frames
-// that failed are reported (and fail the run with --on-bad-frame fail).
-void finish_outputs(const RunOptions& o, graphs::SessionLog& log, const engine::GraphStats& stats,
-                    std::unique_ptr<graphs::LineWriter> telemetry) {
-  int exit_code = EXIT_OK;
-  const graphs::SessionSummary summary = log.summary();
-  if (!summary.first_error.empty()) {
-    std::cerr << "run: " << summary.frames_with_error << " frame(s) failed; the first, frame "
-              << summary.first_error_frame << ": " << summary.first_error.to_string() << "\n";
-    if (o.on_bad_frame == "fail") exit_code = EXIT_BAD_INPUT;
-  }
-  if (log.json() != nullptr && (log.json()->dropped() > 0 || log.json()->failed())) {
-    std::cerr << "run: --json-out " << o.json_out << ": " << log.json()->dropped()
-              << " lines dropped" << (log.json()->failed() ? ", a write failed" : "") << "\n";
-    exit_code = EXIT_FAILURE_GENERIC;
-  }
-  if (telemetry) {
-    telemetry->write(engine::to_json(stats));
-    telemetry->flush();
-    if (telemetry->failed() || telemetry->dropped() > 0) {
-      std::cerr << "run: --telemetry-json " << o.telemetry_json << ": the write failed\n";
-      exit_code = EXIT_FAILURE_GENERIC;
-    }
-  }
-  if (!o.snapshot.empty()) {
-    if (auto drawn = write_scene_snapshot_png(log.snapshot(), o.snapshot); !drawn) {
-      std::cerr << "run: --snapshot: " << drawn.error() << "\n";
-      exit_code = EXIT_FAILURE_GENERIC;
-    } else {
-      std::cout << "snapshot: " << o.snapshot << "\n";
-    }
-  }
-  std::cout.flush();
-  if (!std::cout) {
-    std::cerr << "run: writing the summary to standard output failed\n";
-    exit_code = EXIT_FAILURE_GENERIC;
-  }
-  if (exit_code != EXIT_OK) throw CLI::RuntimeError(exit_code);
-}
+std::atomic<bool> g_run_stop{false};
+extern "C" void on_run_signal(int /*signal*/) { g_run_stop.store(true, std::memory_order_relaxed); }
 
 // --source world:SEED: the world of that seed, following the arm states on --arm-state-topic.
 std::unique_ptr<graphs::ArmWorldFeed> open_world(const RunOptions& o) {

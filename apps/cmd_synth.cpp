@@ -13,8 +13,8 @@
 
 #include "apps/commands.hpp"
 #include "formats/pcd_io.hpp"
-#include "simulation/object_dataset.hpp"
-#include "simulation/synthetic_scene.hpp"
+#include "simulation/world/object_dataset.hpp"
+#include "simulation/world/synthetic_scene.hpp"
 
 namespace orthoflow::apps {
 namespace {

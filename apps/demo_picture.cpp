@@ -5,7 +5,7 @@
 #include <cstdio>
 #include <memory>
 
-#include "simulation/object_catalog.hpp"
+#include "simulation/world/object_catalog.hpp"
 
 namespace orthoflow::apps {
 

@@ -6,7 +6,7 @@
 #include <string>
 
 #include "core/result.hpp"
-#include "graphs/table_task_session.hpp"
+#include "graphs/sessions/table_task_session.hpp"
 
 namespace orthoflow::apps {
 

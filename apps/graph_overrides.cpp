@@ -51,7 +51,8 @@ Result<void, std::string> apply_source(engine::GraphSpec& spec, const std::strin
     src->params.assign("dir", source.substr(7));
     spec.period_ns = 0;  // the recording's own pace (replay_source pace=recorded) unless --rate
   } else if (source.rfind("world:", 0) == 0) {
-    // The closed-loop world the process supplies (apps/cmd_run.cpp: graphs/arm_world_feed.hpp).
+    // The closed-loop world the process supplies (apps/cmd_run.cpp:
+    // graphs/sessions/arm_world_feed.hpp).
     src->kind = "world_source";
     src->params = {};
   } else if (!source.empty()) {

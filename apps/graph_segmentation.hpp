@@ -8,7 +8,7 @@
 #include "core/result.hpp"
 #include "engine/graph.hpp"
 #include "graphs/embedded_graphs.hpp"
-#include "graphs/segment_params.hpp"
+#include "graphs/nodes/segment_params.hpp"
 
 namespace orthoflow::apps {
 

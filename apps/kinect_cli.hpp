@@ -9,7 +9,7 @@
 #include <string>
 
 #include "apps/commands.hpp"
-#include "drivers/usb_transport.hpp"
+#include "drivers/usb/usb_transport.hpp"
 
 namespace orthoflow::apps::kinect_cli {
 

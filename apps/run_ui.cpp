@@ -12,7 +12,7 @@
 #include "apps/commands.hpp"
 #include "apps/graph_run.hpp"
 #include "engine/ipc_runtime.hpp"
-#include "graphs/learning_ipc_bridge.hpp"
+#include "graphs/services/learning_ipc_bridge.hpp"
 #include "ui/graph_backend.hpp"
 #include "ui/ipc_backend.hpp"
 #include "ui/ipc_task_link.hpp"

@@ -9,8 +9,8 @@
 #include <string>
 
 #include "engine/telemetry.hpp"
-#include "graphs/learning_service.hpp"
-#include "graphs/objects_output.hpp"
+#include "graphs/nodes/objects_output.hpp"
+#include "graphs/services/learning_service.hpp"
 
 namespace orthoflow::apps {
 

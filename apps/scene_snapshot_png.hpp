@@ -5,7 +5,7 @@
 #include <string>
 
 #include "core/result.hpp"
-#include "graphs/session_log.hpp"
+#include "graphs/services/session_log.hpp"
 
 namespace orthoflow::apps {
 

@@ -5,7 +5,7 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include "graphs/learning_ipc_bridge.hpp"
+#include "graphs/services/learning_ipc_bridge.hpp"
 
 namespace orthoflow::bridge {
 namespace {

@@ -6,7 +6,7 @@
 
 #include "engine/frame_payload.hpp"
 #include "engine/ipc_runtime.hpp"
-#include "graphs/learning_ipc_bridge.hpp"
+#include "graphs/services/learning_ipc_bridge.hpp"
 
 namespace orthoflow::bridge {
 namespace {

@@ -12,7 +12,7 @@
 #include <string>
 
 #include "bridge/ros_messages.hpp"
-#include "graphs/learning_payloads.hpp"
+#include "graphs/channels/learning_payloads.hpp"
 
 namespace orthoflow::bridge {
 

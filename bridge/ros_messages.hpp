@@ -19,7 +19,7 @@
 #include "core/result.hpp"
 #include "engine/frame_payload.hpp"
 #include "engine/object_list_payload.hpp"
-#include "graphs/learning_payloads.hpp"
+#include "graphs/channels/learning_payloads.hpp"
 #include "orthoflow_msgs/msg/LearningAck.h"
 #include "orthoflow_msgs/msg/LearningCommand.h"
 #include "orthoflow_msgs/msg/ObjectArray.h"

@@ -4,7 +4,7 @@
 /// (learning commands and acknowledgements, durable teach jobs, JSON lines). Storage is allocated
 /// once at construction; push and pop are wait-free, never allocate and never block. Several
 /// producers share one ring through a lock of their own around push (see
-/// graphs/learning_channel.hpp): the consumer side stays lock-free.
+/// graphs/channels/learning_channel.hpp): the consumer side stays lock-free.
 #include <atomic>
 #include <cstddef>
 #include <memory>

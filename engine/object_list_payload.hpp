@@ -1,12 +1,12 @@
 #pragma once
 /// @file
 /// @brief ObjectListPayload: the recognised objects of one frame as one fixed-size POD: what the
-/// tabletop graph's objects_output node hands to in-process consumers (graphs/objects_output.hpp)
-/// and, through ipc_publish, to the iceoryx topic `orthoflow/<graph>/objects`. With
-/// frame_payload.hpp this is the one place orthoflow's message schemas live; the transport and
-/// every consumer include it. Same header rules as every payload: type id, version, payload_bytes
-/// at offset 48. Version 2: decided_ns and age_ns (reserved in 1), per-object sensor-frame box and
-/// flags.
+/// tabletop graph's objects_output node hands to in-process consumers
+/// (graphs/nodes/objects_output.hpp) and, through ipc_publish, to the iceoryx topic
+/// `orthoflow/<graph>/objects`. With frame_payload.hpp this is the one place orthoflow's message
+/// schemas live; the transport and every consumer include it. Same header rules as every payload:
+/// type id, version, payload_bytes at offset 48. Version 2: decided_ns and age_ns (reserved in 1),
+/// per-object sensor-frame box and flags.
 #include <cstddef>
 #include <cstdint>
 #include <type_traits>

@@ -9,7 +9,7 @@
 /// - `a-<host_s>-<dev_ts>.dump`: the 12-byte freenect_raw_tilt_state (int16 accel x, y, z; int8
 ///   tilt in half degrees; a pad byte; int32 status), little-endian;
 /// - `device.json`: the registration parameters (optional: without it only raw replay works); it is
-///   read and written with the driver's calibration in graphs/fakenect_calibration.hpp.
+///   read and written with the driver's calibration in graphs/nodes/fakenect_calibration.hpp.
 /// `<host_s>` is host wall-clock seconds with 6 decimals, `<dev_ts>` the 32-bit 60 MHz device time.
 /// Readers are strict: a wrong header, size or value is an error naming the file, never a frame.
 #include <array>

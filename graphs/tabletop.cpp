@@ -1,14 +1,15 @@
 #include "graphs/tabletop.hpp"
 
 #include "engine/ipc_nodes.hpp"
-#include "graphs/body_filter_node.hpp"
-#include "graphs/kinect_source.hpp"
-#include "graphs/objects_output.hpp"
-#include "graphs/recognise_node.hpp"
-#include "graphs/replay_source.hpp"
-#include "graphs/segment_nodes.hpp"
-#include "graphs/source_nodes.hpp"
-#include "graphs/track_describe_nodes.hpp"
+#include "graphs/nodes/body_filter_node.hpp"
+#include "graphs/nodes/kinect_source.hpp"
+#include "graphs/nodes/objects_output.hpp"
+#include "graphs/nodes/recognise_node.hpp"
+#include "graphs/nodes/replay_source.hpp"
+#include "graphs/nodes/segment_nodes.hpp"
+#include "graphs/nodes/session_log_node.hpp"
+#include "graphs/nodes/source_nodes.hpp"
+#include "graphs/nodes/track_describe_nodes.hpp"
 
 namespace orthoflow::graphs {
 

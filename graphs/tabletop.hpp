@@ -6,11 +6,11 @@
 /// recognise, objects_output and session_log. recognise, objects_output and session_log are bound
 /// to a LearningService, an ObjectsHub and a SessionLog that outlive the graphs built.
 #include "engine/registry.hpp"
-#include "graphs/arm_state_feed.hpp"
-#include "graphs/labels_writer.hpp"
-#include "graphs/learning_service.hpp"
-#include "graphs/objects_output.hpp"
-#include "graphs/session_log.hpp"
+#include "graphs/nodes/labels_writer.hpp"
+#include "graphs/nodes/objects_output.hpp"
+#include "graphs/services/arm_state_feed.hpp"
+#include "graphs/services/learning_service.hpp"
+#include "graphs/services/session_log.hpp"
 
 namespace orthoflow::graphs {
 

@@ -4,9 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "learning/detail/category_writer.hpp"
 #include "learning/detail/learner_common.hpp"
-#include "learning/snapshot_cell.hpp"
 
 namespace orthoflow::learning {
 
@@ -25,10 +23,6 @@ struct BayesSnapshot {
   std::uint64_t total = 0;                                       // N = sum of N_k
   std::uint64_t generation = 0;
   CategoryId next_id = 0;
-};
-
-struct BayesLearner::Cell : SnapshotCell<BayesSnapshot> {
-  using SnapshotCell::SnapshotCell;
 };
 
 void accumulate_views(DescriptorBatch views, std::span<double> sums) noexcept {
@@ -71,8 +65,8 @@ CategoryPtr make_category(CategoryId id, const Label& label, std::uint64_t seen,
   return c;
 }
 
-std::unique_ptr<BayesSnapshot> finish(std::vector<CategoryPtr> categories, std::uint64_t generation,
-                                      CategoryId next_id) {
+std::unique_ptr<BayesSnapshot> make_snapshot(std::vector<CategoryPtr> categories,
+                                             std::uint64_t generation, CategoryId next_id) {
   auto s = std::make_unique<BayesSnapshot>();
   s->categories = std::move(categories);
   s->generation = generation;
@@ -83,32 +77,80 @@ std::unique_ptr<BayesSnapshot> finish(std::vector<CategoryPtr> categories, std::
 
 }  // namespace
 
+template <>
+struct LearnerRules<BayesLearner> {
+  using Category = BayesCategory;
+  using Snapshot = BayesSnapshot;
+  using Views = DescriptorBatch;
+  using L = BayesLearner;
+
+  static Result<Views, LearnError> check(const L& l, DescriptorBatch views) {
+    if (auto r = validate_batch(views, l.descriptor_length(), true); !r) return err(r.error());
+    return views;
+  }
+  // Thesis "Category Initialization and Update": N_k <- N_k + views, a_ki <- a_ki + x'_i.
+  static CategoryPtr grow(const L& l, const Category* existing, CategoryId id,
+                          std::string_view label, Views& views) {
+    std::vector<double> sums =
+        existing == nullptr ? std::vector<double>(l.descriptor_length(), 0.0) : existing->sums;
+    accumulate_views(views, sums);
+    const std::uint64_t seen = (existing == nullptr ? 0 : existing->seen) + views.count();
+    return make_category(id, Label::from(label), seen, std::move(sums), l.config().count_scale);
+  }
+  static Result<CategoryPtr, LearnError> shrink(const L& l, const Category& c, Views& views) {
+    if (views.count() > c.seen) return err(LearnError::NOT_LAST_VIEWS);
+    const std::uint64_t seen = c.seen - views.count();
+    if (seen == 0) return CategoryPtr{};
+    std::vector<double> sums = c.sums;
+    subtract_views(views, sums);
+    return make_category(c.id, c.label, seen, std::move(sums), l.config().count_scale);
+  }
+  static Result<void, LearnError> check_restored(const L& l,
+                                                 std::span<const RestoredCategory> categories) {
+    return validate_restored(categories, l.descriptor_length(), true);
+  }
+  static Result<CategoryPtr, LearnError> rebuild(const L& l, const RestoredCategory& rc) {
+    std::vector<double> sums(rc.accumulators.begin(), rc.accumulators.end());
+    std::uint64_t seen = rc.seen;
+    if (sums.empty()) {
+      sums.assign(l.descriptor_length(), 0.0);
+      accumulate_views(rc.views, sums);
+      seen = rc.views.count();
+    }
+    return make_category(rc.id, Label::from(rc.label), std::max<std::uint64_t>(seen, 1),
+                         std::move(sums), l.config().count_scale);
+  }
+  static std::unique_ptr<Snapshot> finish(const L&, std::vector<CategoryPtr> categories,
+                                          std::uint64_t generation, CategoryId next_id) {
+    return make_snapshot(std::move(categories), generation, next_id);
+  }
+  static std::pair<std::size_t, std::size_t> held(const L& l, const Snapshot& s) {
+    return {static_cast<std::size_t>(s.total), s.categories.size() * l.descriptor_length()};
+  }
+  static CategorySummary summary(const L&, const Snapshot& s, std::size_t k) {
+    const BayesCategory& c = *s.categories[k];
+    return CategorySummary{c.id, c.label, static_cast<std::size_t>(c.seen), 0.0F};
+  }
+};
+
+}  // namespace orthoflow::learning
+
+#include "learning/detail/learner_skeleton.inl"
+
+namespace orthoflow::learning {
+
+template class SkeletonLearner<BayesLearner>;
+
 BayesLearner::BayesLearner(const BayesConfig& cfg) : cfg_(cfg) {
   OF_ENFORCE(cfg.descriptor_length > 0, "BayesConfig::descriptor_length must be positive");
   OF_ENFORCE(cfg.count_scale > 0.0F && std::isfinite(cfg.count_scale),
              "BayesConfig::count_scale must be > 0");
-  cell_ = std::make_unique<Cell>(finish({}, 0, 0));
-}
-
-BayesLearner::~BayesLearner() = default;
-
-Result<CategoryId, LearnError> BayesLearner::teach(std::string_view label, DescriptorBatch views) {
-  if (auto r = validate_label(label); !r) { return err(r.error()); }
-  if (auto r = validate_batch(views, cfg_.descriptor_length, true); !r) { return err(r.error()); }
-  // Thesis "Category Initialization and Update": N_k <- N_k + views, a_ki <- a_ki + x'_i.
-  auto make = [&](const BayesCategory* existing, CategoryId id) {
-    std::vector<double> sums =
-        existing == nullptr ? std::vector<double>(cfg_.descriptor_length, 0.0) : existing->sums;
-    accumulate_views(views, sums);
-    const std::uint64_t seen = (existing == nullptr ? 0 : existing->seen) + views.count();
-    return make_category(id, Label::from(label), seen, std::move(sums), cfg_.count_scale);
-  };
-  return upsert_category(writer_, *cell_, label, make, finish);
+  start();
 }
 
 Prediction BayesLearner::ask(std::span<const float> descriptor,
                              AskScratch& scratch) const noexcept {
-  const auto snap = cell_->read(scratch.slot_hint);
+  const auto snap = cell().read(scratch.slot_hint);
   RankedScores ranked(true);
   if (descriptor.size() != cfg_.descriptor_length) {
     return RankedScores::wrong_length(snap->generation);
@@ -125,63 +167,6 @@ Prediction BayesLearner::ask(std::span<const float> descriptor,
     ranked.offer(static_cast<float>(score), c->id, c->label);
   }
   return ranked.prediction(snap->generation);
-}
-
-Result<void, LearnError> BayesLearner::forget(std::string_view label) {
-  return erase_category(writer_, *cell_, label, finish);
-}
-
-Result<void, LearnError> BayesLearner::retract(std::string_view label, DescriptorBatch views) {
-  if (auto r = validate_batch(views, cfg_.descriptor_length, true); !r) { return err(r.error()); }
-  auto make = [&](const BayesCategory& c) -> Result<CategoryPtr, LearnError> {
-    if (views.count() > c.seen) { return err(LearnError::NOT_LAST_VIEWS); }
-    const std::uint64_t seen = c.seen - views.count();
-    if (seen == 0) { return CategoryPtr{}; }
-    std::vector<double> sums = c.sums;
-    subtract_views(views, sums);
-    return make_category(c.id, c.label, seen, std::move(sums), cfg_.count_scale);
-  };
-  return shrink_category(writer_, *cell_, label, make, finish);
-}
-
-Result<void, LearnError> BayesLearner::restore(std::span<const RestoredCategory> categories,
-                                               CategoryId next_id) {
-  if (auto r = validate_restored(categories, cfg_.descriptor_length, true); !r) {
-    return err(r.error());
-  }
-  std::vector<CategoryPtr> next;
-  for (const RestoredCategory& rc : categories) {
-    std::vector<double> sums(rc.accumulators.begin(), rc.accumulators.end());
-    std::uint64_t seen = rc.seen;
-    if (sums.empty()) {
-      sums.assign(cfg_.descriptor_length, 0.0);
-      accumulate_views(rc.views, sums);
-      seen = rc.views.count();
-    }
-    next.push_back(make_category(rc.id, Label::from(rc.label), std::max<std::uint64_t>(seen, 1),
-                                 std::move(sums), cfg_.count_scale));
-    next_id = std::max(next_id, rc.id + 1);
-  }
-  replace_categories(writer_, *cell_, std::move(next), next_id, finish);
-  return {};
-}
-
-LearnerStats BayesLearner::stats() const noexcept {
-  std::size_t hint = 0;
-  const auto snap = cell_->read(hint);
-  return LearnerStats{snap->categories.size(), static_cast<std::size_t>(snap->total),
-                      snap->categories.size() * cfg_.descriptor_length, snap->generation,
-                      cell_->retired_pending()};
-}
-
-std::vector<CategorySummary> BayesLearner::categories() const {
-  std::size_t hint = 0;
-  const auto snap = cell_->read(hint);
-  std::vector<CategorySummary> out;
-  for (const CategoryPtr& c : snap->categories) {
-    out.push_back(CategorySummary{c->id, c->label, static_cast<std::size_t>(c->seen), 0.0F});
-  }
-  return out;
 }
 
 }  // namespace orthoflow::learning

@@ -13,10 +13,7 @@
 /// - score = log P(C_k) + sum_i y_i log P(x_i | C_k); label = argmax score. Memory per category is
 ///   constant (one row of descriptor_length floats). Unknown is reported only when nothing is
 ///   learned.
-#include <memory>
-#include <mutex>
-
-#include "learning/learner.hpp"
+#include "learning/learner_skeleton.hpp"
 
 namespace orthoflow::learning {
 
@@ -34,28 +31,16 @@ void accumulate_views(DescriptorBatch views, std::span<double> sums) noexcept;
 /// never goes below 0). @pre sums.size() == views.length.
 void subtract_views(DescriptorBatch views, std::span<double> sums) noexcept;
 
-struct BayesSnapshot;
-
 /// @brief Naive Bayes learner, see file comment. Thread-safe as described in learning/learner.hpp.
 /// @note ask() computes each category's dot product y . log P(x | C_k) with Eigen (vectorised); it
 /// is deterministic for one snapshot and build.
-class BayesLearner final : public Learner {
+class BayesLearner final : public SkeletonLearner<BayesLearner> {
  public:
   /// @pre cfg.descriptor_length > 0 and cfg.count_scale > 0 and finite (OF_ENFORCE).
   explicit BayesLearner(const BayesConfig& cfg);
-  ~BayesLearner() override;
 
-  [[nodiscard]] Result<CategoryId, LearnError> teach(std::string_view label,
-                                                     DescriptorBatch views) override;
   [[nodiscard]] Prediction ask(std::span<const float> descriptor,
                                AskScratch& scratch) const noexcept override;
-  [[nodiscard]] Result<void, LearnError> forget(std::string_view label) override;
-  [[nodiscard]] Result<void, LearnError> retract(std::string_view label,
-                                                 DescriptorBatch views) override;
-  [[nodiscard]] Result<void, LearnError> restore(std::span<const RestoredCategory> categories,
-                                                 CategoryId next_id) override;
-  [[nodiscard]] LearnerStats stats() const noexcept override;
-  [[nodiscard]] std::vector<CategorySummary> categories() const override;
   [[nodiscard]] std::size_t descriptor_length() const noexcept override {
     return cfg_.descriptor_length;
   }
@@ -63,10 +48,9 @@ class BayesLearner final : public Learner {
   [[nodiscard]] const BayesConfig& config() const noexcept { return cfg_; }
 
  private:
-  struct Cell;
   BayesConfig cfg_;
-  std::mutex writer_;
-  std::unique_ptr<Cell> cell_;
 };
+
+extern template class SkeletonLearner<BayesLearner>;
 
 }  // namespace orthoflow::learning

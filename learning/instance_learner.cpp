@@ -4,9 +4,7 @@
 #include <cmath>
 
 #include "kernels/distance.hpp"
-#include "learning/detail/category_writer.hpp"
 #include "learning/detail/learner_common.hpp"
-#include "learning/snapshot_cell.hpp"
 
 namespace orthoflow::learning {
 
@@ -30,10 +28,6 @@ struct InstanceSnapshot {
   std::size_t views = 0;
   std::uint64_t generation = 0;
   CategoryId next_id = 0;
-};
-
-struct InstanceLearner::Cell : SnapshotCell<InstanceSnapshot> {
-  using SnapshotCell::SnapshotCell;
 };
 
 namespace {
@@ -74,9 +68,9 @@ CategoryPtr extend(const InstanceCategory& base, DescriptorBatch views, std::siz
 }
 
 // ICD of every category (rules in instance_learner.hpp), their mean, and the view total.
-std::unique_ptr<InstanceSnapshot> finish(std::vector<CategoryPtr> categories,
-                                         std::uint64_t generation, CategoryId next_id,
-                                         const InstanceConfig& cfg) {
+std::unique_ptr<InstanceSnapshot> make_snapshot(std::vector<CategoryPtr> categories,
+                                                std::uint64_t generation, CategoryId next_id,
+                                                const InstanceConfig& cfg) {
   auto s = std::make_unique<InstanceSnapshot>();
   s->categories = std::move(categories);
   s->generation = generation;
@@ -88,14 +82,6 @@ std::unique_ptr<InstanceSnapshot> finish(std::vector<CategoryPtr> categories,
   }
   s->mean_icd = category_icds(sums, cfg.min_icd, cfg.default_icd, s->icd);
   return s;
-}
-
-// finish() with this learner's configuration, in the form the shared writer (category_writer.hpp)
-// calls.
-auto finisher(const InstanceConfig& cfg) {
-  return [&cfg](std::vector<CategoryPtr> categories, std::uint64_t generation, CategoryId next_id) {
-    return finish(std::move(categories), generation, next_id, cfg);
-  };
 }
 
 // Min (approach I) or mean (approach II) of the distances (L2, or chi-squared for topics) from @p
@@ -124,48 +110,6 @@ float ocd(std::span<const float> query, const InstanceCategory& c, bool mean,
   return mean ? static_cast<float>(sum / static_cast<double>(c.count)) : min_d;
 }
 
-}  // namespace
-
-InstanceLearner::InstanceLearner(const InstanceConfig& cfg) : cfg_(cfg) {
-  OF_ENFORCE(cfg.descriptor_length > 0, "InstanceConfig::descriptor_length must be positive");
-  enforce_icd_config(cfg.default_icd, cfg.min_icd, cfg.classification_threshold, "InstanceConfig");
-  cell_ = std::make_unique<Cell>(finish({}, 0, 0, cfg_));
-}
-
-InstanceLearner::~InstanceLearner() = default;
-
-Result<CategoryId, LearnError> InstanceLearner::teach(std::string_view label,
-                                                      DescriptorBatch views) {
-  if (auto r = validate_label(label); !r) { return err(r.error()); }
-  if (auto r = validate_batch(views, cfg_.descriptor_length, false); !r) { return err(r.error()); }
-  auto make = [&](const InstanceCategory* existing, CategoryId id) {
-    InstanceCategory fresh;
-    fresh.id = id;
-    fresh.label = Label::from(label);
-    return extend(existing == nullptr ? fresh : *existing, views, cfg_.descriptor_length,
-                  cfg_.metric);
-  };
-  return upsert_category(writer_, *cell_, label, make, finisher(cfg_));
-}
-
-Prediction InstanceLearner::ask(std::span<const float> descriptor,
-                                AskScratch& scratch) const noexcept {
-  const auto snap = cell_->read(scratch.slot_hint);
-  RankedScores ranked(false);
-  if (descriptor.size() != cfg_.descriptor_length) { return ranked.wrong_length(snap->generation); }
-  const bool mean = cfg_.normalise && cfg_.approach == NocdApproach::MEAN_DISTANCE;
-  for (std::size_t k = 0; k < snap->categories.size(); ++k) {
-    const InstanceCategory& c = *snap->categories[k];
-    const float o = ocd(descriptor, c, mean, cfg_.metric, scratch.distances());
-    ranked.offer(nocd_score(o, snap->icd[k], snap->mean_icd, cfg_.normalise, mean), c.id, c.label);
-  }
-  return with_threshold(ranked.prediction(snap->generation), cfg_.classification_threshold);
-}
-
-Result<void, LearnError> InstanceLearner::forget(std::string_view label) {
-  return erase_category(writer_, *cell_, label, finisher(cfg_));
-}
-
 // The category without its last views.count() views, which must equal @p views bit for bit;
 // null when none would be left. The pair sum is recomputed over the views that stay.
 Result<CategoryPtr, LearnError> without_last(const InstanceCategory& c, DescriptorBatch views,
@@ -191,52 +135,83 @@ Result<CategoryPtr, LearnError> without_last(const InstanceCategory& c, Descript
   return extend(base, DescriptorBatch{kept, dims}, dims, metric);
 }
 
-Result<void, LearnError> InstanceLearner::retract(std::string_view label, DescriptorBatch views) {
-  if (auto r = validate_batch(views, cfg_.descriptor_length, false); !r) { return err(r.error()); }
-  auto make = [&](const InstanceCategory& c) {
-    return without_last(c, views, cfg_.descriptor_length, cfg_.metric);
-  };
-  return shrink_category(writer_, *cell_, label, make, finisher(cfg_));
-}
+}  // namespace
 
-Result<void, LearnError> InstanceLearner::restore(std::span<const RestoredCategory> categories,
-                                                  CategoryId next_id) {
-  if (auto r = validate_restored(categories, cfg_.descriptor_length, false); !r) {
-    return err(r.error());
+template <>
+struct LearnerRules<InstanceLearner> {
+  using Category = InstanceCategory;
+  using Snapshot = InstanceSnapshot;
+  using Views = DescriptorBatch;
+  using L = InstanceLearner;
+
+  static Result<Views, LearnError> check(const L& l, DescriptorBatch views) {
+    if (auto r = validate_batch(views, l.descriptor_length(), false); !r) return err(r.error());
+    return views;
   }
-  for (const RestoredCategory& rc : categories) {
-    if (rc.views.count() == 0) {
-      return err(LearnError::NO_VIEWS);
-    }  // a model alone is not enough here
+  static CategoryPtr grow(const L& l, const Category* existing, CategoryId id,
+                          std::string_view label, Views& views) {
+    InstanceCategory fresh;
+    fresh.id = id;
+    fresh.label = Label::from(label);
+    return extend(existing == nullptr ? fresh : *existing, views, l.descriptor_length(),
+                  l.config().metric);
   }
-  std::vector<CategoryPtr> next;
-  for (const RestoredCategory& rc : categories) {
+  static Result<CategoryPtr, LearnError> shrink(const L& l, const Category& c, Views& views) {
+    return without_last(c, views, l.descriptor_length(), l.config().metric);
+  }
+  static Result<void, LearnError> check_restored(const L& l,
+                                                 std::span<const RestoredCategory> categories) {
+    if (auto r = validate_restored(categories, l.descriptor_length(), false); !r)
+      return err(r.error());
+    for (const RestoredCategory& rc : categories)
+      if (rc.views.count() == 0) return err(LearnError::NO_VIEWS);  // a model alone is not enough
+    return {};
+  }
+  static Result<CategoryPtr, LearnError> rebuild(const L& l, const RestoredCategory& rc) {
     InstanceCategory base;
     base.id = rc.id;
     base.label = Label::from(rc.label);
-    next.push_back(extend(base, rc.views, cfg_.descriptor_length, cfg_.metric));
-    next_id = std::max(next_id, rc.id + 1);
+    return extend(base, rc.views, l.descriptor_length(), l.config().metric);
   }
-  replace_categories(writer_, *cell_, std::move(next), next_id, finisher(cfg_));
-  return {};
+  static std::unique_ptr<Snapshot> finish(const L& l, std::vector<CategoryPtr> categories,
+                                          std::uint64_t generation, CategoryId next_id) {
+    return make_snapshot(std::move(categories), generation, next_id, l.config());
+  }
+  static std::pair<std::size_t, std::size_t> held(const L& l, const Snapshot& s) {
+    return {s.views, s.views * l.descriptor_length()};
+  }
+  static CategorySummary summary(const L&, const Snapshot& s, std::size_t k) {
+    const InstanceCategory& c = *s.categories[k];
+    return CategorySummary{c.id, c.label, c.count, s.icd[k]};
+  }
+};
+
+}  // namespace orthoflow::learning
+
+#include "learning/detail/learner_skeleton.inl"
+
+namespace orthoflow::learning {
+
+template class SkeletonLearner<InstanceLearner>;
+
+InstanceLearner::InstanceLearner(const InstanceConfig& cfg) : cfg_(cfg) {
+  OF_ENFORCE(cfg.descriptor_length > 0, "InstanceConfig::descriptor_length must be positive");
+  enforce_icd_config(cfg.default_icd, cfg.min_icd, cfg.classification_threshold, "InstanceConfig");
+  start();
 }
 
-LearnerStats InstanceLearner::stats() const noexcept {
-  std::size_t hint = 0;
-  const auto snap = cell_->read(hint);
-  return LearnerStats{snap->categories.size(), snap->views, snap->views * cfg_.descriptor_length,
-                      snap->generation, cell_->retired_pending()};
-}
-
-std::vector<CategorySummary> InstanceLearner::categories() const {
-  std::size_t hint = 0;
-  const auto snap = cell_->read(hint);
-  std::vector<CategorySummary> out;
+Prediction InstanceLearner::ask(std::span<const float> descriptor,
+                                AskScratch& scratch) const noexcept {
+  const auto snap = cell().read(scratch.slot_hint);
+  RankedScores ranked(false);
+  if (descriptor.size() != cfg_.descriptor_length) { return ranked.wrong_length(snap->generation); }
+  const bool mean = cfg_.normalise && cfg_.approach == NocdApproach::MEAN_DISTANCE;
   for (std::size_t k = 0; k < snap->categories.size(); ++k) {
     const InstanceCategory& c = *snap->categories[k];
-    out.push_back(CategorySummary{c.id, c.label, c.count, snap->icd[k]});
+    const float o = ocd(descriptor, c, mean, cfg_.metric, scratch.distances());
+    ranked.offer(nocd_score(o, snap->icd[k], snap->mean_icd, cfg_.normalise, mean), c.id, c.label);
   }
-  return out;
+  return with_threshold(ranked.prediction(snap->generation), cfg_.classification_threshold);
 }
 
 }  // namespace orthoflow::learning

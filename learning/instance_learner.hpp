@@ -14,11 +14,9 @@
 /// with two or more views, or by InstanceConfig::default_icd when there are none. ICDs below
 /// min_icd (duplicate views) are clamped to min_icd so NOCD stays finite.
 #include <limits>
-#include <memory>
-#include <mutex>
 
 #include "kernels/distance.hpp"
-#include "learning/learner.hpp"
+#include "learning/learner_skeleton.hpp"
 
 namespace orthoflow::learning {
 
@@ -42,29 +40,17 @@ struct InstanceConfig {
   float min_icd = 1e-6F;  ///< floor of every ICD
 };
 
-struct InstanceSnapshot;
-
 /// @brief Instance-based learner, see file comment. Thread-safe as described in
 /// learning/learner.hpp.
 /// @note ask() is deterministic for one snapshot; SIMD distances (kernels::distances, L2) agree
 /// with the scalar kernel within 1e-5 relative.
-class InstanceLearner final : public Learner {
+class InstanceLearner final : public SkeletonLearner<InstanceLearner> {
  public:
   /// @pre cfg.descriptor_length > 0, default_icd > 0, min_icd > 0, CT not NaN (OF_ENFORCE).
   explicit InstanceLearner(const InstanceConfig& cfg);
-  ~InstanceLearner() override;
 
-  [[nodiscard]] Result<CategoryId, LearnError> teach(std::string_view label,
-                                                     DescriptorBatch views) override;
   [[nodiscard]] Prediction ask(std::span<const float> descriptor,
                                AskScratch& scratch) const noexcept override;
-  [[nodiscard]] Result<void, LearnError> forget(std::string_view label) override;
-  [[nodiscard]] Result<void, LearnError> retract(std::string_view label,
-                                                 DescriptorBatch views) override;
-  [[nodiscard]] Result<void, LearnError> restore(std::span<const RestoredCategory> categories,
-                                                 CategoryId next_id) override;
-  [[nodiscard]] LearnerStats stats() const noexcept override;
-  [[nodiscard]] std::vector<CategorySummary> categories() const override;
   [[nodiscard]] std::size_t descriptor_length() const noexcept override {
     return cfg_.descriptor_length;
   }
@@ -72,10 +58,9 @@ class InstanceLearner final : public Learner {
   [[nodiscard]] const InstanceConfig& config() const noexcept { return cfg_; }
 
  private:
-  struct Cell;
   InstanceConfig cfg_;
-  std::mutex writer_;
-  std::unique_ptr<Cell> cell_;
 };
+
+extern template class SkeletonLearner<InstanceLearner>;
 
 }  // namespace orthoflow::learning

@@ -28,12 +28,10 @@
 /// in their order and gets the same state back. Cost: ask() samples the target once per category
 /// (K x V counts copied, iterations x words x K draws), so it grows with the categories.
 #include <limits>
-#include <memory>
-#include <mutex>
 #include <optional>
 
 #include "kernels/topic_model.hpp"
-#include "learning/learner.hpp"
+#include "learning/learner_skeleton.hpp"
 
 namespace orthoflow::learning {
 
@@ -68,30 +66,17 @@ struct LocalLdaConfig {
 [[nodiscard]] std::optional<std::size_t> expand_word_counts(std::span<const float> counts,
                                                             std::span<std::uint32_t> out) noexcept;
 
-struct LocalLdaSnapshot;
-
 /// @brief Local LDA learner, see file comment. Thread-safe as described in learning/learner.hpp.
-class LocalLdaLearner final : public Learner {
+class LocalLdaLearner final : public SkeletonLearner<LocalLdaLearner> {
  public:
   /// @pre cfg.words > 0, topics within kernels::MAX_LOCAL_TOPICS, positive finite priors,
   /// max_words > 0, positive ICDs and count scale (OF_ENFORCE).
   explicit LocalLdaLearner(const LocalLdaConfig& cfg);
-  ~LocalLdaLearner() override;
 
-  [[nodiscard]] Result<CategoryId, LearnError> teach(std::string_view label,
-                                                     DescriptorBatch views) override;
   /// @pre prepare(scratch) was called (else: unknown, score NaN).
   [[nodiscard]] Prediction ask(std::span<const float> descriptor,
                                AskScratch& scratch) const noexcept override;
   void prepare(AskScratch& scratch) const override;
-  [[nodiscard]] Result<void, LearnError> forget(std::string_view label) override;
-  [[nodiscard]] Result<void, LearnError> retract(std::string_view label,
-                                                 DescriptorBatch views) override;
-  /// @brief Replays every category's views in their order (the counts are a function of them).
-  [[nodiscard]] Result<void, LearnError> restore(std::span<const RestoredCategory> categories,
-                                                 CategoryId next_id) override;
-  [[nodiscard]] LearnerStats stats() const noexcept override;
-  [[nodiscard]] std::vector<CategorySummary> categories() const override;
   [[nodiscard]] std::size_t descriptor_length() const noexcept override { return cfg_.words; }
   [[nodiscard]] const char* kind() const noexcept override {
     return cfg_.decision == LocalLdaDecision::LIKELIHOOD        ? "local-lda-likelihood"
@@ -104,10 +89,9 @@ class LocalLdaLearner final : public Learner {
   [[nodiscard]] std::vector<float> view_topics(std::string_view label) const;
 
  private:
-  struct Cell;
   LocalLdaConfig cfg_;
-  std::mutex writer_;
-  std::unique_ptr<Cell> cell_;
 };
+
+extern template class SkeletonLearner<LocalLdaLearner>;
 
 }  // namespace orthoflow::learning

@@ -1,3 +1,6 @@
+// Opening a perceptual memory (learning/perceptual_memory.hpp): the store directory checked, the
+// schema compared, every category loaded into the learner; and the memory's read-only queries. Its
+// errors are in memory_error.cpp, its writes in memory_write.cpp.
 #include "learning/perceptual_memory.hpp"
 
 #include <leveldb/write_batch.h>
@@ -143,39 +146,6 @@ Result<void, MemoryError> load(PerceptualMemory::State& s) {
 }
 
 }  // namespace
-
-MemoryError memory_error(MemoryError::Code code, const std::filesystem::path& where,
-                         const std::string& what) {
-  return MemoryError{code, where.string() + ": " + what};
-}
-
-const char* to_string(MemoryError::Code code) noexcept {
-  switch (code) {
-    case Code::OPEN_FAILED:
-      return "open_failed";
-    case Code::PARAMS_MISMATCH:
-      return "params_mismatch";
-    case Code::CORRUPT:
-      return "corrupt";
-    case Code::WRITE_FAILED:
-      return "write_failed";
-    case Code::REJECTED:
-      return "rejected";
-    case Code::UNKNOWN_LABEL:
-      return "unknown_label";
-    case Code::FILE_FAILED:
-      return "file_failed";
-    case Code::READ_ONLY:
-      return "read_only";
-    case Code::BAD_IMPORT:
-      return "bad_import";
-  }
-  return "unknown";
-}
-
-std::string MemoryError::to_string() const {
-  return std::string(learning::to_string(code)) + ": " + message;
-}
 
 Result<std::vector<ViewRecord>, MemoryError> PerceptualMemory::State::read_views(State& s,
                                                                                  CategoryId id) {

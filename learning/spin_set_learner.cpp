@@ -4,9 +4,7 @@
 #include <cmath>
 
 #include "kernels/set_distance.hpp"
-#include "learning/detail/category_writer.hpp"
 #include "learning/detail/learner_common.hpp"
-#include "learning/snapshot_cell.hpp"
 
 namespace orthoflow::learning {
 
@@ -40,10 +38,6 @@ struct SetSnapshot {
   std::size_t stored_floats = 0;
   std::uint64_t generation = 0;
   CategoryId next_id = 0;
-};
-
-struct SpinSetLearner::Cell : SnapshotCell<SetSnapshot> {
-  using SnapshotCell::SnapshotCell;
 };
 
 namespace {
@@ -100,8 +94,9 @@ CategoryPtr extend(const SetCategory& base, std::span<const SetViewPtr> added, s
   return c;
 }
 
-std::unique_ptr<SetSnapshot> finish(std::vector<CategoryPtr> categories, std::uint64_t generation,
-                                    CategoryId next_id, const SpinSetConfig& cfg) {
+std::unique_ptr<SetSnapshot> make_snapshot(std::vector<CategoryPtr> categories,
+                                           std::uint64_t generation, CategoryId next_id,
+                                           const SpinSetConfig& cfg) {
   auto s = std::make_unique<SetSnapshot>();
   s->categories = std::move(categories);
   s->generation = generation;
@@ -117,35 +112,80 @@ std::unique_ptr<SetSnapshot> finish(std::vector<CategoryPtr> categories, std::ui
   return s;
 }
 
-auto finisher(const SpinSetConfig& cfg) {
-  return [&cfg](std::vector<CategoryPtr> categories, std::uint64_t generation, CategoryId next_id) {
-    return finish(std::move(categories), generation, next_id, cfg);
-  };
-}
-
 }  // namespace
+
+template <>
+struct LearnerRules<SpinSetLearner> {
+  using Category = SetCategory;
+  using Snapshot = SetSnapshot;
+  using Views = std::vector<SetViewPtr>;
+  using L = SpinSetLearner;
+
+  static Result<Views, LearnError> check(const L& l, DescriptorBatch views) {
+    if (auto r = validate_batch(views, l.descriptor_length(), false); !r) return err(r.error());
+    return sets_of(views, l.config().set.image_values());
+  }
+  static CategoryPtr grow(const L& l, const Category* existing, CategoryId id,
+                          std::string_view label, Views& sets) {
+    SetCategory fresh;
+    fresh.id = id;
+    fresh.label = Label::from(label);
+    return extend(existing == nullptr ? fresh : *existing, sets, l.config().set.image_values());
+  }
+  static Result<CategoryPtr, LearnError> shrink(const L& l, const Category& c, Views& sets) {
+    const std::size_t n = sets.size();
+    if (n > c.views.size()) return err(LearnError::NOT_LAST_VIEWS);
+    const std::size_t keep = c.views.size() - n;
+    for (std::size_t v = 0; v < n; ++v)
+      if (c.views[keep + v]->rows != sets[v]->rows) return err(LearnError::NOT_LAST_VIEWS);
+    if (keep == 0) return CategoryPtr{};
+    SetCategory base;
+    base.id = c.id;
+    base.label = c.label;
+    return extend(base, std::span<const SetViewPtr>(c.views).first(keep),
+                  l.config().set.image_values());
+  }
+  static Result<void, LearnError> check_restored(const L& l,
+                                                 std::span<const RestoredCategory> categories) {
+    if (auto r = validate_restored(categories, l.descriptor_length(), false); !r)
+      return err(r.error());
+    for (const RestoredCategory& rc : categories)
+      if (rc.views.count() == 0) return err(LearnError::NO_VIEWS);
+    return {};
+  }
+  static Result<CategoryPtr, LearnError> rebuild(const L& l, const RestoredCategory& rc) {
+    auto sets = sets_of(rc.views, l.config().set.image_values());
+    if (!sets) return err(sets.error());
+    SetCategory base;
+    base.id = rc.id;
+    base.label = Label::from(rc.label);
+    return extend(base, *sets, l.config().set.image_values());
+  }
+  static std::unique_ptr<Snapshot> finish(const L& l, std::vector<CategoryPtr> categories,
+                                          std::uint64_t generation, CategoryId next_id) {
+    return make_snapshot(std::move(categories), generation, next_id, l.config());
+  }
+  static std::pair<std::size_t, std::size_t> held(const L&, const Snapshot& s) {
+    return {s.views, s.stored_floats};
+  }
+  static CategorySummary summary(const L&, const Snapshot& s, std::size_t k) {
+    const SetCategory& c = *s.categories[k];
+    return CategorySummary{c.id, c.label, c.views.size(), s.icd[k]};
+  }
+};
+
+}  // namespace orthoflow::learning
+
+#include "learning/detail/learner_skeleton.inl"
+
+namespace orthoflow::learning {
+
+template class SkeletonLearner<SpinSetLearner>;
 
 SpinSetLearner::SpinSetLearner(const SpinSetConfig& cfg) : cfg_(cfg) {
   OF_ENFORCE(cfg.set.valid(), "SpinSetConfig::set is not a valid spin-image set");
   enforce_icd_config(cfg.default_icd, cfg.min_icd, cfg.classification_threshold, "SpinSetConfig");
-  cell_ = std::make_unique<Cell>(finish({}, 0, 0, cfg_));
-}
-
-SpinSetLearner::~SpinSetLearner() = default;
-
-Result<CategoryId, LearnError> SpinSetLearner::teach(std::string_view label,
-                                                     DescriptorBatch views) {
-  if (auto r = validate_label(label); !r) return err(r.error());
-  if (auto r = validate_batch(views, cfg_.set.length(), false); !r) return err(r.error());
-  auto sets = sets_of(views, cfg_.set.image_values());
-  if (!sets) return err(sets.error());
-  auto make = [&](const SetCategory* existing, CategoryId id) {
-    SetCategory fresh;
-    fresh.id = id;
-    fresh.label = Label::from(label);
-    return extend(existing == nullptr ? fresh : *existing, *sets, cfg_.set.image_values());
-  };
-  return upsert_category(writer_, *cell_, label, make, finisher(cfg_));
+  start();
 }
 
 void SpinSetLearner::prepare(AskScratch& scratch) const {
@@ -154,7 +194,7 @@ void SpinSetLearner::prepare(AskScratch& scratch) const {
 
 Prediction SpinSetLearner::ask(std::span<const float> descriptor,
                                AskScratch& scratch) const noexcept {
-  const auto snap = cell_->read(scratch.slot_hint);
+  const auto snap = cell().read(scratch.slot_hint);
   RankedScores ranked(false);
   const std::size_t dims = cfg_.set.image_values();
   const auto count = descriptor.size() == cfg_.set.length()
@@ -178,66 +218,6 @@ Prediction SpinSetLearner::ask(std::span<const float> descriptor,
     ranked.offer(nocd_score(o, snap->icd[k], snap->mean_icd, cfg_.normalise, mean), c.id, c.label);
   }
   return with_threshold(ranked.prediction(snap->generation), cfg_.classification_threshold);
-}
-
-Result<void, LearnError> SpinSetLearner::forget(std::string_view label) {
-  return erase_category(writer_, *cell_, label, finisher(cfg_));
-}
-
-Result<void, LearnError> SpinSetLearner::retract(std::string_view label, DescriptorBatch views) {
-  if (auto r = validate_batch(views, cfg_.set.length(), false); !r) return err(r.error());
-  auto sets = sets_of(views, cfg_.set.image_values());
-  if (!sets) return err(sets.error());
-  const std::size_t dims = cfg_.set.image_values();
-  auto make = [&](const SetCategory& c) -> Result<CategoryPtr, LearnError> {
-    const std::size_t n = sets->size();
-    if (n > c.views.size()) return err(LearnError::NOT_LAST_VIEWS);
-    const std::size_t keep = c.views.size() - n;
-    for (std::size_t v = 0; v < n; ++v)
-      if (c.views[keep + v]->rows != (*sets)[v]->rows) return err(LearnError::NOT_LAST_VIEWS);
-    if (keep == 0) return CategoryPtr{};
-    SetCategory base;
-    base.id = c.id;
-    base.label = c.label;
-    return extend(base, std::span<const SetViewPtr>(c.views).first(keep), dims);
-  };
-  return shrink_category(writer_, *cell_, label, make, finisher(cfg_));
-}
-
-Result<void, LearnError> SpinSetLearner::restore(std::span<const RestoredCategory> categories,
-                                                 CategoryId next_id) {
-  if (auto r = validate_restored(categories, cfg_.set.length(), false); !r) return err(r.error());
-  std::vector<CategoryPtr> next;
-  for (const RestoredCategory& rc : categories) {
-    if (rc.views.count() == 0) return err(LearnError::NO_VIEWS);
-    auto sets = sets_of(rc.views, cfg_.set.image_values());
-    if (!sets) return err(sets.error());
-    SetCategory base;
-    base.id = rc.id;
-    base.label = Label::from(rc.label);
-    next.push_back(extend(base, *sets, cfg_.set.image_values()));
-    next_id = std::max(next_id, rc.id + 1);
-  }
-  replace_categories(writer_, *cell_, std::move(next), next_id, finisher(cfg_));
-  return {};
-}
-
-LearnerStats SpinSetLearner::stats() const noexcept {
-  std::size_t hint = 0;
-  const auto snap = cell_->read(hint);
-  return LearnerStats{snap->categories.size(), snap->views, snap->stored_floats, snap->generation,
-                      cell_->retired_pending()};
-}
-
-std::vector<CategorySummary> SpinSetLearner::categories() const {
-  std::size_t hint = 0;
-  const auto snap = cell_->read(hint);
-  std::vector<CategorySummary> out;
-  for (std::size_t k = 0; k < snap->categories.size(); ++k) {
-    const SetCategory& c = *snap->categories[k];
-    out.push_back(CategorySummary{c.id, c.label, c.views.size(), snap->icd[k]});
-  }
-  return out;
 }
 
 }  // namespace orthoflow::learning

@@ -12,11 +12,9 @@
 ///   normalise is off. A category of one view takes the others' mean ICD (or default_icd).
 /// Naive Bayes has no form over sets: learning::make_learner() gives every SPIN_SET specification
 /// this learner. Thread-safety and snapshots as every Learner (learner.hpp).
-#include <memory>
-#include <mutex>
-
 #include "kernels/spin_set.hpp"
 #include "learning/instance_learner.hpp"
+#include "learning/learner_skeleton.hpp"
 
 namespace orthoflow::learning {
 
@@ -33,34 +31,24 @@ struct SpinSetConfig {
 /// category (O(views x images^2) distances); asking computes D(T, O) for every stored view.
 /// @note ask() allocates nothing once prepare() has sized the scratch's distances (one per image
 /// of a stored set); an unprepared scratch too small for a set gets an Unknown answer, score NaN.
-class SpinSetLearner final : public Learner {
+class SpinSetLearner final : public SkeletonLearner<SpinSetLearner> {
  public:
   /// @pre cfg.set.valid(), default_icd > 0, min_icd > 0, CT not NaN (OF_ENFORCE).
   explicit SpinSetLearner(const SpinSetConfig& cfg);
-  ~SpinSetLearner() override;
 
-  [[nodiscard]] Result<CategoryId, LearnError> teach(std::string_view label,
-                                                     DescriptorBatch views) override;
   [[nodiscard]] Prediction ask(std::span<const float> descriptor,
                                AskScratch& scratch) const noexcept override;
   void prepare(AskScratch& scratch) const override;
-  [[nodiscard]] Result<void, LearnError> forget(std::string_view label) override;
-  [[nodiscard]] Result<void, LearnError> retract(std::string_view label,
-                                                 DescriptorBatch views) override;
-  [[nodiscard]] Result<void, LearnError> restore(std::span<const RestoredCategory> categories,
-                                                 CategoryId next_id) override;
-  [[nodiscard]] LearnerStats stats() const noexcept override;
-  [[nodiscard]] std::vector<CategorySummary> categories() const override;
   [[nodiscard]] std::size_t descriptor_length() const noexcept override {
     return cfg_.set.length();
   }
   [[nodiscard]] const char* kind() const noexcept override { return "instance-spin-set"; }
+  [[nodiscard]] const SpinSetConfig& config() const noexcept { return cfg_; }
 
  private:
-  struct Cell;
   SpinSetConfig cfg_;
-  std::mutex writer_;
-  std::unique_ptr<Cell> cell_;
 };
+
+extern template class SkeletonLearner<SpinSetLearner>;
 
 }  // namespace orthoflow::learning

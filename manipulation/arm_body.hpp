@@ -14,7 +14,7 @@
 
 #include <Eigen/Geometry>
 
-#include "drivers/jaco_kinematics.hpp"
+#include "drivers/jaco/jaco_kinematics.hpp"
 #include "kernels/capsule_mask.hpp"
 
 namespace orthoflow::manipulation {

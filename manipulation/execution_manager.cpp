@@ -1,50 +1,17 @@
+// The execution manager's state machine (manipulation/execution_manager.hpp): a job started, each
+// phase entered with its request to the arm, aborts (backing away or holding), and step(), which
+// decides every cycle. Its checks are in execution_checks.cpp; the names of its phases and its
+// conversions to the driver's types in execution_io.cpp.
 #include "manipulation/execution_manager.hpp"
-
-#include "manipulation/segment_distance.hpp"
 
 #include <algorithm>
 #include <cmath>
 
 namespace orthoflow::manipulation {
 
-ArmInput arm_input(const drivers::jaco::ArmSnapshot& s) noexcept {
-  ArmInput a;
-  a.joints = s.joints;
-  a.fingers = {s.fingers[0], s.fingers[1], s.fingers[2]};
-  a.idle = s.control == drivers::jaco::ControlState::IDLE && !s.fingers_moving;
-  a.fingers_blocked = s.fingers_blocked;
-  a.fault = s.fault;
-  a.estop = s.estop;
-  return a;
-}
-
-drivers::jaco::ArmCommand arm_command(const ArmRequest& r) noexcept {
-  using Kind = drivers::jaco::ArmCommand::Kind;
-  drivers::jaco::ArmCommand c;
-  c.speed_fraction = r.speed_fraction;
-  if (r.kind == ArmRequest::Kind::MOVE_JOINTS) {
-    c.kind = Kind::MOVE_JOINTS;
-    c.joints = r.joints;
-  } else if (r.kind == ArmRequest::Kind::MOVE_FINGERS) {
-    c.kind = Kind::MOVE_FINGERS;
-    c.fingers = {r.fingers, r.fingers, r.fingers};
-  } else {
-    c.kind = Kind::STOP;
-  }
-  return c;
-}
-
 namespace {
 
 using drivers::jaco::JointAngles;
-
-/// The tool point at sample @p s of JOINT_PATH_SAMPLES along the joint-space segment.
-Eigen::Vector3d tool_along(const JointAngles& from, const JointAngles& to, std::size_t s) noexcept {
-  const double t = static_cast<double>(s) / static_cast<double>(JOINT_PATH_SAMPLES);
-  JointAngles q{};
-  for (std::size_t j = 0; j < q.size(); ++j) q[j] = from[j] + t * (to[j] - from[j]);
-  return drivers::jaco::forward_kinematics(q).translation();
-}
 
 ArmRequest move_to(const JointAngles& joints, double speed) noexcept {
   ArmRequest r;
@@ -69,68 +36,6 @@ ArmRequest stop_now() noexcept {
 }
 
 }  // namespace
-
-const char* to_string(Phase phase) noexcept {
-  switch (phase) {
-    case Phase::IDLE:
-      return "idle";
-    case Phase::GO_INITIAL:
-      return "go_initial";
-    case Phase::OPEN:
-      return "open";
-    case Phase::PRE_GRASP:
-      return "pre_grasp";
-    case Phase::APPROACH:
-      return "approach";
-    case Phase::CLOSE:
-      return "close";
-    case Phase::LIFT:
-      return "lift";
-    case Phase::CARRY:
-      return "carry";
-    case Phase::PLACE:
-      return "place";
-    case Phase::RELEASE:
-      return "release";
-    case Phase::RETREAT:
-      return "retreat";
-    case Phase::DONE:
-      return "done";
-    case Phase::BACKING_AWAY:
-      return "backing_away";
-    case Phase::ABORTED:
-      return "aborted";
-  }
-  return "unknown";
-}
-
-const char* to_string(AbortReason reason) noexcept {
-  switch (reason) {
-    case AbortReason::NONE:
-      return "none";
-    case AbortReason::TIMEOUT:
-      return "timeout";
-    case AbortReason::PERCEPTION_STALE:
-      return "perception_stale";
-    case AbortReason::TARGET_LOST:
-      return "target_lost";
-    case AbortReason::TARGET_MOVED:
-      return "target_moved";
-    case AbortReason::OBSTACLE:
-      return "obstacle";
-    case AbortReason::ARM_FAULT:
-      return "arm_fault";
-    case AbortReason::ARM_ESTOP:
-      return "arm_estop";
-    case AbortReason::REFUSED:
-      return "refused";
-    case AbortReason::GRASP_MISSED:
-      return "grasp_missed";
-    case AbortReason::STOP_REQUESTED:
-      return "stop_requested";
-  }
-  return "unknown";
-}
 
 bool ExecutionManager::start(const PickPlaceJob& job, std::int64_t now_ns) noexcept {
   if (running()) return false;
@@ -230,97 +135,6 @@ void ExecutionManager::request_stop(std::int64_t now_ns) noexcept {
   if (!running()) return;
   stop_requested_ = true;
   stop_requested_ns_ = now_ns;
-}
-
-const JointAngles* ExecutionManager::joint_goal(Phase phase) const noexcept {
-  switch (phase) {
-    case Phase::GO_INITIAL:
-      return risen_reached_ ? &job_.initial : &job_.risen;
-    case Phase::PRE_GRASP:
-      return above_reached_ ? &job_.pre_grasp : &job_.above_pre_grasp;
-    case Phase::APPROACH:
-      return &job_.grasp;
-    case Phase::LIFT:
-      return &job_.lift;
-    case Phase::CARRY:
-      return aside_reached_ ? &job_.carry : &job_.aside;
-    case Phase::PLACE:
-      return &job_.place;
-    case Phase::RETREAT:
-      return &job_.retreat;
-    case Phase::BACKING_AWAY:
-      return back_away_after_open_ ? nullptr : &job_.pre_grasp;
-    default:
-      return nullptr;
-  }
-}
-
-bool ExecutionManager::at_joints(const ArmInput& arm, const JointAngles& goal) const noexcept {
-  if (!arm.idle) return false;
-  for (std::size_t j = 0; j < goal.size(); ++j) {
-    if (!(std::fabs(arm.joints[j] - goal[j]) <= limits_.joint_tolerance_deg)) return false;
-  }
-  return true;
-}
-
-bool ExecutionManager::at_fingers(const ArmInput& arm, double goal) const noexcept {
-  if (!arm.idle) return false;
-  for (double f : arm.fingers) {
-    if (!(std::fabs(f - goal) <= limits_.finger_tolerance)) return false;
-  }
-  return true;
-}
-
-bool ExecutionManager::closed_beyond_open(const ArmInput& arm) const noexcept {
-  // Stopped on the way, each finger past a quarter of the way from open to the goal (not blocked
-  // right where it started).
-  const double quarter = job_.open_fingers + 0.25 * (job_.close_fingers - job_.open_fingers);
-  for (double f : arm.fingers) {
-    if (!(f >= quarter)) return false;
-  }
-  return true;
-}
-
-bool ExecutionManager::moved(const Eigen::Vector3d& seen) const noexcept {
-  const Eigen::Vector3d d = seen - job_.target_centre;
-  const double rise = d.dot(job_.up);
-  return (d - rise * job_.up).norm() > limits_.target_moved_m || rise > limits_.target_moved_m;
-}
-
-bool ExecutionManager::path_blocked(const ArmInput& arm,
-                                    std::span<const Obstacle> others) const noexcept {
-  const JointAngles* goal = joint_goal(phase_);
-  if (goal == nullptr || others.empty()) return false;
-  return joint_path_blocked(arm.joints, *goal, others, limits_.obstacle_clearance_m);
-}
-
-bool joint_path_blocked(const JointAngles& from, const JointAngles& to,
-                        std::span<const Obstacle> others, double clearance_m) noexcept {
-  if (others.empty()) return false;
-  Eigen::Vector3d previous = tool_along(from, to, 0);
-  for (std::size_t s = 1; s <= JOINT_PATH_SAMPLES; ++s) {
-    const Eigen::Vector3d point = tool_along(from, to, s);
-    if (segment_blocked(previous, point, others, clearance_m)) return true;
-    previous = point;
-  }
-  return false;
-}
-
-double joint_path_deviation(const JointAngles& from, const JointAngles& to) noexcept {
-  const Eigen::Vector3d a = tool_along(from, to, 0);
-  const Eigen::Vector3d b = tool_along(from, to, JOINT_PATH_SAMPLES);
-  double worst = 0.0;
-  for (std::size_t s = 1; s < JOINT_PATH_SAMPLES; ++s)
-    worst = std::max(worst, distance_to_segment(a, b, tool_along(from, to, s)));
-  return worst;
-}
-
-bool segment_blocked(const Eigen::Vector3d& from, const Eigen::Vector3d& to,
-                     std::span<const Obstacle> others, double clearance_m) noexcept {
-  for (const Obstacle& o : others) {
-    if (distance_to_segment(from, to, o.centre) < o.radius + clearance_m) return true;
-  }
-  return false;
 }
 
 ArmRequest ExecutionManager::step(std::int64_t now_ns, const ArmInput& arm,

@@ -28,8 +28,8 @@
 
 #include <Eigen/Geometry>
 
-#include "drivers/jaco_controller.hpp"
-#include "drivers/jaco_kinematics.hpp"
+#include "drivers/jaco/jaco_controller.hpp"
+#include "drivers/jaco/jaco_kinematics.hpp"
 
 namespace orthoflow::manipulation {
 
@@ -159,7 +159,7 @@ struct PerceptionInput {
                                    std::span<const Obstacle> others, double clearance_m) noexcept;
 
 /// @brief Tool points sampled along a joint-space move to check its path: the controller moves
-/// every joint on one synchronised profile (drivers/jaco_motion.hpp), so the tool follows the
+/// every joint on one synchronised profile (drivers/jaco/jaco_motion.hpp), so the tool follows the
 /// forward kinematics of the straight joint-space segment, a curve that can sag far from the
 /// straight Cartesian line between its ends. The polyline through these points is within a few mm
 /// of it.

@@ -7,7 +7,7 @@
 /// feasible is kept with the reason.
 ///
 /// Frames (all in the arm's base frame, metres): the hand pose is the pose the arm's Cartesian
-/// command names (drivers/jaco_kinematics.hpp: the DH end-effector frame), taken as the grasp
+/// command names (drivers/jaco/jaco_kinematics.hpp: the DH end-effector frame), taken as the grasp
 /// centre between the finger pads (HandModel::tcp_offset_m moves it along the approach). Its z
 /// axis is the approach direction; its y axis is the direction the fingers close along; x = y * z.
 /// The box is centred at its frame's origin (for a GOOD frame: the object's centroid), with full
@@ -26,7 +26,7 @@
 #include <Eigen/Geometry>
 
 #include "core/result.hpp"
-#include "drivers/jaco_kinematics.hpp"
+#include "drivers/jaco/jaco_kinematics.hpp"
 
 namespace orthoflow::manipulation {
 

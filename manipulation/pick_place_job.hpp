@@ -14,7 +14,7 @@
 #include <Eigen/Geometry>
 
 #include "core/result.hpp"
-#include "drivers/jaco_safety.hpp"
+#include "drivers/jaco/jaco_safety.hpp"
 #include "manipulation/execution_manager.hpp"
 #include "manipulation/grasp_planner.hpp"
 

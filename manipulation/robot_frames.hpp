@@ -20,7 +20,7 @@
 ///
 /// joints in actuator degrees (forward kinematics of the chosen model); positions in metres;
 /// theta in radians, R = Rx * Ry * Rz (the arm's Cartesian convention,
-/// drivers/jaco_kinematics.hpp).
+/// drivers/jaco/jaco_kinematics.hpp).
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -33,7 +33,7 @@
 #include <Eigen/Geometry>
 
 #include "core/result.hpp"
-#include "drivers/jaco_kinematics.hpp"
+#include "drivers/jaco/jaco_kinematics.hpp"
 #include "manipulation/hand_eye.hpp"
 
 namespace orthoflow::manipulation {

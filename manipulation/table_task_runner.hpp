@@ -33,7 +33,7 @@
 #include <Eigen/Geometry>
 
 #include "core/result.hpp"
-#include "drivers/jaco_controller.hpp"
+#include "drivers/jaco/jaco_controller.hpp"
 #include "kernels/capsule_mask.hpp"
 #include "manipulation/arm_body.hpp"
 #include "manipulation/execution_manager.hpp"

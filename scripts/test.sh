@@ -11,13 +11,20 @@
 #   5. image (after the aarch64 stage, from its two packages): an amd64 and an arm64 robot image built
 #      by scripts/build_image.sh from tests/image/robot.yaml and booted under qemu-system by
 #      scripts/test_image.sh (issue 24). IMAGE=0 skips the stage; IMAGE_ARCHES picks (default both).
-# Prints a closing line "tests: N passed, M failed" and exits non-zero on any failure.
+# Prints the skipped tests with their reasons per stage, a table of passed / failed / skipped per
+# stage, and a closing line "tests: N passed, M failed, K skipped"; exits non-zero on any failure.
+# With CI=true (.ci/run sets it), a skipped or missing must-run test is a failure naming its
+# prerequisite (scripts/ctest_gate.py, tests/must_run.txt); outside CI it is listed as a skip.
 set -uo pipefail
 cd "$(dirname "$0")/.."
 FUZZ_SECONDS="${FUZZ_SECONDS:-60}"
 PRESETS="${PRESETS:-release asan}"
 passed=0
 failed=0
+skipped=0
+stages=""    # one "stage | passed | failed | skipped" row per stage
+ci_flag=""
+[ "${CI:-}" = true ] && ci_flag="--ci"
 failures=""  # "preset/test" names, printed again at the very end where a truncated log still shows them
 timings=""   # one "stage: seconds" line per stage
 logdir=$(mktemp -d)
@@ -53,7 +60,7 @@ run_ctest_preset() {
   note_time "$preset build" "$t0"
   t0=$(date +%s)
   echo "=== preset $preset: ctest"
-  ctest --preset "$preset" 2>&1 | tee "$log"
+  ctest --preset "$preset" --output-junit "$logdir/$preset.junit.xml" 2>&1 | tee "$log"
   note_time "$preset ctest" "$t0"
   # The failed tests' names from ctest's own list ("  12 - name (Failed)"), and the end of each one's
   # output from ctest's LastTest.log, printed again at the very end (a truncated CI log keeps its tail).
@@ -67,17 +74,34 @@ run_ctest_preset() {
       on && /^<end of output>/ {exit} on' "build/$preset/Testing/Temporary/LastTest.log" 2>/dev/null |
       tail -n 25 >>"$logdir/failure_tails.txt"
   done <<<"$names"
-  local line total nfail
-  line=$(grep -E "tests passed, [0-9]+ tests failed out of [0-9]+" "$log" | tail -1)
-  if [ -z "$line" ]; then
+  if ! grep -qE "tests passed, [0-9]+ tests failed out of [0-9]+" "$log"; then
     echo "preset $preset: ctest gave no summary"
     failed=$((failed + 1))
+    failures="$failures$preset: ctest gave no summary"$'\n'
     return
   fi
-  nfail=$(echo "$line" | sed -E 's/.* ([0-9]+) tests failed out of ([0-9]+).*/\1/')
-  total=$(echo "$line" | sed -E 's/.* tests failed out of ([0-9]+).*/\1/')
-  passed=$((passed + total - nfail))
-  failed=$((failed + nfail))
+  gate_stage "$preset" "build/$preset" "$logdir/$preset.junit.xml"
+}
+
+# gate_stage STAGE BUILD_DIR JUNIT: counts passed / failed / skipped with scripts/ctest_gate.py (a
+# must-run test skipped or missing fails in CI), lists every skip with its reason, and adds the stage
+# to the totals and the per-stage table.
+gate_stage() {
+  local stage=$1 out problems p f k line
+  out=$(python3 scripts/ctest_gate.py --stage "$stage" --build "$2" --junit "$3" \
+        --manifest tests/must_run.txt $ci_flag)
+  echo "$out" | sed -n 's/^GATE FAILURE //p; /^GATE /!p'
+  problems=$(echo "$out" | sed -n 's/^GATE FAILURE //p')
+  [ -n "$problems" ] && failures="$failures$problems"$'\n'
+  line=$(echo "$out" | grep -E "^GATE $stage passed=" | tail -1)
+  p=$(echo "$line" | sed -E 's/.*passed=([0-9]+).*/\1/')
+  f=$(echo "$line" | sed -E 's/.*failed=([0-9]+).*/\1/')
+  k=$(echo "$line" | sed -E 's/.*skipped=([0-9]+).*/\1/')
+  [ -n "$line" ] || { p=0; f=1; k=0; failures="$failures$stage: no test gate result"$'\n'; }
+  passed=$((passed + p))
+  failed=$((failed + f))
+  skipped=$((skipped + k))
+  stages="$stages$(printf '%-10s %8s %8s %8s' "$stage" "$p" "$f" "$k")"$'\n'
 }
 
 # collect_fuzzer PID NAME: waits for one background fuzzer, prints its log and counts its result.
@@ -203,6 +227,9 @@ if [ "${AARCH64:-1}" != 0 ]; then run_aarch64; fi
 if [ "${IMAGE:-1}" != 0 ]; then run_image; fi
 echo "--- time per stage"
 printf "%s" "$timings"
+echo "--- tests per stage (ctest stages; fuzz, packages and images count as passed or failed)"
+printf '%-10s %8s %8s %8s\n' stage passed failed skipped
+printf "%s" "$stages"
 [ -n "${CMAKE_CXX_COMPILER_LAUNCHER:-}" ] && ccache -s 2>/dev/null | grep -E "^(Cacheable calls|  Hits|  Misses)" || true
 if [ -n "$failures" ]; then
   echo "--- the end of each failed test's output"
@@ -212,5 +239,5 @@ if [ -n "$failures" ]; then
 fi
 rm -rf "$logdir"
 echo "elapsed: $(( $(date +%s) - start )) s"
-echo "tests: $passed passed, $failed failed"
+echo "tests: $passed passed, $failed failed, $skipped skipped"
 [ "$failed" -eq 0 ] && [ "$passed" -gt 0 ]

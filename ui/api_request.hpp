@@ -19,7 +19,7 @@
 
 #include "core/fixed_text.hpp"
 #include "core/result.hpp"
-#include "graphs/task_payloads.hpp"
+#include "graphs/channels/task_payloads.hpp"
 
 namespace orthoflow::ui {
 

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "graphs/camera_tap.hpp"
+#include "graphs/nodes/camera_tap.hpp"
 #include "ui/ui_backend.hpp"
 
 namespace orthoflow::ui {

@@ -6,7 +6,7 @@
 
 #include "engine/ipc_pubsub.hpp"
 #include "engine/ipc_runtime.hpp"
-#include "graphs/learning_ipc_bridge.hpp"
+#include "graphs/services/learning_ipc_bridge.hpp"
 #include "ui/background_thread.hpp"
 
 namespace orthoflow::ui {

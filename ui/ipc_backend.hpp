@@ -3,9 +3,10 @@
 /// @brief IpcBackend: the web view's backend over a graph running in another process (`orthoflow
 /// ui`, beside `orthoflow run --ipc-learning`). Objects come from the iceoryx topic
 /// orthoflow/<graph>/objects, the memory and telemetry from .../status, and actions go out on
-/// .../learning_commands and come back on .../learning_acks (graphs/learning_payloads.hpp). A
-/// thread here takes every topic; state older than STALE_AFTER_NS is not shown (a graph that
-/// stopped shows no objects to click). No camera image: frames do not cross to this process.
+/// .../learning_commands and come back on .../learning_acks
+/// (graphs/channels/learning_payloads.hpp). A thread here takes every topic; state older than
+/// STALE_AFTER_NS is not shown (a graph that stopped shows no objects to click). No camera image:
+/// frames do not cross to this process.
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
@@ -18,7 +19,7 @@
 
 #include "core/result.hpp"
 #include "engine/object_list_payload.hpp"
-#include "graphs/learning_payloads.hpp"
+#include "graphs/channels/learning_payloads.hpp"
 #include "ui/backend_support.hpp"
 #include "ui/ui_backend.hpp"
 

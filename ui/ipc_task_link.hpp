@@ -2,9 +2,9 @@
 /// @file
 /// @brief IpcTaskLink: the web view's link to `orthoflow task run` over iceoryx: commands out on
 /// orthoflow/<graph>/task_commands, the task's state in on .../task_status
-/// (graphs/task_payloads.hpp), the same channel `orthoflow task start|stop|status` uses. A thread
-/// here keeps the newest status; a send waits for the status that answers its own command (the
-/// link's random client id and the command's number).
+/// (graphs/channels/task_payloads.hpp), the same channel `orthoflow task start|stop|status` uses. A
+/// thread here keeps the newest status; a send waits for the status that answers its own command
+/// (the link's random client id and the command's number).
 #include <atomic>
 #include <condition_variable>
 #include <memory>

@@ -8,7 +8,7 @@
 #include <optional>
 #include <string>
 
-#include "graphs/task_payloads.hpp"
+#include "graphs/channels/task_payloads.hpp"
 #include "ui/ui_backend.hpp"
 
 namespace orthoflow::ui {

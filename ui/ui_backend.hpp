@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "graphs/learning_channel.hpp"
-#include "graphs/task_payloads.hpp"
+#include "graphs/channels/learning_channel.hpp"
+#include "graphs/channels/task_payloads.hpp"
 
 namespace orthoflow::ui {
 

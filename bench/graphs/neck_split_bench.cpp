@@ -13,11 +13,11 @@
 #include "engine/graph.hpp"
 #include "formats/pcd_io.hpp"
 #include "graphs/embedded_graphs.hpp"
-#include "graphs/segment_params.hpp"
-#include "graphs/table_task_session.hpp"
+#include "graphs/nodes/segment_params.hpp"
+#include "graphs/sessions/table_task_session.hpp"
 #include "kernels/detail/neck_scratch.hpp"
 #include "kernels/segmentation_chain.hpp"
-#include "simulation/synthetic_scene.hpp"
+#include "simulation/world/synthetic_scene.hpp"
 
 namespace {
 

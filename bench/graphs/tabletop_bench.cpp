@@ -14,7 +14,7 @@
 #include "engine/graph.hpp"
 #include "formats/pcd_io.hpp"
 #include "graphs/embedded_graphs.hpp"
-#include "graphs/segment_params.hpp"
+#include "graphs/nodes/segment_params.hpp"
 #include "graphs/tabletop.hpp"
 
 namespace {

@@ -5,7 +5,7 @@
 #include <benchmark/benchmark.h>
 
 #include "kernels/sphere_target.hpp"
-#include "simulation/synthetic_scene.hpp"
+#include "simulation/world/synthetic_scene.hpp"
 
 namespace {
 

@@ -6,9 +6,9 @@
 #include <cmath>
 #include <cstdint>
 
-#include "simulation/object_dataset.hpp"
-#include "simulation/synthetic_scene.hpp"
-#include "simulation/synthetic_sequence.hpp"
+#include "simulation/world/object_dataset.hpp"
+#include "simulation/world/synthetic_scene.hpp"
+#include "simulation/world/synthetic_sequence.hpp"
 
 namespace orthoflow::simulation {
 namespace {

@@ -38,7 +38,7 @@
 #include "engine/graph.hpp"
 #include "engine/histogram.hpp"
 #include "graphs/embedded_graphs.hpp"
-#include "graphs/objects_output.hpp"
+#include "graphs/nodes/objects_output.hpp"
 #include "graphs/tabletop.hpp"
 #include "tests/support/pinhole_image.hpp"
 #include "ui/background_thread.hpp"

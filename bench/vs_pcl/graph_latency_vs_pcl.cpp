@@ -27,7 +27,7 @@
 #include "formats/pcd_io.hpp"
 #include "graphs/embedded_graphs.hpp"
 #include "graphs/tabletop.hpp"
-#include "simulation/synthetic_sequence.hpp"
+#include "simulation/world/synthetic_sequence.hpp"
 #include "tests/support/unorganized_copy.hpp"
 
 namespace {

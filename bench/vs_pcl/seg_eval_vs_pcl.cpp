@@ -14,7 +14,7 @@
 #include "engine/graph.hpp"
 #include "evaluation/segmentation_eval.hpp"
 #include "graphs/embedded_graphs.hpp"
-#include "graphs/segment_params.hpp"
+#include "graphs/nodes/segment_params.hpp"
 #include "kernels/frame_labels.hpp"
 
 namespace ob = orthoflow::bench;

@@ -13,7 +13,7 @@
 #include "bench/vs_pcl/pcl_chain.hpp"
 #include "formats/pcd_io.hpp"
 #include "kernels/segmentation_chain.hpp"
-#include "simulation/synthetic_scene.hpp"
+#include "simulation/world/synthetic_scene.hpp"
 #include "tests/kernels/seg_quality.hpp"
 
 namespace ob = orthoflow::bench;

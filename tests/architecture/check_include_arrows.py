@@ -37,10 +37,22 @@ ALLOWED = {
     "apps": ["core", "memory_pool", "kernels", "engine", "formats", "simulation", "drivers", "learning", "bridge",
              "evaluation", "graphs", "ui", "manipulation", "deploy"],
 }
+# Rooms inside a folder, and the rooms of the same folder each may include besides itself ("." is a
+# file directly in the folder). A folder's own files follow these arrows; other folders are not bound
+# by them. Each device driver uses the USB seam and never the other device; the simulated devices
+# look at the simulated world, never the other way; in graphs/, a frame is the bottom, channels
+# carry frames' commands, services serve the nodes, and sessions run whole graphs.
+ROOMS = {
+    "drivers": {"usb": [], "kinect": ["usb"], "jaco": ["usb"]},
+    "simulation": {"world": [], "devices": ["world"]},
+    "graphs": {"frame": [], "channels": ["frame"], "services": ["frame", "channels"],
+               "nodes": ["frame", "channels", "services"], ".": ["frame", "channels", "services", "nodes"],
+               "sessions": ["frame", "channels", "services", "nodes", "."]},
+}
 # Top-level folders beside the product that product code never includes (STYLE rule 1).
 NOT_PRODUCT = ["tests", "bench", "toolchains", "docs", "scripts", "config"]
 # Headers only drivers/ may include (its libusb transport, STYLE rule 16).
-DRIVERS_ONLY = re.compile(r"(^|/)libusb\.h$")
+DRIVERS_ONLY = re.compile(r"(^|/)(libusb\.h|libusb_api\.hpp)$")
 # Headers kernels/ never includes (STYLE rule 1: xsimd and Eigen only).
 KERNELS_FORBIDDEN = re.compile(r"^(tbb/|oneapi/|iceoryx|iox/|leveldb/|libusb)|(^|/)libusb\.h$")
 # Folders scanned for libusb.h besides the product ones.
@@ -58,6 +70,10 @@ def print_table(out):
     out.write("include arrows enforced (a folder may always include itself):\n")
     for folder, uses in ALLOWED.items():
         out.write("  %-12s may use: %s\n" % (folder, ", ".join(uses) if uses else "(nothing of ours)"))
+    for folder, rooms in ROOMS.items():
+        for room, uses in rooms.items():
+            out.write("  %-12s may use: %s\n" % ("%s/%s" % (folder, room),
+                      ", ".join("%s/%s" % (folder, r) for r in uses) if uses else "(no other room)"))
     out.write("  never from product code: %s/\n" % "/, ".join(NOT_PRODUCT))
     out.write("  libusb.h: drivers/ only (and the test shim %s); kernels/: no tbb, oneapi/tbb, iceoryx, iox, leveldb or "
               "libusb headers\n" % LIBUSB_SHIM_DIR)
@@ -91,6 +107,30 @@ def source_files(root, folder):
                 yield os.path.join(directory, name)
 
 
+def room_of(folder, parts):
+    """The room of a path inside @p folder given as its components after the folder, or None."""
+    rooms = ROOMS.get(folder)
+    if rooms is None:
+        return None
+    if len(parts) >= 2 and parts[0] in rooms:
+        return parts[0]
+    return "." if len(parts) == 1 else None
+
+
+def room_violation(folder, rel, header):
+    """A sentence when @p header breaks the room arrows of @p folder for the file @p rel, else None."""
+    parts = rel.replace(os.sep, "/").split("/")
+    own = room_of(folder, parts[1:])
+    head = header.split("/")
+    if own is None or head[0] != folder:
+        return None
+    target = room_of(folder, head[1:])
+    if target is None or target == own or target in ROOMS[folder][own]:
+        return None
+    uses = ", ".join("%s/%s" % (folder, r) for r in ROOMS[folder][own]) or "no other room"
+    return "%s/%s may not include \"%s\" (%s/%s may use: %s)" % (folder, own, header, folder, own, uses)
+
+
 def violations_in(root, folder, path):
     rel = os.path.relpath(path, root)
     problems = []
@@ -102,6 +142,8 @@ def violations_in(root, folder, path):
                 uses = ", ".join(ALLOWED[folder]) or "nothing of ours"
                 problems.append("%s: %s/ may not include \"%s\" (%s/ may use: %s)" % (where, folder, header, folder,
                                                                                      uses))
+            elif room_violation(folder, rel, header):
+                problems.append("%s: %s" % (where, room_violation(folder, rel, header)))
             elif first in NOT_PRODUCT:
                 problems.append("%s: %s/ may not include \"%s\" (product code never includes %s/)" % (
                     where, folder, header, first))
@@ -146,6 +188,10 @@ def self_test():
         "tests/t.cpp": '#include "graphs/tabletop.hpp"\n#include <libusb.h>\n',
         "tests/support/sim_libusb/shim.cpp": '#include <libusb-1.0/libusb.h>\n',
         "tests/support/sim_libusb_other/x.cpp": '#include <libusb-1.0/libusb.h>\n',
+        "drivers/kinect/k.cpp": '#include "drivers/usb/u.hpp"\n#include "drivers/jaco/j.hpp"\n#include "drivers/kinect/x.hpp"\n',
+        "simulation/world/w.cpp": '#include "simulation/devices/d.hpp"\n#include "drivers/kinect/x.hpp"\n',
+        "graphs/nodes/n.cpp": '#include "graphs/services/s.hpp"\n#include "graphs/sessions/t.hpp"\n#include "graphs/tabletop.hpp"\n',
+        "graphs/tabletop.cpp": '#include "graphs/nodes/n.hpp"\n',
     }
     expected = [
         "kernels/k.hpp:3: kernels/ may not include \"engine/graph.hpp\"",
@@ -158,6 +204,10 @@ def self_test():
         "drivers/d.cpp:3: drivers/ may not include \"graphs/g.hpp\"",
         "tests/t.cpp:2: \"libusb.h\" outside drivers/",
         "tests/support/sim_libusb_other/x.cpp:1: \"libusb-1.0/libusb.h\" outside drivers/",
+        "drivers/kinect/k.cpp:2: drivers/kinect may not include \"drivers/jaco/j.hpp\"",
+        "simulation/world/w.cpp:1: simulation/world may not include \"simulation/devices/d.hpp\"",
+        "graphs/nodes/n.cpp:2: graphs/nodes may not include \"graphs/sessions/t.hpp\"",
+        "graphs/nodes/n.cpp:3: graphs/nodes may not include \"graphs/tabletop.hpp\"",
     ]
     with tempfile.TemporaryDirectory() as root:
         for rel, text in files.items():

@@ -12,8 +12,8 @@
 #include "kernels/good.hpp"
 #include "learning/bayes_learner.hpp"
 #include "learning/instance_learner.hpp"
-#include "simulation/object_catalog.hpp"
-#include "simulation/object_dataset.hpp"
+#include "simulation/world/object_catalog.hpp"
+#include "simulation/world/object_dataset.hpp"
 
 namespace orthoflow::testing {
 namespace {

@@ -18,9 +18,9 @@
 #include "kernels/good.hpp"
 #include "kernels/segmentation_chain.hpp"
 #include "kernels/simd_arch.hpp"
-#include "simulation/object_catalog.hpp"
-#include "simulation/object_dataset.hpp"
-#include "simulation/synthetic_scene.hpp"
+#include "simulation/world/object_catalog.hpp"
+#include "simulation/world/object_dataset.hpp"
+#include "simulation/world/synthetic_scene.hpp"
 
 namespace orthoflow::testing {
 namespace {

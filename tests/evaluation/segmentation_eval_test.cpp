@@ -11,7 +11,7 @@
 #include "evaluation/segmentation_eval.hpp"
 #include "formats/pcd_io.hpp"
 #include "kernels/frame_labels.hpp"
-#include "simulation/synthetic_scene.hpp"
+#include "simulation/world/synthetic_scene.hpp"
 #include "tests/evaluation/box_dataset.hpp"
 
 namespace orthoflow::evaluation {

@@ -1,9 +1,9 @@
-// Fuzzes the JACO packet codec (drivers/jaco_protocol.hpp) with arbitrary arm bytes: the input is
-// cut into 64-byte packets (a trailing partial one zero-padded) and every packet goes through the
-// reply check for every known command, the header reader and every payload parser; the first 112
-// bytes also go through the client-info parser. No input may crash or hit UB, and whatever a parser
-// accepts must be finite and in range, and must survive its encoder and the parser again unchanged
-// (for the payloads that are all fields: bit for bit against the input bytes).
+// Fuzzes the JACO packet codec (drivers/jaco/jaco_protocol.hpp) with arbitrary arm bytes: the input
+// is cut into 64-byte packets (a trailing partial one zero-padded) and every packet goes through
+// the reply check for every known command, the header reader and every payload parser; the first
+// 112 bytes also go through the client-info parser. No input may crash or hit UB, and whatever a
+// parser accepts must be finite and in range, and must survive its encoder and the parser again
+// unchanged (for the payloads that are all fields: bit for bit against the input bytes).
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -12,7 +12,7 @@
 #include <span>
 #include <string_view>
 
-#include "drivers/jaco_protocol.hpp"
+#include "drivers/jaco/jaco_protocol.hpp"
 
 namespace jaco = orthoflow::drivers::jaco;
 

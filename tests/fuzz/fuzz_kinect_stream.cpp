@@ -8,10 +8,10 @@
 #include <string_view>
 #include <vector>
 
-#include "drivers/kinect_assembler.hpp"
-#include "drivers/kinect_protocol.hpp"
+#include "drivers/kinect/kinect_assembler.hpp"
+#include "drivers/kinect/kinect_protocol.hpp"
 #include "formats/fakenect.hpp"
-#include "graphs/fakenect_calibration.hpp"
+#include "graphs/nodes/fakenect_calibration.hpp"
 
 namespace kinect = orthoflow::drivers::kinect;
 

@@ -1,9 +1,9 @@
-// Fuzzes the learning channel's payload decoding (graphs/learning_payloads.hpp): what another
-// process publishes as a command, an acknowledgement or a status. The first byte picks the payload
-// and whether its header is made right (so the fuzzer reaches the fields behind it); the rest fills
-// the payload. No input may crash, hang, leak or hit UB; a decoded command must hold a known kind
-// and, where its kind needs one, a label the label rule accepts, and re-encode to itself; a decoded
-// ack or status must hold only what its ranges allow.
+// Fuzzes the learning channel's payload decoding (graphs/channels/learning_payloads.hpp): what
+// another process publishes as a command, an acknowledgement or a status. The first byte picks the
+// payload and whether its header is made right (so the fuzzer reaches the fields behind it); the
+// rest fills the payload. No input may crash, hang, leak or hit UB; a decoded command must hold a
+// known kind and, where its kind needs one, a label the label rule accepts, and re-encode to
+// itself; a decoded ack or status must hold only what its ranges allow.
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -11,7 +11,7 @@
 #include <span>
 
 #include "core/label_text.hpp"
-#include "graphs/learning_payloads.hpp"
+#include "graphs/channels/learning_payloads.hpp"
 #include "tests/fuzz/fuzz_payload_support.hpp"
 
 namespace g = orthoflow::graphs;

@@ -1,8 +1,8 @@
-// Fuzzes the task command channel's payload decoding (graphs/task_payloads.hpp): what another
-// process publishes as a task command or a task status. The first byte picks the payload and
-// whether its header is made right (so the fuzzer reaches the fields behind it); the rest fills the
-// payload. No input may crash, hang, leak or hit UB; a decoded command must hold a known kind and
-// task, at most TASK_MAX_BRING categories the label rule accepts, and re-encode to itself; a
+// Fuzzes the task command channel's payload decoding (graphs/channels/task_payloads.hpp): what
+// another process publishes as a task command or a task status. The first byte picks the payload
+// and whether its header is made right (so the fuzzer reaches the fields behind it); the rest fills
+// the payload. No input may crash, hang, leak or hit UB; a decoded command must hold a known kind
+// and task, at most TASK_MAX_BRING categories the label rule accepts, and re-encode to itself; a
 // decoded status must hold only what its ranges allow.
 #include <cstdint>
 #include <cstring>
@@ -10,7 +10,7 @@
 #include <span>
 
 #include "core/label_text.hpp"
-#include "graphs/task_payloads.hpp"
+#include "graphs/channels/task_payloads.hpp"
 #include "tests/fuzz/fuzz_payload_support.hpp"
 
 namespace g = orthoflow::graphs;

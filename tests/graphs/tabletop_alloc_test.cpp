@@ -16,11 +16,11 @@
 #include <unistd.h>
 
 #include "core/rng.hpp"
-#include "drivers/jaco_kinematics.hpp"
+#include "drivers/jaco/jaco_kinematics.hpp"
 #include "formats/pcd_io.hpp"
-#include "graphs/body_filter_node.hpp"
-#include "graphs/descriptor_params.hpp"
-#include "graphs/labels_writer.hpp"
+#include "graphs/nodes/body_filter_node.hpp"
+#include "graphs/nodes/descriptor_params.hpp"
+#include "graphs/nodes/labels_writer.hpp"
 #include "kernels/frame_labels.hpp"
 #include "learning/dictionary.hpp"
 #include "learning/topic_training.hpp"

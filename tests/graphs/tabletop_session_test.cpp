@@ -13,7 +13,7 @@
 #include <string>
 
 #include "formats/pcd_io.hpp"
-#include "graphs/descriptor_params.hpp"
+#include "graphs/nodes/descriptor_params.hpp"
 #include "tabletop_run.hpp"
 #include "tests/support/unorganized_copy.hpp"
 

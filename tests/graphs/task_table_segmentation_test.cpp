@@ -12,11 +12,11 @@
 
 #include "engine/graph.hpp"
 #include "graphs/embedded_graphs.hpp"
-#include "graphs/segment_params.hpp"
-#include "graphs/table_task_session.hpp"
+#include "graphs/nodes/segment_params.hpp"
+#include "graphs/sessions/table_task_session.hpp"
 #include "kernels/frame_labels.hpp"
 #include "kernels/segmentation_chain.hpp"
-#include "simulation/synthetic_scene.hpp"
+#include "simulation/world/synthetic_scene.hpp"
 #include "tests/support/counting_new.hpp"  // the one TU of this binary that replaces operator new
 
 namespace orthoflow::graphs {

@@ -6,6 +6,7 @@
 #include <signal.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <string>
 #include <thread>
 
@@ -40,6 +41,18 @@ TEST(IpcArmState, ArmStatePublishesEveryCycleToAnotherProcess) {
   EXPECT_EQ(outcome.failures, "");
 }
 
+// The number after @p key in a summary line ("frames_filtered 60,"), or -1.
+long counter(const std::string& text, const std::string& key) {
+  const std::size_t at = text.find(key);
+  return at == std::string::npos ? -1 : std::strtol(text.c_str() + at + key.size(), nullptr, 10);
+}
+
+#if defined(__SANITIZE_ADDRESS__)
+constexpr bool SANITIZED = true;
+#else
+constexpr bool SANITIZED = false;
+#endif
+
 TEST(IpcArmState, TheRunRemovesTheArmUsingTheStreamedState) {
   // The robot-body filter across processes: the simulated arm publishes its joints at 100 Hz and
   // `orthoflow run --robot-frames` filters every frame with them; none is dropped for a stale
@@ -57,10 +70,17 @@ TEST(IpcArmState, TheRunRemovesTheArmUsingTheStreamedState) {
         const ProcResult r = box.wait(run, 60s);
         ::kill(arm, SIGTERM);
         box.check(r.exit_code == 0, "run with the body filter exits 0", r);
-        box.check(r.out.find("frames_filtered 60,") != std::string::npos,
-                  "all 60 frames filtered with a fresh state", r);
-        box.check(r.out.find("dropped_stale_state 0,") != std::string::npos,
-                  "none dropped as stale", r);
+        // Every frame is filtered with the arm's state or dropped: none passes unfiltered. How many
+        // are dropped depends on speed: a frame that reaches the filter later than the state
+        // history's 640 ms finds no state near its stamp (the sanitizers' slowdown on a loaded
+        // machine), so "all filtered, none dropped" is asserted in the uninstrumented build only.
+        const long filtered = counter(r.out, "frames_filtered ");
+        const long stale = counter(r.out, "dropped_stale_state ");
+        const long no_state = counter(r.out, "dropped_no_state ");
+        box.check(filtered + stale + no_state == 60 && filtered > 0,
+                  "every frame filtered with the arm's state or dropped", r);
+        box.check(SANITIZED || (filtered == 60 && stale == 0),
+                  "all 60 frames filtered with a fresh state, none dropped as stale", r);
         const ProcResult a = box.wait(arm, 20s);
         box.check(a.exit_code == 0, "the arm exits 0 on SIGTERM", a);
         box.check(a.err.find("published ") != std::string::npos, "and says how many it sent", a);

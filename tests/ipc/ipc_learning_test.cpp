@@ -1,8 +1,9 @@
 // Teaching across processes: `orthoflow ui` serves the web view over a graph that `orthoflow run
 // --ipc-learning` runs in another process (objects and status in, learning commands out, answers
-// back over iceoryx; graphs/learning_payloads.hpp), driven here by the CLI's thin client exactly
-// as a person's page or a script would; and a process publishing malformed commands gets a refusal
-// for each while the graph runs on. Own RouDi in a private mount namespace (roudi_sandbox.hpp).
+// back over iceoryx; graphs/channels/learning_payloads.hpp), driven here by the CLI's thin client
+// exactly as a person's page or a script would; and a process publishing malformed commands gets a
+// refusal for each while the graph runs on. Own RouDi in a private mount namespace
+// (roudi_sandbox.hpp).
 #include <gtest/gtest.h>
 #include <signal.h>
 
@@ -17,7 +18,7 @@
 #include "core/label_text.hpp"
 #include "engine/ipc_pubsub.hpp"
 #include "engine/ipc_runtime.hpp"
-#include "graphs/learning_payloads.hpp"
+#include "graphs/channels/learning_payloads.hpp"
 #include "tests/ipc/roudi_sandbox.hpp"
 
 namespace orthoflow::tests {

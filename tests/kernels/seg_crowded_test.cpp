@@ -16,10 +16,10 @@
 #include "evaluation/segmentation_eval.hpp"
 #include "formats/pcd_io.hpp"
 #include "graphs/embedded_graphs.hpp"
-#include "graphs/segment_params.hpp"
+#include "graphs/nodes/segment_params.hpp"
 #include "kernels/segmentation_chain.hpp"
 #include "seg_quality.hpp"
-#include "simulation/synthetic_scene.hpp"
+#include "simulation/world/synthetic_scene.hpp"
 #include "tests/support/counting_new.hpp"  // the one TU of this binary that replaces operator new
 
 namespace ok = orthoflow::kernels;

@@ -1,7 +1,7 @@
 // The execution manager (manipulation/execution_manager.hpp) driving the simulated JACO through its
-// real controller, in lock step on simulated time (tests/drivers/jaco_test_rig.hpp), in a small
-// world that reacts to the arm: a mug that follows the hand once the fingers close around it, seen
-// by a perception stand-in that reports it every 33 ms with 30 ms of latency. A whole pick and
+// real controller, in lock step on simulated time (tests/drivers/jaco/jaco_test_rig.hpp), in a
+// small world that reacts to the arm: a mug that follows the hand once the fingers close around it,
+// seen by a perception stand-in that reports it every 33 ms with 30 ms of latency. A whole pick and
 // place, then every abort: target moved, lost, stale perception, an obstacle while carrying, a
 // missed grasp, the emergency stop, a refused command, a timeout, a person's stop.
 #include <gtest/gtest.h>
@@ -13,7 +13,7 @@
 
 #include "manipulation/execution_manager.hpp"
 #include "manipulation/pick_place_job.hpp"
-#include "tests/drivers/jaco_test_rig.hpp"
+#include "tests/drivers/jaco/jaco_test_rig.hpp"
 #include "tests/support/counting_new.hpp"  // the one TU of this binary that replaces operator new
 
 namespace orthoflow::manipulation {

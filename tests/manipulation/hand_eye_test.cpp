@@ -10,7 +10,7 @@
 
 #include <gtest/gtest.h>
 
-#include "drivers/jaco_kinematics.hpp"
+#include "drivers/jaco/jaco_kinematics.hpp"
 
 namespace orthoflow::manipulation {
 namespace {

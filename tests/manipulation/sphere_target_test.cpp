@@ -12,12 +12,12 @@
 #include <random>
 #include <vector>
 
-#include "drivers/jaco_kinematics.hpp"
+#include "drivers/jaco/jaco_kinematics.hpp"
 #include "kernels/sphere_target.hpp"
 #include "manipulation/arm_body.hpp"
 #include "manipulation/hand_eye.hpp"
 #include "manipulation/robot_frames.hpp"
-#include "simulation/synthetic_scene.hpp"
+#include "simulation/world/synthetic_scene.hpp"
 
 namespace orthoflow::manipulation {
 namespace {

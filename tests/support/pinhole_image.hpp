@@ -6,7 +6,7 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "graphs/camera_tap.hpp"
+#include "graphs/nodes/camera_tap.hpp"
 
 namespace orthoflow::test {
 

@@ -3,8 +3,8 @@
 // /usr/bin/fakenect-record run as child processes with LD_LIBRARY_PATH=<the shim's directory>;
 // this process keeps the real libusb. What they wrote is compared with SimKinectDevice built
 // from the same ORTHOFLOW_SIM_KINECT string, and libfreenect's FREENECT_DEPTH_MM with orthoflow's
-// own raw-to-millimetre table (drivers/kinect_depth.hpp), and FREENECT_DEPTH_REGISTERED with
-// orthoflow's depth-to-colour registration (drivers/kinect_registration.hpp).
+// own raw-to-millimetre table (drivers/kinect/kinect_depth.hpp), and FREENECT_DEPTH_REGISTERED with
+// orthoflow's depth-to-colour registration (drivers/kinect/kinect_registration.hpp).
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
@@ -28,11 +28,11 @@
 #include <thread>
 #include <vector>
 
-#include "drivers/kinect_control.hpp"
-#include "drivers/kinect_depth.hpp"
-#include "drivers/kinect_registration.hpp"
-#include "simulation/sim_kinect_device.hpp"
-#include "simulation/sim_usb_transport.hpp"
+#include "drivers/kinect/kinect_control.hpp"
+#include "drivers/kinect/kinect_depth.hpp"
+#include "drivers/kinect/kinect_registration.hpp"
+#include "simulation/devices/sim_kinect_device.hpp"
+#include "simulation/devices/sim_usb_transport.hpp"
 #include "tests/support/sim_libusb/sim_kinect_env.hpp"
 
 extern char** environ;

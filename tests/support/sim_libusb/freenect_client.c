@@ -10,7 +10,7 @@
  * per device libfreenect lists). Exit status 0 only if FRAMES frames arrived within 20 s.
  *
  * usage: freenect_client 11bit|mm PERIODS -
- * (bench/drivers/loss_vs_libfreenect.sh) streams every frame libfreenect delivers to stdout as one
+ * (bench/drivers/kinect/loss_vs_libfreenect.sh) streams every frame libfreenect delivers to stdout as one
  * record each: the callback's 60 MHz timestamp (u32, host order), then 640 x 480 host-order u16.
  * Stops after the first frame at least PERIODS frame periods (2,000,000 ticks each) after the
  * first delivered frame, so a frame lost before that is never waited for; the messages go to

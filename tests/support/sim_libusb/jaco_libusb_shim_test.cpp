@@ -1,7 +1,7 @@
-// The JACO driver (drivers/jaco_controller.hpp over drivers/libusb_transport.hpp) end to end
-// against the simulated arm inside the sim_libusb shim: the binary links the real libusb-1.0; CTest
-// starts it with LD_LIBRARY_PATH=<the shim's directory>, so every libusb call (the driver's and the
-// raw ones below) reaches the shim, which hosts simulation::SimJacoArm behind
+// The JACO driver (drivers/jaco/jaco_controller.hpp over drivers/usb/libusb_transport.hpp) end to
+// end against the simulated arm inside the sim_libusb shim: the binary links the real libusb-1.0;
+// CTest starts it with LD_LIBRARY_PATH=<the shim's directory>, so every libusb call (the driver's
+// and the raw ones below) reaches the shim, which hosts simulation::SimJacoArm behind
 // libusb_interrupt_transfer. Each test sets ORTHOFLOW_SIM_JACO / ORTHOFLOW_SIM_KINECT before its
 // libusb_init (the shim builds its bus at the first libusb_init after the last libusb_exit). The
 // arm runs in real time (README "JACO"), so the controller is cycled as JacoArm::run does: one
@@ -18,11 +18,11 @@
 #include <string>
 #include <thread>
 
-#include "drivers/jaco_arm.hpp"
-#include "drivers/jaco_controller.hpp"
-#include "drivers/kinect_camera.hpp"
-#include "drivers/libusb_transport.hpp"
-#include "simulation/sim_jaco_arm.hpp"
+#include "drivers/jaco/jaco_arm.hpp"
+#include "drivers/jaco/jaco_controller.hpp"
+#include "drivers/kinect/kinect_camera.hpp"
+#include "drivers/usb/libusb_transport.hpp"
+#include "simulation/devices/sim_jaco_arm.hpp"
 #include "tests/support/sim_libusb/sim_jaco_env.hpp"
 #include "tests/support/sim_libusb/sim_kinect_env.hpp"
 

@@ -1,8 +1,8 @@
-// orthoflow's real libusb transport (drivers/libusb_transport.hpp) end to end against the simulated
-// Kinect, through the sim_libusb shim: the binary links the real libusb-1.0; CTest starts it with
-// LD_LIBRARY_PATH=<the shim's directory> and ORTHOFLOW_SIM_KINECT_PACE=max, so the dynamic loader
-// binds every libusb call to the shim. Frames are compared bit for bit with SimKinectDevice built
-// from the same ORTHOFLOW_SIM_KINECT string.
+// orthoflow's real libusb transport (drivers/usb/libusb_transport.hpp) end to end against the
+// simulated Kinect, through the sim_libusb shim: the binary links the real libusb-1.0; CTest starts
+// it with LD_LIBRARY_PATH=<the shim's directory> and ORTHOFLOW_SIM_KINECT_PACE=max, so the dynamic
+// loader binds every libusb call to the shim. Frames are compared bit for bit with SimKinectDevice
+// built from the same ORTHOFLOW_SIM_KINECT string.
 #include <dlfcn.h>
 #include <gtest/gtest.h>
 
@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
-#include "drivers/kinect_camera.hpp"
-#include "drivers/libusb_transport.hpp"
-#include "simulation/sim_kinect_device.hpp"
+#include "drivers/kinect/kinect_camera.hpp"
+#include "drivers/usb/libusb_transport.hpp"
+#include "simulation/devices/sim_kinect_device.hpp"
 #include "tests/support/sim_libusb/sim_kinect_env.hpp"
 
 namespace orthoflow::drivers::kinect {

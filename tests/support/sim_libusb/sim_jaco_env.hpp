@@ -26,8 +26,8 @@
 #include <vector>
 
 #include "core/result.hpp"
-#include "simulation/sim_jaco_arm.hpp"
-#include "simulation/sim_kinect_device.hpp"
+#include "simulation/devices/sim_jaco_arm.hpp"
+#include "simulation/devices/sim_kinect_device.hpp"
 
 namespace orthoflow::sim_libusb {
 

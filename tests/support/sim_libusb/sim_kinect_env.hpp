@@ -27,7 +27,7 @@
 #include <vector>
 
 #include "core/result.hpp"
-#include "simulation/sim_kinect_device.hpp"
+#include "simulation/devices/sim_kinect_device.hpp"
 
 namespace orthoflow::sim_libusb {
 

@@ -1,8 +1,9 @@
 // A libusb-1.0 compatible shim (SONAME libusb-1.0.so.0) over simulated Kinects
-// (simulation/sim_kinect_device.hpp) and Kinova JACO arms (simulation/sim_jaco_arm.hpp), so that
-// unmodified libusb programs (libfreenect, orthoflow's LibusbTransport) run against the simulators
-// when started with LD_LIBRARY_PATH=<this lib's dir>.
-// Test support only: README.md beside this file documents the behaviour and the environment.
+// (simulation/devices/sim_kinect_device.hpp) and Kinova JACO arms
+// (simulation/devices/sim_jaco_arm.hpp), so that unmodified libusb programs (libfreenect,
+// orthoflow's LibusbTransport) run against the simulators when started with LD_LIBRARY_PATH=<this
+// lib's dir>. Test support only: README.md beside this file documents the behaviour and the
+// environment.
 //
 // Structure: one process-wide World (the simulated bus: devices, open handles, iso queues and the
 // simulated clock), created at the first libusb_init and destroyed at the last libusb_exit, and
@@ -26,8 +27,8 @@
 #include <string>
 #include <vector>
 
-#include "simulation/sim_jaco_arm.hpp"
-#include "simulation/sim_kinect_device.hpp"
+#include "simulation/devices/sim_jaco_arm.hpp"
+#include "simulation/devices/sim_kinect_device.hpp"
 #include "tests/support/sim_libusb/sim_jaco_env.hpp"
 #include "tests/support/sim_libusb/sim_kinect_env.hpp"
 

@@ -1,0 +1,269 @@
+#include "drivers/jaco/jaco_controller.hpp"
+
+#include <cmath>
+
+namespace orthoflow::drivers::jaco {
+namespace {
+
+Unexpected<JacoError> error_of(JacoError::Code code) {
+  JacoError e;
+  e.code = code;
+  return err(e);
+}
+
+Unexpected<JacoError> refused(const SafetyViolation& violation) {
+  JacoError e;
+  e.code = JacoError::Code::REFUSED;
+  e.violation = violation;
+  return err(e);
+}
+
+}  // namespace
+
+const char* to_string(ControlState state) noexcept {
+  switch (state) {
+    case ControlState::IDLE:
+      return "idle";
+    case ControlState::MOVING:
+      return "moving";
+    case ControlState::VELOCITY:
+      return "velocity";
+    case ControlState::HOMING:
+      return "homing";
+    case ControlState::ESTOP:
+      return "estop";
+    case ControlState::FAULT:
+      return "fault";
+  }
+  return "unknown";
+}
+
+const char* to_string(StopReason reason) noexcept {
+  switch (reason) {
+    case StopReason::NONE:
+      return "none";
+    case StopReason::REACHED:
+      return "reached";
+    case StopReason::STOPPED:
+      return "stopped";
+    case StopReason::WATCHDOG:
+      return "watchdog";
+    case StopReason::ESTOP:
+      return "estop";
+    case StopReason::FAULT:
+      return "fault";
+    case StopReason::SETTLE_TIMEOUT:
+      return "settle_timeout";
+    case StopReason::HOME_TIMEOUT:
+      return "home_timeout";
+    case StopReason::REFUSED:
+      return "refused";
+  }
+  return "unknown";
+}
+
+JacoController::JacoController(UsbTransport& transport, ControllerOptions options) noexcept
+    : transport_(&transport), clock_(&transport.clock()), options_(options) {}
+
+Result<std::unique_ptr<JacoController>, JacoError> JacoController::open(UsbTransport& transport,
+                                                                        const UsbDeviceInfo& device,
+                                                                        ControllerOptions options) {
+  std::unique_ptr<JacoController> controller(new JacoController(transport, options));
+  auto started = controller->start_up(device);
+  if (!started) return err(started.error());
+  return controller;
+}
+
+Result<void, JacoError> JacoController::start_up(const UsbDeviceInfo& device) {
+  link_.reset();
+  auto link = JacoLink::open(*transport_, device, options_.link);
+  if (!link) return err(link.error());
+  link_.emplace(std::move(link).value());
+  auto identity = link_->read_identity();
+  if (!identity) return err(identity.error());
+  identity_ = identity.value();
+  options_.limits.geometry =
+      identity_.model == Model::JACO_V1 ? &jaco_v1_geometry() : &jaco2_geometry();
+  options_.limits.max_finger =
+      std::min(options_.limits.max_finger, static_cast<double>(finger_closed(identity_.model)));
+  // Take control, then make sure nothing latched or queued by an earlier session moves the arm.
+  for (Command c : {Command::START_API_CONTROL, Command::SET_CONTROL_ANGULAR}) {
+    auto ok = link_->command(c);
+    if (!ok) return err(ok.error());
+  }
+  if (!send_joystick(JoystickState{})) return err(state_.fault_error);
+  auto erased = link_->command(Command::ERASE_TRAJECTORIES);
+  if (!erased) return err(erased.error());
+  auto arm_state = link_->read_state(identity_.firmware.dsp.dsp5());
+  if (!arm_state) return err(arm_state.error());
+  state_ = ArmSnapshot{};
+  state_.arm_state = arm_state.value();
+  have_previous_ = false;
+  read_state();
+  if (state_.fault) return err(state_.fault_error);
+  state_.control = ControlState::IDLE;
+  std::lock_guard lock(mutex_);
+  pending_motion_.reset();
+  pending_fingers_.reset();
+  pending_stop_ = false;
+  published_ = state_;
+  return {};
+}
+
+JacoController::~JacoController() {
+  if (!link_ || state_.fault) return;
+  // Best effort on the way out: stop, then hand control back to the joystick.
+  (void)send_joystick(JoystickState{});
+  (void)link_->command(Command::ERASE_TRAJECTORIES);
+  (void)link_->command(Command::STOP_API_CONTROL);
+}
+
+Result<void, JacoError> JacoController::validate(const ArmCommand& command,
+                                                 const ArmSnapshot& now) const {
+  using Kind = ArmCommand::Kind;
+  const SafetyLimits& limits = options_.limits;
+  if (command.kind == Kind::STOP || command.kind == Kind::KEEP_ALIVE) return {};
+  if (now.estop || estop_.load(std::memory_order_acquire)) return error_of(JacoError::Code::ESTOP);
+  if (now.fault) return error_of(JacoError::Code::FAULT);
+  if (!std::isfinite(command.speed_fraction) || command.speed_fraction <= 0.0 ||
+      command.speed_fraction > 1.0) {
+    SafetyViolation v;
+    v.limit = SafetyViolation::Limit::SPEED;
+    v.value = command.speed_fraction;
+    v.bound = 1.0;
+    return refused(v);
+  }
+  const bool homed = now.arm_state != ArmState::NOINIT && now.arm_state != ArmState::ERROR;
+  switch (command.kind) {
+    case Kind::MOVE_JOINTS: {
+      if (!homed) return error_of(JacoError::Code::INVALID_STATE);
+      auto ok = check_joint_move(limits, now.joints, command.joints);
+      if (!ok) return refused(ok.error());
+      return {};
+    }
+    case Kind::MOVE_POSE: {
+      if (!homed) return error_of(JacoError::Code::INVALID_STATE);
+      auto ok = check_pose(limits, command.pose);
+      if (!ok) return refused(ok.error());
+      return {};  // submit() solves the IK and checks the joint path
+    }
+    case Kind::VELOCITY: {
+      if (!homed) return error_of(JacoError::Code::INVALID_STATE);
+      auto ok = check_joint_velocity(limits, command.velocity, now.commanded, 0.01);
+      if (!ok) return refused(ok.error());
+      // Where this velocity would take the arm if the client vanished now: until the watchdog.
+      const double horizon_s = static_cast<double>(options_.command_timeout_ns) * 1e-9;
+      JointAngles ahead = now.joints;
+      for (std::size_t j = 0; j < JOINTS; ++j) ahead[j] += command.velocity[j] * horizon_s;
+      auto path = check_joint_move(limits, now.joints, ahead);
+      if (!path) return refused(path.error());
+      return {};
+    }
+    case Kind::MOVE_FINGERS: {
+      auto ok = check_fingers(limits, command.fingers);
+      if (!ok) return refused(ok.error());
+      return {};
+    }
+    case Kind::HOME:
+      return {};
+    case Kind::RETRACT: {
+      const ButtonAction first = next_button_action(now.arm_state, ArmGoal::RETRACT, false);
+      if (first == ButtonAction::REFUSE) return error_of(JacoError::Code::INVALID_STATE);
+      return {};
+    }
+    default:
+      return {};
+  }
+}
+
+Result<ArmCommand, JacoError> JacoController::check_command(const ArmCommand& command,
+                                                            const ArmSnapshot& now) const {
+  auto ok = validate(command, now);
+  if (!ok) return err(ok.error());
+  ArmCommand accepted = command;
+  if (command.kind == ArmCommand::Kind::MOVE_POSE) {
+    // Solved on the caller's thread, so an unreachable pose is refused to the caller.
+    auto solution = inverse_kinematics(to_transform(command.pose), now.joints,
+                                       options_.limits.joints, {}, *options_.limits.geometry);
+    if (!solution) {
+      SafetyViolation v;
+      v.limit = SafetyViolation::Limit::UNREACHABLE;
+      return refused(v);
+    }
+    auto path = check_joint_move(options_.limits, now.joints, solution.value());
+    if (!path) return refused(path.error());
+    accepted.kind = ArmCommand::Kind::MOVE_JOINTS;
+    accepted.joints = solution.value();
+  }
+  return accepted;
+}
+
+Result<void, JacoError> JacoController::submit(const ArmCommand& command) {
+  // Check on a copy, without the lock: the path check and the IK take microseconds to a
+  // millisecond, and the USB thread must never wait for them.
+  ArmSnapshot now;
+  {
+    std::lock_guard lock(mutex_);
+    now = published_;
+  }
+  auto checked = check_command(command, now);
+  std::lock_guard lock(mutex_);
+  if (!checked) {
+    ++published_.refused;
+    return err(checked.error());
+  }
+  const ArmCommand& accepted = checked.value();
+  // The latch or a fault may have come while the command was checked.
+  if (command.kind != ArmCommand::Kind::STOP && command.kind != ArmCommand::Kind::KEEP_ALIVE) {
+    if (published_.estop || estop_.load(std::memory_order_acquire)) {
+      ++published_.refused;
+      return error_of(JacoError::Code::ESTOP);
+    }
+    if (published_.fault) {
+      ++published_.refused;
+      return error_of(JacoError::Code::FAULT);
+    }
+  }
+  last_client_ns_.store(clock_->now_ns(), std::memory_order_release);
+  switch (command.kind) {
+    case ArmCommand::Kind::KEEP_ALIVE:
+      break;
+    case ArmCommand::Kind::STOP:
+      pending_stop_ = true;
+      pending_motion_.reset();
+      pending_fingers_.reset();
+      break;
+    case ArmCommand::Kind::MOVE_FINGERS:
+      pending_fingers_ = accepted;
+      break;
+    default:
+      pending_motion_ = accepted;
+      break;
+  }
+  return {};
+}
+
+void JacoController::keep_alive() noexcept {
+  last_client_ns_.store(clock_->now_ns(), std::memory_order_release);
+}
+
+Result<void, JacoError> JacoController::reset_estop() {
+  std::lock_guard lock(mutex_);
+  if (published_.fault) return error_of(JacoError::Code::FAULT);
+  if (!published_.estop && !estop_.load(std::memory_order_acquire)) return {};
+  // The latch clears on the USB thread's next cycle, after it has erased once more.
+  estop_.store(false, std::memory_order_release);
+  published_.estop = false;
+  return {};
+}
+
+Result<void, JacoError> JacoController::reinitialise(const UsbDeviceInfo& device) {
+  return start_up(device);
+}
+
+ArmSnapshot JacoController::snapshot() const {
+  std::lock_guard lock(mutex_);
+  return published_;
+}
+
+}  // namespace orthoflow::drivers::jaco

@@ -1,0 +1,207 @@
+#pragma once
+/// @file
+/// @brief JacoController: the JACO driver's control loop and its always-on safety layer (issue 19,
+/// specs/JACO.md 10 and 11). One thread calls cycle() every 10 ms (the arm's period; JacoArm does
+/// it); any thread submits commands, reads the newest snapshot and pulls the emergency stop.
+///
+/// Each cycle: read the joints and fingers (command 15, plus a rotating slow read: sensors,
+/// currents, arm state), run the watchdog, then send at most one motion packet:
+/// - a joint move or a pose (IK to the solution nearest the current joints) is streamed as 100 Hz
+///   angular velocity points along a synchronised trapezoid (jaco_motion.hpp), never as position
+///   points, which the arm would finish even if the host died;
+/// - HOME / RETRACT press and release the virtual button (next_button_action, JACO.md 10.1), with
+///   the DSP >= 5 double send 100 ms apart (JACO.md 9);
+/// - a client-streamed joint velocity is sent as it is, once checked.
+///
+/// Safety, on every path:
+/// - every command is checked before it is accepted (jaco_safety.hpp): a violation is refused with
+///   the limit's name (JacoError::REFUSED), nothing is clipped;
+/// - watchdog: a motion needs a command or keep_alive() at least every command_timeout (100 ms);
+///   the cycle that could not send again before that deadline releases the joystick and erases the
+///   arm's trajectory FIFO, so the arm has stopped by last command + command_timeout;
+/// - estop() (any thread, wait-free) latches: the next cycle releases and erases, and keeps erasing
+///   every cycle until reset_estop(); every motion command is refused meanwhile;
+/// - a failed exchange (unplug, stall, bad reply) puts the controller in FAULT in that same cycle:
+///   the snapshot says so, a best-effort stop is sent unless the arm is gone, and every command is
+///   refused until reinitialise().
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <optional>
+
+#include "core/result.hpp"
+#include "drivers/jaco/jaco_kinematics.hpp"
+#include "drivers/jaco/jaco_link.hpp"
+#include "drivers/jaco/jaco_motion.hpp"
+#include "drivers/jaco/jaco_safety.hpp"
+
+namespace orthoflow::drivers::jaco {
+
+/// @brief What the controller is doing.
+enum class ControlState : std::uint8_t { IDLE, MOVING, VELOCITY, HOMING, ESTOP, FAULT };
+[[nodiscard]] const char* to_string(ControlState state) noexcept;
+
+/// @brief Why the last motion ended.
+enum class StopReason : std::uint8_t {
+  NONE,
+  REACHED,
+  STOPPED,
+  WATCHDOG,
+  ESTOP,
+  FAULT,
+  SETTLE_TIMEOUT,
+  HOME_TIMEOUT,
+  REFUSED
+};
+[[nodiscard]] const char* to_string(StopReason reason) noexcept;
+
+/// @brief A command from a client. Fields not used by `kind` are ignored.
+struct ArmCommand {
+  enum class Kind : std::uint8_t {
+    KEEP_ALIVE,    ///< "still here": feeds the watchdog
+    MOVE_JOINTS,   ///< joints: actuator degrees
+    MOVE_POSE,     ///< pose: metres / radians (JACO.md 8)
+    VELOCITY,      ///< velocity: deg/s, streamed by the client at up to 100 Hz
+    MOVE_FINGERS,  ///< fingers: targets in the model's units (0 open)
+    HOME,
+    RETRACT,
+    STOP,  ///< stop now (not latched)
+  };
+  Kind kind = Kind::KEEP_ALIVE;
+  JointAngles joints{};
+  CartesianPose pose{};
+  JointVelocity velocity{};
+  std::array<double, FINGERS> fingers{};
+  double speed_fraction = 1.0;  ///< of the speed cap, in (0, 1]
+};
+
+/// @brief Tuning. Defaults follow JACO.md 9 and issue 19.
+struct ControllerOptions {
+  SafetyLimits limits{};
+  LinkPolicy link{};
+  std::int64_t command_timeout_ns = 100'000'000;  ///< watchdog
+  double gain_per_s = 4.0;                        ///< position correction while streaming
+  double goal_tolerance_deg = 0.1;
+  double finger_tolerance = 0.01;  ///< of the finger range
+  /// Fingers that travel less than this share of their range for finger_stall_ns have stopped
+  /// against something (a grasped object): the finger goal ends there (fingers_blocked).
+  double finger_stall_travel = 0.005;
+  std::int64_t finger_stall_ns = 300'000'000;
+  std::int64_t settle_timeout_ns = 2'000'000'000;  ///< after the profile ends
+  std::int64_t home_timeout_ns = 60'000'000'000;   ///< HOME / RETRACT
+  std::int64_t double_send_gap_ns = 100'000'000;   ///< DSP >= 5 joystick quirk
+};
+
+/// @brief Everything known about the arm after a cycle. Plain data; copied under a mutex.
+struct ArmSnapshot {
+  std::int64_t stamp_ns = 0;  ///< transport clock when the joints were read
+  std::uint64_t cycle = 0;
+  JointAngles joints{};
+  JointVelocity velocity{};   ///< from successive readings, deg/s
+  JointVelocity commanded{};  ///< the last velocity point sent, deg/s
+  std::array<double, FINGERS> fingers{};
+  bool fingers_moving = false;   ///< a finger goal is under way
+  bool fingers_blocked = false;  ///< the last finger goal ended short: the fingers stalled against
+                                 ///< something (ControllerOptions::finger_stall_ns)
+  CartesianPose pose{};          ///< forward kinematics of `joints`
+  std::array<float, JOINTS> currents{};
+  SensorInfo sensors{};
+  ArmState arm_state = ArmState::NOINIT;
+  ControlState control = ControlState::IDLE;
+  StopReason last_stop = StopReason::NONE;
+  bool estop = false;
+  bool fault = false;
+  JacoError fault_error{};
+  std::uint64_t watchdog_stops = 0;
+  std::uint64_t refused = 0;
+  std::uint64_t points_sent = 0;
+  std::uint64_t cycles_overrun = 0;  ///< cycles whose exchanges took longer than the period
+};
+
+class JacoController {
+ public:
+  /// @brief Opens the arm, reads its identity, takes API control, selects angular control,
+  /// releases the joystick and erases the FIFO (nothing a previous session left can move it).
+  /// @pre @p transport outlives the controller; the calling thread becomes the USB thread.
+  [[nodiscard]] static Result<std::unique_ptr<JacoController>, JacoError> open(
+      UsbTransport& transport, const UsbDeviceInfo& device, ControllerOptions options = {});
+  /// @brief Stops any motion, releases API control. @pre Called on the USB thread.
+  ~JacoController();
+  JacoController(const JacoController&) = delete;
+  JacoController& operator=(const JacoController&) = delete;
+
+  /// @brief Validates and queues @p command (any thread). The newest motion command replaces a
+  /// queued one. @return REFUSED naming the limit, ESTOP, FAULT, INVALID_STATE. @note Accepted
+  /// commands feed the watchdog; refused ones do not.
+  [[nodiscard]] Result<void, JacoError> submit(const ArmCommand& command);
+  /// @brief Feeds the watchdog (any thread, wait-free).
+  void keep_alive() noexcept;
+  /// @brief Latches the emergency stop (any thread, wait-free, async-signal-safe).
+  void estop() noexcept { estop_.store(true, std::memory_order_release); }
+  /// @brief Clears the latch once the arm is stopped. @return FAULT if the link failed meanwhile.
+  [[nodiscard]] Result<void, JacoError> reset_estop();
+  /// @brief One control period (USB thread only). Never throws; never allocates.
+  void cycle() noexcept;
+  /// @brief After a FAULT: open the device again (a re-plugged arm: enumerate first and pass the
+  /// new @p device) and run the start-up again. @pre USB thread.
+  [[nodiscard]] Result<void, JacoError> reinitialise(const UsbDeviceInfo& device);
+
+  /// @brief A copy of the newest snapshot (any thread). @pre none.
+  [[nodiscard]] ArmSnapshot snapshot() const;
+  [[nodiscard]] const ArmIdentity& identity() const noexcept { return identity_; }
+  [[nodiscard]] const ControllerOptions& options() const noexcept { return options_; }
+  [[nodiscard]] const LinkStats& link_stats() const noexcept { return link_->stats(); }
+  [[nodiscard]] std::int64_t now_ns() const noexcept { return clock_->now_ns(); }
+
+ private:
+  JacoController(UsbTransport& transport, ControllerOptions options) noexcept;
+  Result<void, JacoError> start_up(const UsbDeviceInfo& device);
+  Result<void, JacoError> validate(const ArmCommand& command, const ArmSnapshot& now) const;
+  Result<ArmCommand, JacoError> check_command(const ArmCommand& command,
+                                              const ArmSnapshot& now) const;
+  void read_state() noexcept;
+  void run_motion(std::int64_t now) noexcept;
+  void run_homing(std::int64_t now) noexcept;
+  void start_pending(std::int64_t now) noexcept;
+  bool send_joystick(const JoystickState& state) noexcept;
+  bool send_velocity(const JointVelocity& joints,
+                     const std::array<double, FINGERS>& fingers) noexcept;
+  void stop_arm(StopReason reason) noexcept;
+  void fail(const JacoError& error) noexcept;
+  std::array<double, FINGERS> finger_velocity() const noexcept;
+  /// True once the fingers have made no progress for finger_stall_ns (marks progress otherwise).
+  bool fingers_stalled(std::int64_t now) noexcept;
+
+  UsbTransport* transport_;
+  const MonotonicClock* clock_;
+  ControllerOptions options_;
+  std::optional<JacoLink> link_;
+  ArmIdentity identity_{};
+
+  // Shared with client threads (mutex_ guards pending_* and published_).
+  mutable std::mutex mutex_;
+  std::optional<ArmCommand> pending_motion_;
+  std::optional<ArmCommand> pending_fingers_;
+  bool pending_stop_ = false;
+  ArmSnapshot published_{};
+  std::atomic<bool> estop_{false};
+  std::atomic<std::int64_t> last_client_ns_{0};
+
+  // USB thread only.
+  ArmSnapshot state_{};
+  ArmCommand active_{};
+  JointProfile profile_{};
+  std::int64_t motion_start_ns_ = 0;
+  JointVelocity last_velocity_{};
+  std::optional<std::array<double, FINGERS>> finger_goal_;
+  std::array<double, FINGERS> finger_mark_{};  ///< where the fingers were at finger_mark_ns_
+  std::int64_t finger_mark_ns_ = 0;            ///< the fingers' last progress
+  bool button_pressed_ = false;
+  std::int64_t button_sent_ns_ = 0;
+  bool button_resent_ = false;
+  bool joystick_dirty_ = false;  ///< a non-release joystick state may be latched in the arm
+  bool have_previous_ = false;
+};
+
+}  // namespace orthoflow::drivers::jaco
