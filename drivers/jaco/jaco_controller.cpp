@@ -58,6 +58,8 @@ const char* to_string(StopReason reason) noexcept {
       return "home_timeout";
     case StopReason::REFUSED:
       return "refused";
+    case StopReason::SAFETY:
+      return "safety";
   }
   return "unknown";
 }
@@ -75,6 +77,7 @@ Result<std::unique_ptr<JacoController>, JacoError> JacoController::open(UsbTrans
 }
 
 Result<void, JacoError> JacoController::start_up(const UsbDeviceInfo& device) {
+  linked_.store(false, std::memory_order_release);  // the guard waits until the link is up
   link_.reset();
   auto link = JacoLink::open(*transport_, device, options_.link);
   if (!link) return err(link.error());
@@ -99,9 +102,13 @@ Result<void, JacoError> JacoController::start_up(const UsbDeviceInfo& device) {
   state_ = ArmSnapshot{};
   state_.arm_state = arm_state.value();
   have_previous_ = false;
+  readings_ = {};
   read_state();
   if (state_.fault) return err(state_.fault_error);
   state_.control = ControlState::IDLE;
+  last_reply_ns_.store(clock_->now_ns(), std::memory_order_release);
+  silent_.store(false, std::memory_order_release);
+  linked_.store(true, std::memory_order_release);
   std::lock_guard lock(mutex_);
   pending_motion_.reset();
   pending_fingers_.reset();
@@ -137,7 +144,7 @@ Result<void, JacoError> JacoController::validate(const ArmCommand& command,
   switch (command.kind) {
     case Kind::MOVE_JOINTS: {
       if (!homed) return error_of(JacoError::Code::INVALID_STATE);
-      auto ok = check_joint_move(limits, now.joints, command.joints);
+      auto ok = check_joint_move(limits, now.joints, command.joints, 0.0, now.held);
       if (!ok) return refused(ok.error());
       return {};
     }
@@ -151,15 +158,22 @@ Result<void, JacoError> JacoController::validate(const ArmCommand& command,
       if (!homed) return error_of(JacoError::Code::INVALID_STATE);
       auto ok = check_joint_velocity(limits, command.velocity, now.commanded, 0.01);
       if (!ok) return refused(ok.error());
-      // Where this velocity would take the arm if the client vanished now: until the watchdog.
-      const double horizon_s = static_cast<double>(options_.command_timeout_ns) * 1e-9;
-      JointAngles ahead = now.joints;
-      for (std::size_t j = 0; j < JOINTS; ++j) ahead[j] += command.velocity[j] * horizon_s;
-      auto path = check_joint_move(limits, now.joints, ahead);
-      if (!path) return refused(path.error());
+      // An early refusal of what the first periods would do; the monitor checks every cycle of
+      // the stream as it runs.
+      CycleIntent intent;
+      intent.joints = now.joints;
+      intent.velocity = now.velocity;
+      intent.command = command.velocity;
+      intent.previous = now.commanded;
+      intent.held = now.held;
+      auto envelope = check_cycle(limits, intent);
+      if (!envelope) return refused(envelope.error());
       return {};
     }
     case Kind::MOVE_FINGERS: {
+      // A NOINIT arm ignores finger commands: say so instead of waiting for fingers that never
+      // move.
+      if (!homed) return error_of(JacoError::Code::INVALID_STATE);
       auto ok = check_fingers(limits, command.fingers);
       if (!ok) return refused(ok.error());
       return {};
@@ -190,7 +204,7 @@ Result<ArmCommand, JacoError> JacoController::check_command(const ArmCommand& co
       v.limit = SafetyViolation::Limit::UNREACHABLE;
       return refused(v);
     }
-    auto path = check_joint_move(options_.limits, now.joints, solution.value());
+    auto path = check_joint_move(options_.limits, now.joints, solution.value(), 0.0, now.held);
     if (!path) return refused(path.error());
     accepted.kind = ArmCommand::Kind::MOVE_JOINTS;
     accepted.joints = solution.value();

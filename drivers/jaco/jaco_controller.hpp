@@ -1,29 +1,36 @@
 #pragma once
 /// @file
-/// @brief JacoController: the JACO driver's control loop and its always-on safety layer (issue 19,
-/// specs/JACO.md 10 and 11). One thread calls cycle() every 10 ms (the arm's period; JacoArm does
-/// it); any thread submits commands, reads the newest snapshot and pulls the emergency stop.
+/// @brief JacoController: the JACO driver's control loop (issue 19, specs/JACO.md 10 and 11) and
+/// the safety monitor's seat (issue 49, docs/SAFETY.md). One thread calls cycle() every 10 ms (the
+/// arm's period; JacoArm does it); a guard calls guard() every few milliseconds from a thread that
+/// never touches USB; any thread submits commands, reads the newest snapshot and pulls the stop.
 ///
 /// Each cycle: read the joints and fingers (command 15, plus a rotating slow read: sensors,
-/// currents, arm state), run the watchdog, then send at most one motion packet:
+/// currents, arm state), then let the active mode say what the next period would do:
 /// - a joint move or a pose (IK to the solution nearest the current joints) is streamed as 100 Hz
 ///   angular velocity points along a synchronised trapezoid (jaco_motion.hpp), never as position
 ///   points, which the arm would finish even if the host died;
 /// - HOME / RETRACT press and release the virtual button (next_button_action, JACO.md 10.1), with
-///   the DSP >= 5 double send 100 ms apart (JACO.md 9);
-/// - a client-streamed joint velocity is sent as it is, once checked.
+///   the DSP >= 5 double send 100 ms apart (JACO.md 9): the firmware drives the arm;
+/// - a client-streamed joint velocity is sent as it is;
+/// - the fingers' goal becomes a finger velocity;
+/// and the safety monitor (jaco_safety_monitor.hpp) checks that next state and its stopping
+/// envelope for the whole arm, every cycle, in every mode, idle included. Only then is a packet
+/// sent; a violation stops the arm (StopReason::SAFETY) and is kept in the snapshot.
 ///
-/// Safety, on every path:
-/// - every command is checked before it is accepted (jaco_safety.hpp): a violation is refused with
-///   the limit's name (JacoError::REFUSED), nothing is clipped;
+/// Stops, on every path:
+/// - submit() refuses a command the monitor refuses along its whole path (an early, named refusal);
 /// - watchdog: a motion needs a command or keep_alive() at least every command_timeout (100 ms);
-///   the cycle that could not send again before that deadline releases the joystick and erases the
-///   arm's trajectory FIFO, so the arm has stopped by last command + command_timeout;
-/// - estop() (any thread, wait-free) latches: the next cycle releases and erases, and keeps erasing
-///   every cycle until reset_estop(); every motion command is refused meanwhile;
+///   the cycle that could not send again before that deadline releases and erases;
+/// - estop() (any thread, wait-free, async-signal-safe) latches: no motion packet leaves after it,
+///   the next chance on the USB thread releases the joystick and erases the FIFO, and every cycle
+///   erases again until reset_estop(); every motion command is refused meanwhile;
+/// - guard(): an arm that has not answered for silence_fault_ns is FAULT in the snapshot at once
+///   (bound: period + the link's transfer budget, docs/SAFETY.md), whatever the USB thread is
+///   doing;
 /// - a failed exchange (unplug, stall, bad reply) puts the controller in FAULT in that same cycle:
-///   the snapshot says so, a best-effort stop is sent unless the arm is gone, and every command is
-///   refused until reinitialise().
+///   a best-effort stop is sent unless the arm is gone, and every command is refused until
+///   reinitialise().
 #include <atomic>
 #include <cstdint>
 #include <memory>
@@ -35,6 +42,7 @@
 #include "drivers/jaco/jaco_link.hpp"
 #include "drivers/jaco/jaco_motion.hpp"
 #include "drivers/jaco/jaco_safety.hpp"
+#include "drivers/jaco/jaco_safety_monitor.hpp"
 
 namespace orthoflow::drivers::jaco {
 
@@ -52,7 +60,8 @@ enum class StopReason : std::uint8_t {
   FAULT,
   SETTLE_TIMEOUT,
   HOME_TIMEOUT,
-  REFUSED
+  REFUSED,
+  SAFETY  ///< the safety monitor stopped it: see ArmSnapshot::violation
 };
 [[nodiscard]] const char* to_string(StopReason reason) noexcept;
 
@@ -89,8 +98,14 @@ struct ControllerOptions {
   double finger_stall_travel = 0.005;
   std::int64_t finger_stall_ns = 300'000'000;
   std::int64_t settle_timeout_ns = 2'000'000'000;  ///< after the profile ends
-  std::int64_t home_timeout_ns = 60'000'000'000;   ///< HOME / RETRACT
-  std::int64_t double_send_gap_ns = 100'000'000;   ///< DSP >= 5 joystick quirk
+  std::int64_t home_timeout_ns = 30'000'000'000;   ///< HOME / RETRACT (from far: about 15 s)
+  /// Where the firmware drives the arm for HOME and RETRACT (the monitor's envelope of that motion;
+  /// the real arm's RETRACT is a setting of its own: docs/SAFETY.md).
+  JointAngles home_joints = HOME_JOINTS;
+  JointAngles retract_joints{270.0, 210.0, 30.0, 270.0, 90.0, 90.0};
+  /// No reply for this long is a FAULT (guard()): one period plus the link's transfer budget.
+  std::int64_t silence_fault_ns = 26'000'000;
+  std::int64_t double_send_gap_ns = 100'000'000;  ///< DSP >= 5 joystick quirk
 };
 
 /// @brief Everything known about the arm after a cycle. Plain data; copied under a mutex.
@@ -117,6 +132,13 @@ struct ArmSnapshot {
   std::uint64_t refused = 0;
   std::uint64_t points_sent = 0;
   std::uint64_t cycles_overrun = 0;  ///< cycles whose exchanges took longer than the period
+  SafetyViolation violation{};       ///< what the monitor found when last_stop is SAFETY
+  std::uint64_t monitor_stops = 0;   ///< motions the monitor stopped
+  std::uint64_t monitor_nodes = 0;   ///< stretches the monitor examined in the last cycle
+  std::int64_t last_reply_ns = 0;    ///< when the arm last answered (transport clock)
+  std::int64_t stop_request_ns = 0;  ///< when the current stop latch was requested
+  std::int64_t stop_sent_ns = 0;     ///< when its release + erase reached the wire (0: not yet)
+  HeldCapsule held{};                ///< what the monitor counts the hand holding
 };
 
 class JacoController {
@@ -137,8 +159,18 @@ class JacoController {
   [[nodiscard]] Result<void, JacoError> submit(const ArmCommand& command);
   /// @brief Feeds the watchdog (any thread, wait-free).
   void keep_alive() noexcept;
-  /// @brief Latches the emergency stop (any thread, wait-free, async-signal-safe).
-  void estop() noexcept { estop_.store(true, std::memory_order_release); }
+  /// @brief Latches the emergency stop (any thread, wait-free, async-signal-safe): from now on no
+  /// motion packet leaves; the USB thread releases and erases at its next chance.
+  void estop() noexcept {
+    if (!estop_.exchange(true, std::memory_order_acq_rel))
+      estop_request_ns_.store(clock_->now_ns(), std::memory_order_release);
+  }
+  /// @brief The guard's tick (any thread, never blocks on USB; JacoArm runs it every 2 ms): an arm
+  /// silent for silence_fault_ns is FAULT in the snapshot now, and no packet but a stop leaves.
+  void guard(std::int64_t now_ns) noexcept;
+  /// @brief What the hand holds from now on, for the monitor (the task runner sets it at a grasp
+  /// and clears it at a release). @pre finite values.
+  void set_held(const HeldCapsule& held);
   /// @brief Clears the latch once the arm is stopped. @return FAULT if the link failed meanwhile.
   [[nodiscard]] Result<void, JacoError> reset_estop();
   /// @brief One control period (USB thread only). Never throws; never allocates.
@@ -163,12 +195,20 @@ class JacoController {
   void read_state() noexcept;
   void run_motion(std::int64_t now) noexcept;
   void run_homing(std::int64_t now) noexcept;
+  void run_modes(std::int64_t now) noexcept;
   void start_pending(std::int64_t now) noexcept;
   bool send_joystick(const JoystickState& state) noexcept;
   bool send_velocity(const JointVelocity& joints,
                      const std::array<double, FINGERS>& fingers) noexcept;
   void stop_arm(StopReason reason) noexcept;
   void fail(const JacoError& error) noexcept;
+  /// The monitor's gate: true when the next period may run @p v (and the fingers); otherwise the
+  /// arm has been stopped with the violation kept.
+  bool monitor_allows(const JointVelocity& v, bool firmware) noexcept;
+  /// A stop was latched or a fault declared by another thread: nothing but a stop may leave.
+  [[nodiscard]] bool halted() const noexcept;
+  void latch_estop() noexcept;
+  void publish() noexcept;
   std::array<double, FINGERS> finger_velocity() const noexcept;
   /// True once the fingers have made no progress for finger_stall_ns (marks progress otherwise).
   bool fingers_stalled(std::int64_t now) noexcept;
@@ -186,7 +226,12 @@ class JacoController {
   bool pending_stop_ = false;
   ArmSnapshot published_{};
   std::atomic<bool> estop_{false};
+  std::atomic<std::int64_t> estop_request_ns_{0};
   std::atomic<std::int64_t> last_client_ns_{0};
+  std::atomic<std::int64_t> last_reply_ns_{0};
+  std::atomic<bool> silent_{false};  ///< set by guard(): the arm stopped answering
+  std::atomic<bool> linked_{false};  ///< start-up done: the guard watches
+  HeldCapsule held_{};               ///< guarded by mutex_; copied into state_ each cycle
 
   // USB thread only.
   ArmSnapshot state_{};
@@ -202,6 +247,12 @@ class JacoController {
   bool button_resent_ = false;
   bool joystick_dirty_ = false;  ///< a non-release joystick state may be latched in the arm
   bool have_previous_ = false;
+  struct Reading {
+    std::int64_t t_ns = 0;
+    JointAngles q{};
+  };
+  std::array<Reading, 8> readings_{};  ///< the newest joint readings, for the velocity
+  std::size_t reading_next_ = 0;
 };
 
 }  // namespace orthoflow::drivers::jaco

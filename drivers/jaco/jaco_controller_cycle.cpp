@@ -1,5 +1,6 @@
-// JacoController's USB-thread half: the 10 ms cycle, the watchdog, the streamed moves, the virtual
-// button, stops and faults (jaco_controller.hpp).
+// JacoController's USB-thread half: the 10 ms cycle, the watchdog, the streamed moves and the
+// virtual button, each through the safety monitor's gate (jaco_controller.hpp; stops and faults in
+// jaco_controller_stop.cpp).
 #include <algorithm>
 #include <cmath>
 
@@ -9,79 +10,9 @@ namespace orthoflow::drivers::jaco {
 namespace {
 
 constexpr double PERIOD_S = static_cast<double>(ARM_PERIOD_NS) * 1e-9;
+constexpr double STILL_DEG_S = 0.5;  // measured speed below which a joint counts as still
 
 }  // namespace
-
-bool JacoController::send_joystick(const JoystickState& state) noexcept {
-  Packet reply{};
-  auto ok = link_->exchange(encode_joystick(state), reply);
-  if (!ok) {
-    fail(ok.error());
-    return false;
-  }
-  joystick_dirty_ = !state.is_release();
-  return true;
-}
-
-bool JacoController::send_velocity(const JointVelocity& joints,
-                                   const std::array<double, FINGERS>& fingers) noexcept {
-  TrajectoryPoint point;
-  point.type = PositionType::ANGULAR_VELOCITY;
-  point.hand_mode = HandMode::VELOCITY;
-  for (std::size_t j = 0; j < JOINTS; ++j) point.target[j] = static_cast<float>(joints[j]);
-  for (std::size_t f = 0; f < FINGERS; ++f) point.fingers[f] = static_cast<float>(fingers[f]);
-  Packet reply{};
-  auto ok = link_->exchange(encode_trajectory(point), reply);
-  if (!ok) {
-    fail(ok.error());
-    return false;
-  }
-  ++state_.points_sent;
-  state_.commanded = joints;
-  last_velocity_ = joints;
-  return true;
-}
-
-void JacoController::fail(const JacoError& error) noexcept {
-  if (state_.fault) return;
-  state_.fault = true;
-  state_.fault_error = error;
-  state_.control = ControlState::FAULT;
-  state_.last_stop = StopReason::FAULT;
-  // Best effort: an arm that is still there (a bad reply, a stall) gets erase and release; an
-  // unplugged one cannot hear it.
-  const bool gone =
-      error.code == JacoError::Code::USB && error.usb.code == UsbError::Code::NO_DEVICE;
-  if (!gone && link_) {
-    Packet reply{};
-    (void)link_->exchange(make_plain_command(Command::ERASE_TRAJECTORIES), reply);
-    (void)link_->exchange(encode_joystick(JoystickState{}), reply);
-  }
-  last_velocity_ = {};
-  state_.commanded = {};
-  finger_goal_.reset();
-  state_.fingers_moving = false;
-}
-
-void JacoController::stop_arm(StopReason reason) noexcept {
-  if (state_.fault) return;
-  if (joystick_dirty_ || button_pressed_) {
-    if (!send_joystick(JoystickState{})) return;
-  }
-  button_pressed_ = false;
-  Packet reply{};
-  auto erased = link_->exchange(make_plain_command(Command::ERASE_TRAJECTORIES), reply);
-  if (!erased) {
-    fail(erased.error());
-    return;
-  }
-  last_velocity_ = {};
-  state_.commanded = {};
-  finger_goal_.reset();
-  state_.fingers_moving = false;
-  if (state_.control != ControlState::ESTOP) state_.control = ControlState::IDLE;
-  state_.last_stop = reason;
-}
 
 void JacoController::read_state() noexcept {
   auto joints = link_->read_nine(Command::GET_ANG_POS);
@@ -90,12 +21,26 @@ void JacoController::read_state() noexcept {
     return;
   }
   const std::int64_t now = clock_->now_ns();
+  last_reply_ns_.store(now, std::memory_order_release);
+  state_.last_reply_ns = now;
   JointAngles q{};
   for (std::size_t j = 0; j < JOINTS; ++j) q[j] = joints.value().values[j];
-  if (have_previous_ && now > state_.stamp_ns) {
-    const double dt = static_cast<double>(now - state_.stamp_ns) * 1e-9;
-    for (std::size_t j = 0; j < JOINTS; ++j) state_.velocity[j] = (q[j] - state_.joints[j]) / dt;
+  // The arm updates its positions every 10 ms: a difference over a span of one or two periods may
+  // hold one step more or less than its time. The velocity is taken over the newest earlier
+  // reading at least two periods old, so such a miscount is at most a third.
+  const Reading* base = nullptr;
+  for (std::size_t i = 0; i < readings_.size(); ++i) {
+    const Reading& r = readings_[(reading_next_ + readings_.size() - 1 - i) % readings_.size()];
+    if (!have_previous_ || r.t_ns == 0) break;
+    base = &r;
+    if (now - r.t_ns >= 2 * ARM_PERIOD_NS) break;
   }
+  if (base != nullptr && now > base->t_ns) {
+    const double dt = static_cast<double>(now - base->t_ns) * 1e-9;
+    for (std::size_t j = 0; j < JOINTS; ++j) state_.velocity[j] = (q[j] - base->q[j]) / dt;
+  }
+  readings_[reading_next_] = {now, q};
+  reading_next_ = (reading_next_ + 1) % readings_.size();
   have_previous_ = true;
   state_.joints = q;
   for (std::size_t f = 0; f < FINGERS; ++f) state_.fingers[f] = joints.value().fingers[f];
@@ -171,7 +116,9 @@ void JacoController::start_pending(std::int64_t now) noexcept {
   switch (motion->kind) {
     case ArmCommand::Kind::MOVE_JOINTS: {
       // The arm may have moved since the command was checked: check the path from here again.
-      if (!check_joint_move(limits, state_.joints, active_.joints)) {
+      if (auto path = check_joint_move(limits, state_.joints, active_.joints, 0.0, state_.held);
+          !path) {
+        state_.violation = path.error();
         state_.last_stop = StopReason::REFUSED;
         ++state_.refused;
         return;
@@ -214,13 +161,6 @@ void JacoController::run_motion(std::int64_t now) noexcept {
   } else if (state_.control == ControlState::VELOCITY) {
     v = active_.velocity;
   }
-  // Never step the arm past a joint limit, whatever the correction term asked for.
-  for (std::size_t j = 0; j < JOINTS; ++j) {
-    const double next = state_.joints[j] + v[j] * PERIOD_S;
-    if (next < limits.joints.lower[j] || next > limits.joints.upper[j]) {
-      return stop_arm(StopReason::REFUSED);
-    }
-  }
   const std::array<double, FINGERS> fv = finger_velocity();
   if (finger_goal_) {
     bool fingers_done = true;
@@ -239,12 +179,18 @@ void JacoController::run_motion(std::int64_t now) noexcept {
   const bool moving = std::any_of(v.begin(), v.end(), [](double x) { return x != 0.0; });
   const bool was_moving =
       std::any_of(last_velocity_.begin(), last_velocity_.end(), [](double x) { return x != 0.0; });
+  // An arm that is still and told nothing cannot move: only then is the monitor skipped.
+  const bool still = std::all_of(state_.velocity.begin(), state_.velocity.end(),
+                                 [](double x) { return std::abs(x) < STILL_DEG_S; });
+  if (!moving && !was_moving && !finger_goal_ && still) return;
+  if (!monitor_allows(v, false)) return;
   if (moving || was_moving || finger_goal_) (void)send_velocity(v, fv);
 }
 
 void JacoController::run_homing(std::int64_t now) noexcept {
   const ArmGoal goal = active_.kind == ArmCommand::Kind::RETRACT ? ArmGoal::RETRACT : ArmGoal::HOME;
   if (now - motion_start_ns_ > options_.home_timeout_ns) return stop_arm(StopReason::HOME_TIMEOUT);
+  if (!monitor_allows(state_.velocity, true)) return;
   switch (next_button_action(state_.arm_state, goal, button_pressed_)) {
     case ButtonAction::PRESS:
       if (!send_joystick(home_button_press())) return;
@@ -277,50 +223,42 @@ void JacoController::cycle() noexcept {
   if (!link_) return;
   const std::int64_t start = clock_->now_ns();
   ++state_.cycle;
+  if (!state_.fault && silent_.load(std::memory_order_acquire))
+    fail(JacoError{JacoError::Code::USB, UsbError{UsbError::Code::TIMEOUT, 0, "silent arm"}});
   if (!state_.fault) read_state();
   const std::int64_t now = clock_->now_ns();
-
   if (!state_.fault) {
     if (estop_.load(std::memory_order_acquire)) {
-      state_.estop = true;
-      state_.control = ControlState::ESTOP;
-      {
-        std::lock_guard lock(mutex_);
-        pending_motion_.reset();
-        pending_fingers_.reset();
-        pending_stop_ = false;
-      }
-      stop_arm(StopReason::ESTOP);  // every cycle while latched: erase whatever reached the FIFO
+      latch_estop();
     } else {
       if (state_.estop) {
         state_.estop = false;
         state_.control = ControlState::IDLE;
       }
-      start_pending(now);
-      const bool active = state_.control == ControlState::MOVING ||
-                          state_.control == ControlState::VELOCITY ||
-                          state_.control == ControlState::HOMING || finger_goal_.has_value();
-      // Watchdog: stop in the last cycle that still lies before the deadline.
-      const std::int64_t deadline =
-          last_client_ns_.load(std::memory_order_acquire) + options_.command_timeout_ns;
-      if (active && now + ARM_PERIOD_NS > deadline) {
-        ++state_.watchdog_stops;
-        stop_arm(StopReason::WATCHDOG);
-      } else if (state_.control == ControlState::HOMING) {
-        run_homing(now);
-        if (finger_goal_ && !state_.fault) run_motion(now);
-      } else if (!state_.fault) {
-        run_motion(now);
-      }
+      run_modes(now);
     }
   }
   if (clock_->now_ns() - start > ARM_PERIOD_NS) ++state_.cycles_overrun;
-  std::lock_guard lock(mutex_);
-  const std::uint64_t refused = published_.refused;
-  published_ = state_;
-  published_.refused += refused;
-  state_.refused = 0;
-  if (state_.estop || estop_.load(std::memory_order_acquire)) published_.estop = true;
+  publish();
+}
+
+void JacoController::run_modes(std::int64_t now) noexcept {
+  start_pending(now);
+  const bool active = state_.control == ControlState::MOVING ||
+                      state_.control == ControlState::VELOCITY ||
+                      state_.control == ControlState::HOMING || finger_goal_.has_value();
+  // Watchdog: stop in the last cycle that still lies before the deadline.
+  const std::int64_t deadline =
+      last_client_ns_.load(std::memory_order_acquire) + options_.command_timeout_ns;
+  if (active && now + ARM_PERIOD_NS > deadline) {
+    ++state_.watchdog_stops;
+    stop_arm(StopReason::WATCHDOG);
+  } else if (state_.control == ControlState::HOMING) {
+    run_homing(now);
+    if (finger_goal_ && !state_.fault && state_.control == ControlState::HOMING) run_motion(now);
+  } else if (!state_.fault) {
+    run_motion(now);  // idle too: the monitor watches an arm that should be still
+  }
 }
 
 }  // namespace orthoflow::drivers::jaco

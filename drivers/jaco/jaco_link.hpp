@@ -43,11 +43,13 @@ struct JacoError {
 /// get_ang_pos". @note Allocates.
 [[nodiscard]] std::string to_string(const JacoError& error);
 
-/// @brief How patient the link is.
+/// @brief How patient the link is. Every transfer has a deadline: a full-speed interrupt exchange
+/// takes about 2 ms (JACO.md 9), so a transfer that has not completed in transfer_timeout is lost,
+/// and a silent arm costs the control thread at most (retries + 1) x 2 x transfer_timeout before
+/// the cycle goes on (the guard declares the FAULT meanwhile: jaco_controller.hpp).
 struct LinkPolicy {
-  UsbTimeout transfer_timeout{
-      100};                        ///< per interrupt transfer (libkindrv: 1 s; a stall costs this)
-  std::uint32_t retries = 2;       ///< resends of a read request
+  UsbTimeout transfer_timeout{6};  ///< per interrupt transfer (libkindrv waits 1 s)
+  std::uint32_t retries = 1;       ///< resends of a read request
   UsbTimeout flush_timeout{20};    ///< per read while flushing stale replies at open
   std::uint32_t flush_reads = 32;  ///< at most this many stale replies discarded
 };

@@ -44,6 +44,12 @@ bool SafetyLimits::add_keep_out(const Box& box) noexcept {
   return true;
 }
 
+const Box* SafetyLimits::find_keep_out(std::string_view name) const noexcept {
+  for (std::size_t i = 0; i < keep_out_count; ++i)
+    if (keep_out[i].name.view() == name) return &keep_out[i];
+  return nullptr;
+}
+
 const char* to_string(SafetyViolation::Limit limit) noexcept {
   switch (limit) {
     case Violation::Limit::NOT_FINITE:
@@ -62,6 +68,8 @@ const char* to_string(SafetyViolation::Limit limit) noexcept {
       return "finger";
     case Violation::Limit::UNREACHABLE:
       return "unreachable";
+    case Violation::Limit::UNPROVEN:
+      return "unproven";
   }
   return "unknown";
 }
@@ -78,14 +86,18 @@ std::string describe(const SafetyViolation& v) {
                     joint, v.value, v.value > v.bound ? "upper" : "lower", v.bound);
       break;
     case Violation::Limit::WORKSPACE:
-      std::snprintf(text, sizeof text,
-                    "the end effector would leave the %s box at (%.3f, %.3f, %.3f) m",
-                    std::string(v.box.view()).c_str(), v.point.x(), v.point.y(), v.point.z());
+      std::snprintf(
+          text, sizeof text,
+          "the %s would leave the %s box by %.1f mm near (%.3f, %.3f, %.3f) m, %.2f s ahead",
+          to_string(v.part), std::string(v.box.view()).c_str(), 1000.0 * v.depth_m, v.point.x(),
+          v.point.y(), v.point.z(), v.ahead_s);
       break;
     case Violation::Limit::KEEP_OUT:
       std::snprintf(text, sizeof text,
-                    "the end effector would enter keep-out box '%s' at (%.3f, %.3f, %.3f) m",
-                    std::string(v.box.view()).c_str(), v.point.x(), v.point.y(), v.point.z());
+                    "the %s would enter keep-out box '%s' by %.1f mm near (%.3f, %.3f, %.3f) m, "
+                    "%.2f s ahead",
+                    to_string(v.part), std::string(v.box.view()).c_str(), 1000.0 * v.depth_m,
+                    v.point.x(), v.point.y(), v.point.z(), v.ahead_s);
       break;
     case Violation::Limit::SPEED:
       std::snprintf(text, sizeof text, "joint %u speed %.2f deg/s exceeds the cap %.2f deg/s",
@@ -104,34 +116,14 @@ std::string describe(const SafetyViolation& v) {
       std::snprintf(text, sizeof text,
                     "no joint solution reaches the pose within the joint limits");
       break;
+    case Violation::Limit::UNPROVEN:
+      std::snprintf(text, sizeof text,
+                    "the motion could not be shown clear of the limits within the check's budget "
+                    "(%.1f mm of sweep left), so it is not made",
+                    1000.0 * v.depth_m);
+      break;
   }
   return std::string("safety: ") + to_string(v.limit) + ": " + text;
-}
-
-Result<void, SafetyViolation> check_joint_move(const SafetyLimits& limits, const JointAngles& from,
-                                               const JointAngles& to) noexcept {
-  for (std::size_t j = 0; j < JOINTS; ++j) {
-    if (!std::isfinite(to[j]) || !std::isfinite(from[j])) {
-      return violation(Violation::Limit::NOT_FINITE, j, to[j], 0.0);
-    }
-    if (to[j] < limits.joints.lower[j]) {
-      return violation(Violation::Limit::JOINT_LIMIT, j, to[j], limits.joints.lower[j]);
-    }
-    if (to[j] > limits.joints.upper[j]) {
-      return violation(Violation::Limit::JOINT_LIMIT, j, to[j], limits.joints.upper[j]);
-    }
-  }
-  // The path from the current pose: sample 1..n (the start is where the arm already is; a start
-  // outside the workspace may move back inside, which every sample after it must then satisfy).
-  const std::size_t n = std::max<std::size_t>(limits.path_samples, 1);
-  for (std::size_t s = 1; s <= n; ++s) {
-    const double t = static_cast<double>(s) / static_cast<double>(n);
-    JointAngles q{};
-    for (std::size_t j = 0; j < JOINTS; ++j) q[j] = from[j] + t * (to[j] - from[j]);
-    auto ok = check_point(limits, forward_kinematics(q, *limits.geometry).translation());
-    if (!ok) return ok;
-  }
-  return {};
 }
 
 Result<void, SafetyViolation> check_joint_velocity(const SafetyLimits& limits,

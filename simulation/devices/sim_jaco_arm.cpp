@@ -76,6 +76,9 @@ SimJacoArm::SimJacoArm(SimJacoConfig config, std::int64_t start_ns)
                  valid_rate(f.wrong_command_rate),
              "SimJacoArm: fault rates lie in [0, 1]");
   OF_ENFORCE(f.stale_replies <= SIM_JACO_REPLY_QUEUE, "SimJacoArm: too many stale replies");
+  OF_ENFORCE(c.dynamics.accel_deg_s2 > 0.0 && c.dynamics.decel_deg_s2 > 0.0 &&
+                 c.dynamics.command_latency_ns >= 0,
+             "SimJacoArm: dynamics need positive rates and a latency >= 0");
   power_on(start_ns);
 }
 
@@ -90,6 +93,9 @@ void SimJacoArm::power_on(std::int64_t now_ns) noexcept {
   joints_ = c.start_joints.value_or(
       c.start_state == jaco::ArmState::READY_STANDBY ? c.home_joints : c.retract_joints);
   velocity_ = {};
+  desired_ = {};
+  toward_.reset();
+  delayed_count_ = 0;
   fingers_ = c.start_fingers;
   finger_velocity_ = {};
   finger_target_ = fingers_;
@@ -116,6 +122,10 @@ void SimJacoArm::receive(std::span<const std::byte, jaco::PACKET_BYTES> packet,
                          std::int64_t now_ns) noexcept {
   step(now_ns);
   ++counters_.packets;
+  if (silent(now_ns)) {
+    ++counters_.silent_drops;
+    return;
+  }
   if (fault(config_.faults.drop_out_rate)) {
     ++counters_.dropped_outs;
     return;

@@ -183,6 +183,9 @@ class SimJacoArm {
   void pop_head() noexcept;
   bool move_toward(const drivers::jaco::JointAngles& target) noexcept;
   void move_velocity(const std::array<double, drivers::jaco::JOINTS>& deg_s) noexcept;
+  void integrate() noexcept;
+  void run_delayed(std::int64_t t_ns) noexcept;
+  [[nodiscard]] bool silent(std::int64_t t_ns) const noexcept;
   void cartesian_step(const Eigen::Vector3d& linear, const Eigen::Vector3d& angular) noexcept;
   void move_fingers() noexcept;
 
@@ -201,6 +204,16 @@ class SimJacoArm {
   SimJacoControlMode mode_ = SimJacoControlMode::ANGULAR;
   drivers::jaco::JointAngles joints_{};
   std::array<double, drivers::jaco::JOINTS> velocity_{};
+  std::array<double, drivers::jaco::JOINTS> desired_{};  // this cycle's velocity command
+  std::optional<drivers::jaco::JointAngles> toward_{};   // a position the joints stop exactly at
+  struct Delayed {
+    std::int64_t due_ns = 0;
+    drivers::jaco::Packet packet{};
+  };
+  // Motion packets in flight (command latency): room for a whole FIFO's worth and then some.
+  std::array<Delayed, drivers::jaco::TRAJECTORY_FIFO + 64> delayed_{};
+  std::size_t delayed_head_ = 0;
+  std::size_t delayed_count_ = 0;
   std::array<double, drivers::jaco::FINGERS> fingers_{};
   std::array<double, drivers::jaco::FINGERS> finger_velocity_{};
   std::array<double, drivers::jaco::FINGERS> finger_target_{};

@@ -11,7 +11,18 @@ void SimJacoArm::handle(std::span<const std::byte, jaco::PACKET_BYTES> packet,
                         jaco::PacketHeader header, std::optional<jaco::Packet>& reply) noexcept {
   using C = jaco::Command;
   const auto command = static_cast<C>(header.command_id);
-  if (command == C::JOYSTICK || command == C::SEND_BASIC_TRAJECTORY) {
+  const bool motion = command == C::JOYSTICK || command == C::SEND_BASIC_TRAJECTORY ||
+                      command == C::ERASE_TRAJECTORIES;
+  if (motion && config_.dynamics.command_latency_ns > 0) {
+    // Acked now; it acts once the command latency has passed (SimJacoDynamics).
+    if (delayed_count_ == delayed_.size()) {
+      ++counters_.delayed_lost;
+    } else {
+      Delayed& d = delayed_[(delayed_head_ + delayed_count_++) % delayed_.size()];
+      d.due_ns = now_ns_ + config_.dynamics.command_latency_ns;
+      std::copy(packet.begin(), packet.end(), d.packet.begin());
+    }
+  } else if (command == C::JOYSTICK || command == C::SEND_BASIC_TRAJECTORY) {
     motion_command(command, packet);
   } else if (!setting_command(command)) {
     reply = state_reply(command, header);

@@ -48,9 +48,12 @@ void SimJacoArm::step(std::int64_t now_ns) noexcept {
 
 void SimJacoArm::cycle(std::int64_t t_ns) noexcept {
   ++counters_.cycles;
+  run_delayed(t_ns);
   const jaco::JointAngles before = joints_;
   const bool button = joystick_.buttons[jaco::HOME_BUTTON] != 0;
   head_ran_ = false;
+  desired_ = {};  // what no mode commands, the joints brake to
+  toward_.reset();
   if (state_ != jaco::ArmState::NOINIT) {
     if (button) {
       run_button(t_ns);
@@ -58,13 +61,11 @@ void SimJacoArm::cycle(std::int64_t t_ns) noexcept {
       run_fifo(t_ns);
     }
   }
+  integrate();
   move_fingers();
   if (head_ran_) finish_head(t_ns);
   bool moved = false;
-  for (std::size_t j = 0; j < jaco::JOINTS; ++j) {
-    velocity_[j] = (joints_[j] - before[j]) / DT_S;
-    moved = moved || joints_[j] != before[j];
-  }
+  for (std::size_t j = 0; j < jaco::JOINTS; ++j) moved = moved || joints_[j] != before[j];
   if (moved) {
     last_motion_ns_ = t_ns;
     if (!button) state_ = jaco::ArmState::NORMAL;  // moved by the API, not by the HOME button
@@ -217,29 +218,6 @@ void SimJacoArm::pop_head() noexcept {
   head_pose_.reset();
   if (head_finger_velocity_) finger_target_ = fingers_;  // velocity-driven fingers stop
   head_finger_velocity_ = false;
-}
-
-bool SimJacoArm::move_toward(const jaco::JointAngles& target) noexcept {
-  bool reached = true;
-  for (std::size_t j = 0; j < jaco::JOINTS; ++j) {
-    const double max_step = config_.max_joint_speed_deg_s[j] * DT_S;
-    const double error = target[j] - joints_[j];
-    if (std::abs(error) <= max_step) {
-      joints_[j] = target[j];
-    } else {
-      joints_[j] += std::copysign(max_step, error);
-      reached = false;
-    }
-  }
-  return reached;
-}
-
-void SimJacoArm::move_velocity(const std::array<double, jaco::JOINTS>& deg_s) noexcept {
-  for (std::size_t j = 0; j < jaco::JOINTS; ++j) {
-    const double top = config_.max_joint_speed_deg_s[j];
-    const double v = std::clamp(deg_s[j], -top, top);
-    joints_[j] = std::clamp(joints_[j] + v * DT_S, limits_.lower[j], limits_.upper[j]);
-  }
 }
 
 void SimJacoArm::cartesian_step(const Eigen::Vector3d& linear,

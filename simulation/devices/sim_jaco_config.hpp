@@ -50,6 +50,22 @@ struct SimJacoFaults {
   std::int64_t fw5_quirk_window_ns = 150'000'000;
   std::optional<std::int64_t> unplug_at_ns{};  ///< the host unplugs the cable then (the arm itself
                                                ///< keeps running: SimJacoTransport)
+  /// From silent_from_ns until silent_until_ns the arm neither hears nor answers anything (a hung
+  /// link): OUTs have no effect, INs time out, what the FIFO holds keeps running.
+  std::optional<std::int64_t> silent_from_ns{};
+  std::int64_t silent_until_ns = 0;
+};
+
+/// @brief How the joints move (the physics the monitor's assumptions are tested against,
+/// docs/SAFETY.md). Each joint's velocity follows its command at most at accel_deg_s2 when
+/// speeding up and decel_deg_s2 when slowing down; a motion packet (308, 305, 301) acts
+/// command_latency_ns after it arrives. Infinite rates and zero latency give the old ideal arm.
+struct SimJacoDynamics {
+  double accel_deg_s2 = 150.0;
+  double decel_deg_s2 = 100.0;
+  std::int64_t command_latency_ns = 10'000'000;
+  /// @brief The ideal arm: speeds jump, packets act at the next cycle. @pre none.
+  [[nodiscard]] static SimJacoDynamics ideal() noexcept { return {1e12, 1e12, 0}; }
 };
 
 /// @brief One simulated arm. Plain data with defaults (a JACO2 on DSP 5.2); validated by the
@@ -92,6 +108,7 @@ struct SimJacoConfig {
   drivers::jaco::NineFloats motor_current = SIM_JACO_IDLE_CURRENTS;   ///< 113
   std::uint64_t fault_seed = 1;  ///< seeds the core::Rng of every random fault
   SimJacoFaults faults{};
+  SimJacoDynamics dynamics{};
 };
 
 /// @brief A JACO v1 on DSP 4.2: model string "JACO v1", fingers 0..60, 20 / 30 deg/s joints.
@@ -117,7 +134,9 @@ struct SimJacoCounters {
   std::uint64_t garbage_replies = 0;
   std::uint64_t corrupt_replies = 0;
   std::uint64_t wrong_command_replies = 0;
-  std::uint64_t cycles = 0;  ///< 10 ms cycles run
+  std::uint64_t cycles = 0;        ///< 10 ms cycles run
+  std::uint64_t silent_drops = 0;  ///< packets lost to a silent period
+  std::uint64_t delayed_lost = 0;  ///< motion packets lost to a full latency queue
 };
 
 }  // namespace orthoflow::simulation

@@ -116,7 +116,9 @@ TEST(JacoArm, EmergencyStopFromAnyThread) {
   }
   std::thread puller([&] { arm->estop(); });
   puller.join();
-  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  // The simulated arm brakes from about 12 deg/s at 100 deg/s^2 after its 10 ms command latency:
+  // at rest well within 400 ms.
+  std::this_thread::sleep_for(std::chrono::milliseconds(400));
   const auto s = arm->snapshot();
   EXPECT_TRUE(s.estop);
   EXPECT_EQ(s.control, jaco::ControlState::ESTOP);

@@ -34,6 +34,22 @@ double max_abs(const std::array<double, 6>& v) {
   return m;
 }
 
+// When the first @p command left the host at or after @p since (simulated time), or -1.
+std::int64_t first_sent(const JacoRig& rig, jaco::Command command, std::int64_t since) {
+  for (const auto& p : rig.recorder.sent)
+    if (p.t_ns >= since && p.command() == command) return p.t_ns;
+  return -1;
+}
+
+// The simulated arm's own stopping time after an erase leaves the host, from @p speed (deg/s): its
+// command latency, its deceleration to rest, and a DSP cycle each for the packet to be taken, the
+// last braking step and the transfer.
+std::int64_t rest_after_ns(JacoRig& rig, double speed) {
+  const simulation::SimJacoDynamics& d = rig.arm().config().dynamics;
+  return d.command_latency_ns + static_cast<std::int64_t>(speed / d.decel_deg_s2 * 1e9) +
+         3 * jaco::ARM_PERIOD_NS;
+}
+
 TEST(JacoControllerSim, StartUpTakesControlAndLeavesNothingToMove) {
   JacoRig rig;
   EXPECT_EQ(rig.controller->identity().model, jaco::Model::JACO2);
@@ -157,19 +173,24 @@ TEST(JacoControllerSim, FingersStoppedByAnObjectEndTheirGoalAsBlocked) {
   EXPECT_FALSE(rig.controller->snapshot().fingers_blocked);
 }
 
-// The watchdog: after the client's last word the arm's motion has stopped within 100 ms of
-// simulated time, measured on the simulator's own record of when a joint last moved.
+// The watchdog: after the client's last word the driver has sent its erase within 100 ms of
+// simulated time, and the arm (with its own deceleration) is at rest within its stopping time after
+// that, measured on the simulator's own record of when a joint last moved.
 TEST(JacoControllerSim, WatchdogStopsTheArmWithin100msOfTheLastCommand) {
   JacoRig rig;
   const auto goal = offset(rig.arm().joints(), {60.0, 0.0, 0.0, 60.0, 0.0, 60.0});
   ASSERT_TRUE(rig.controller->submit(move_to(goal)).has_value());
   for (int i = 0; i < 50; ++i) rig.cycle(true);  // 0.5 s of motion, fed every cycle
   ASSERT_TRUE(rig.arm().moving());
+  const double speed = rig.controller->options().limits.max_joint_speed_deg_s;  // at most
   rig.controller->keep_alive();
   const std::int64_t last = rig.now();
-  for (int i = 0; i < 50; ++i) rig.cycle(false);  // the client is gone
+  for (int i = 0; i < 80; ++i) rig.cycle(false);  // the client is gone
+  const std::int64_t erased = first_sent(rig, jaco::Command::ERASE_TRAJECTORIES, last);
+  ASSERT_GE(erased, 0);
+  EXPECT_LE(erased, last + 100'000'000);
   ASSERT_TRUE(rig.arm().last_motion_ns().has_value());
-  EXPECT_LE(*rig.arm().last_motion_ns(), last + 100'000'000);
+  EXPECT_LE(*rig.arm().last_motion_ns(), erased + rest_after_ns(rig, speed));
   EXPECT_FALSE(rig.arm().moving());
   EXPECT_EQ(rig.arm().fifo_size(), 0U);
   const auto s = rig.controller->snapshot();
@@ -189,14 +210,19 @@ TEST(JacoControllerSim, WatchdogStopsTheArmWithAFullFifo) {
   ASSERT_TRUE(rig.controller->submit(move_to(offset(rig.arm().joints(), {1, 0, 0, 0, 0, 0}))));
   for (std::size_t i = 0; i < jaco::TRAJECTORY_FIFO; ++i) rig.arm().receive(packet, rig.now());
   rig.arm().reset_replies();
-  EXPECT_GE(rig.arm().fifo_size(), jaco::TRAJECTORY_FIFO - 1);
+  // The points act after the arm's command latency.
+  rig.arm().step(rig.now() + rig.arm().config().dynamics.command_latency_ns + jaco::ARM_PERIOD_NS);
+  EXPECT_GE(rig.arm().fifo_size(), jaco::TRAJECTORY_FIFO - 3);
   rig.controller->keep_alive();
   const std::int64_t last = rig.now();
-  for (int i = 0; i < 30; ++i) rig.cycle(false);
+  for (int i = 0; i < 40; ++i) rig.cycle(false);
   EXPECT_EQ(rig.arm().fifo_size(), 0U);
   EXPECT_FALSE(rig.arm().moving());
+  const std::int64_t erased = first_sent(rig, jaco::Command::ERASE_TRAJECTORIES, last);
+  ASSERT_GE(erased, 0);
+  EXPECT_LE(erased, last + 100'000'000);
   ASSERT_TRUE(rig.arm().last_motion_ns().has_value());
-  EXPECT_LE(*rig.arm().last_motion_ns(), last + 100'000'000);
+  EXPECT_LE(*rig.arm().last_motion_ns(), erased + rest_after_ns(rig, 5.0));
 }
 
 TEST(JacoControllerSim, EmergencyStopHoldsUntilReset) {
@@ -205,11 +231,17 @@ TEST(JacoControllerSim, EmergencyStopHoldsUntilReset) {
   ASSERT_TRUE(rig.controller->submit(move_to(goal)).has_value());
   for (int i = 0; i < 40; ++i) rig.cycle(true);
   ASSERT_TRUE(rig.arm().moving());
+  const double speed = max_abs(rig.arm().joint_velocities());
   rig.controller->estop();
   const std::int64_t pulled = rig.now();
-  rig.cycle(true);
-  rig.cycle(true);
-  EXPECT_LE(*rig.arm().last_motion_ns(), pulled + 20'000'000);
+  for (int i = 0; i < 60; ++i) rig.cycle(true);
+  // No motion packet after the pull; the erase in the next cycle; rest within the arm's own
+  // stopping time.
+  const std::int64_t erased = first_sent(rig, jaco::Command::ERASE_TRAJECTORIES, pulled);
+  ASSERT_GE(erased, 0);
+  EXPECT_LE(erased, pulled + jaco::ARM_PERIOD_NS);
+  EXPECT_LT(first_sent(rig, jaco::Command::SEND_BASIC_TRAJECTORY, pulled), 0);
+  EXPECT_LE(*rig.arm().last_motion_ns(), erased + rest_after_ns(rig, speed));
   auto refused = rig.controller->submit(move_to(goal));
   ASSERT_FALSE(refused.has_value());
   EXPECT_EQ(refused.error().code, jaco::JacoError::Code::ESTOP);
@@ -319,15 +351,18 @@ TEST(JacoControllerSim, ClientStreamedVelocityMovesAndStopsWithTheStream) {
   const double start = rig.arm().joints()[5];
   ArmCommand v;
   v.kind = Kind::VELOCITY;
-  for (int i = 1; i <= 100; ++i) {  // ramp to 10 deg/s at 50 deg/s^2, then hold
-    v.velocity = {0.0, 0.0, 0.0, 0.0, 0.0, std::min(10.0, 0.5 * i)};
+  for (int i = 1; i <= 100; ++i) {  // ramp to 10 deg/s at 40 deg/s^2 (the cap), then hold
+    v.velocity = {0.0, 0.0, 0.0, 0.0, 0.0, std::min(10.0, 0.4 * i)};
     ASSERT_TRUE(rig.controller->submit(v).has_value()) << i;
     rig.cycle(false);
   }
   EXPECT_GT(rig.arm().joints()[5] - start, 5.0);
   const std::int64_t last = rig.now();
-  for (int i = 0; i < 30; ++i) rig.cycle(false);
-  EXPECT_LE(*rig.arm().last_motion_ns(), last + 100'000'000);
+  for (int i = 0; i < 40; ++i) rig.cycle(false);
+  const std::int64_t erased = first_sent(rig, jaco::Command::ERASE_TRAJECTORIES, last);
+  ASSERT_GE(erased, 0);
+  EXPECT_LE(erased, last + 100'000'000);
+  EXPECT_LE(*rig.arm().last_motion_ns(), erased + rest_after_ns(rig, 10.0));
   EXPECT_EQ(rig.controller->snapshot().last_stop, jaco::StopReason::WATCHDOG);
 }
 
@@ -340,6 +375,8 @@ TEST(JacoControllerSim, HomesFromNoinitAndRefusesMotionBefore) {
   EXPECT_EQ(refused.error().code, jaco::JacoError::Code::INVALID_STATE);
   ASSERT_TRUE(rig.controller->submit(ArmCommand{Kind::HOME}).has_value());
   rig.run_until_idle(3000);
+  rig.cycle(true);  // the release acts after the arm's command latency
+  rig.cycle(true);
   const auto s = rig.controller->snapshot();
   EXPECT_EQ(s.last_stop, jaco::StopReason::REACHED);
   EXPECT_EQ(s.arm_state, jaco::ArmState::READY_STANDBY);
@@ -351,6 +388,8 @@ TEST(JacoControllerSim, RetractsFromHomeAndHomesBack) {
   JacoRig rig;
   ASSERT_TRUE(rig.controller->submit(ArmCommand{Kind::RETRACT}).has_value());
   rig.run_until_idle(3000);
+  rig.cycle(true);  // the release acts after the arm's command latency
+  rig.cycle(true);
   EXPECT_EQ(rig.arm().state(), jaco::ArmState::RETRACT_STANDBY);
   EXPECT_TRUE(rig.arm().joystick().is_release());
   ASSERT_TRUE(rig.controller->submit(ArmCommand{Kind::HOME}).has_value());
@@ -377,6 +416,8 @@ TEST(JacoControllerSim, AnArmThatNeverLeavesNoinitTimesOutAndIsReleased) {
   ASSERT_TRUE(rig.controller->submit(ArmCommand{Kind::HOME}).has_value());
   const int cycles = rig.run_until_idle(1000);
   EXPECT_LT(cycles, 300);
+  rig.cycle(true);  // the release acts after the arm's command latency
+  rig.cycle(true);
   EXPECT_EQ(rig.controller->snapshot().last_stop, jaco::StopReason::HOME_TIMEOUT);
   EXPECT_TRUE(rig.arm().joystick().is_release());
 }

@@ -1,7 +1,9 @@
 #pragma once
 // Helpers for the simulated-JACO tests: a SimJacoTransport with one arm opened and claimed, spoken
 // to only through the UsbTransport interface with packets built by drivers/jaco/jaco_protocol.hpp
-// (no driver code above the codec).
+// (no driver code above the codec). The protocol tests run the ideal arm (speeds jump, a packet
+// acts at the next cycle: SimJacoDynamics::ideal()); the arm's physics has its own tests
+// (sim_jaco_dynamics_test.cpp).
 #include <gtest/gtest.h>
 
 #include <array>
@@ -26,10 +28,11 @@ using namespace std::chrono_literals;
 inline constexpr UsbTimeout TIMEOUT_1S{1000};
 inline constexpr std::int64_t MS = 1'000'000;
 
-/// A JACO2 already at HOME (READY_STANDBY).
+/// A JACO2 already at HOME (READY_STANDBY), the ideal arm.
 inline SimJacoConfig ready_config() {
   SimJacoConfig c;
   c.start_state = jaco::ArmState::READY_STANDBY;
+  c.dynamics = SimJacoDynamics::ideal();
   return c;
 }
 
@@ -38,7 +41,10 @@ struct JacoRig {
   SimJacoTransport usb;
   UsbDeviceHandle h;
 
-  explicit JacoRig(SimJacoConfig config = ready_config(), SimJacoTransportConfig t = {}) : usb(t) {
+  explicit JacoRig(SimJacoConfig config = ready_config(), SimJacoTransportConfig t = {},
+                   bool ideal = true)
+      : usb(t) {
+    if (ideal) config.dynamics = SimJacoDynamics::ideal();
     usb.add_arm(std::move(config));
     auto list = usb.enumerate(jaco::VENDOR_KINOVA, jaco::PID_JACO);
     EXPECT_TRUE(list && list->size() == 1);

@@ -364,7 +364,7 @@ TEST(SimLibusbJaco, ControllerReadsTheIdentityMovesTheJointsAndLatchesTheEstop) 
 
   // The emergency stop mid-move: the arm stops and stays stopped until the latch is reset.
   ASSERT_TRUE(rig.controller->submit(move_to(config.home_joints)).has_value());
-  for (int i = 0; i < 15; ++i) rig.cycle(true);
+  for (int i = 0; i < 30; ++i) rig.cycle(true);  // ramping up at 40 deg/s^2, after the latency
   ASSERT_EQ(rig.controller->snapshot().control, ControlState::MOVING);
   ASSERT_GT(max_error(rig.controller->snapshot().joints, goal), 0.3);
   rig.controller->estop();
@@ -374,7 +374,8 @@ TEST(SimLibusbJaco, ControllerReadsTheIdentityMovesTheJointsAndLatchesTheEstop) 
   EXPECT_TRUE(s.estop);
   EXPECT_EQ(s.control, ControlState::ESTOP);
   EXPECT_EQ(s.last_stop, StopReason::ESTOP);
-  const JointAngles stopped = s.joints;
+  for (int i = 0; i < 50; ++i) rig.cycle(true);  // the arm brakes to rest (its deceleration)
+  const JointAngles stopped = rig.controller->snapshot().joints;
   for (int i = 0; i < 10; ++i) rig.cycle(true);
   EXPECT_LT(max_error(rig.controller->snapshot().joints, stopped), 0.01);
   auto refused = rig.controller->submit(move_to(config.home_joints));
@@ -406,7 +407,8 @@ TEST(SimLibusbJaco, HomesFromNoinitOnBothModels) {
     ASSERT_TRUE(rig.controller->submit(ArmCommand{Kind::HOME}).has_value());
     const int cycles = rig.run_until_idle(3000);
     const ArmSnapshot s = rig.controller->snapshot();
-    EXPECT_EQ(s.last_stop, StopReason::REACHED) << to_string(s.last_stop) << " after " << cycles;
+    EXPECT_EQ(s.last_stop, StopReason::REACHED)
+        << to_string(s.last_stop) << " after " << cycles << ": " << describe(s.violation);
     EXPECT_EQ(s.arm_state, ArmState::READY_STANDBY);
     EXPECT_LT(max_error(s.joints, config.home_joints), 0.3);
   }
