@@ -8,8 +8,11 @@
 #include <iostream>
 #include <sstream>
 
+#include <unistd.h>
+
 #include "apps/arm_cli.hpp"
 #include "drivers/usb/libusb_transport.hpp"
+#include "engine/ipc_runtime.hpp"
 #include "simulation/devices/sim_jaco_transport.hpp"
 
 namespace orthoflow::apps::arm_cli {
@@ -82,32 +85,96 @@ jaco::Box parse_box(const std::string& text, const std::string& what, const std:
     numbers = text.substr(0, last);
     box_name = text.substr(last + 1);
   }
+  if (box_name.empty() || box_name.size() > 23)
+    fail(what + ": a box's name has 1 to 23 characters", EXIT_USAGE);
   const auto v = parse_numbers(numbers, 6, what);
   jaco::Box box;
-  box.min = {std::min(v[0], v[3]), std::min(v[1], v[4]), std::min(v[2], v[5])};
-  box.max = {std::max(v[0], v[3]), std::max(v[1], v[4]), std::max(v[2], v[5])};
+  box.min = {v[0], v[1], v[2]};
+  box.max = {v[3], v[4], v[5]};
+  // Corners in order only: a swapped pair is more likely a typo than a box (docs/SAFETY.md).
+  if (!(box.min.array() < box.max.array()).all())
+    fail(what + " " + text + ": an inverted or empty box (x0 < x1, y0 < y1, z0 < z1 are needed)",
+         EXIT_USAGE);
   box.name.assign(box_name);
   return box;
 }
 
 }  // namespace
 
-std::unique_ptr<jaco::JacoArm> start_arm(const ArmArgs& a,
-                                         std::vector<jaco::StateCallback> subscribers) {
+std::string state_dir_path(const ArmArgs& a) {
+  return a.state_dir.empty() ? jaco::ArmStateDir::default_path(a.sim) : a.state_dir;
+}
+
+manipulation::ArmLimitsFile load_limits(const ArmArgs& a) {
+  manipulation::ArmLimitsFile file = manipulation::default_arm_limits();
+  const std::string path = !a.limits.empty()                          ? a.limits
+                           : ::access(DEFAULT_LIMITS_PATH, F_OK) == 0 ? DEFAULT_LIMITS_PATH
+                                                                      : "";
+  if (!path.empty()) {
+    auto loaded = manipulation::load_arm_limits(path);
+    if (!loaded) fail(loaded.error(), EXIT_BAD_INPUT);
+    file = std::move(*loaded);
+  }
+  jaco::SafetyLimits& limits = file.limits;
+  if (!a.workspace.empty()) limits.workspace = parse_box(a.workspace, "--workspace", "workspace");
+  for (const std::string& box : a.keep_out) {
+    const jaco::Box b = parse_box(box, "--keep-out", "keep-out");
+    if (limits.find_keep_out(b.name.view()) != nullptr)
+      fail("--keep-out: a box named '" + std::string(b.name.view()) + "' exists already",
+           EXIT_USAGE);
+    if (!limits.add_keep_out(b))
+      fail("at most " + std::to_string(jaco::MAX_KEEP_OUT) + " keep-out boxes", EXIT_USAGE);
+  }
+  if (a.base_from_camera) {
+    if (auto placed = manipulation::place_camera_keep_out(file, *a.base_from_camera); !placed)
+      fail(placed.error(), EXIT_USAGE);
+  }
+  return file;
+}
+
+HeldArm start_arm(const ArmArgs& a, std::vector<jaco::StateCallback> subscribers) {
+  const manipulation::ArmLimitsFile limits = load_limits(a);
   auto transport = make_transport(a);
   const auto device = find_arm(*transport, a);
   jaco::ArmOptions options;
   options.subscribers = std::move(subscribers);
   options.pace_to_wall_clock = a.sim;  // the simulated arm moves as fast as a real one
-  if (!a.workspace.empty())
-    options.controller.limits.workspace = parse_box(a.workspace, "--workspace", "workspace");
-  for (const std::string& box : a.keep_out) {
-    if (!options.controller.limits.add_keep_out(parse_box(box, "--keep-out", "keep-out")))
-      fail("at most " + std::to_string(jaco::MAX_KEEP_OUT) + " keep-out boxes", EXIT_USAGE);
+  options.controller.limits = limits.limits;
+  options.state_dir = state_dir_path(a);
+  options.holder = a.what;
+  // Before the arm is open: a signal from here on halts it in place and latches it.
+  if (a.motion) jaco::install_stop_signals();
+  std::string busy;
+  auto arm = jaco::JacoArm::start(std::move(transport), device, std::move(options), &busy);
+  if (!arm.has_value()) {
+    if (!busy.empty()) fail("the arm is not free: " + busy);
+    fail("cannot open the arm: " + jaco::to_string(arm.error()));
   }
-  auto arm = jaco::JacoArm::start(std::move(transport), device, std::move(options));
-  if (!arm.has_value()) fail("cannot open the arm: " + jaco::to_string(arm.error()));
-  return std::move(arm).value();
+  HeldArm held;
+  held.arm = std::move(arm).value();
+  if (a.motion && !held->realtime_guard())
+    std::cerr << "orthoflow arm: note: the guard thread runs without SCHED_FIFO (it needs "
+                 "CAP_SYS_NICE or an rtprio limit, docs/SAFETY.md); it still runs every 2 ms\n";
+  if (a.motion) {
+    if (const std::string latched = held->latch_reason(); !latched.empty())
+      fail("the arm's stop is latched (" + latched + ") in " + state_dir_path(a) +
+           ": check the arm, then `orthoflow arm reset`");
+  }
+  // Reachable by `orthoflow arm stop`, the web view and the DDS bridge whenever RouDi runs.
+  if (engine::ipc_runtime_ready() || engine::probe_roudi()) {
+    const bool ready = engine::ipc_runtime_ready() ||
+                       engine::init_ipc_runtime("orthoflow_arm_" + std::to_string(::getpid()));
+    if (ready) {
+      jaco::JacoArm* raw = held.arm.get();
+      auto listener = graphs::ArmStopListener::start(
+          [raw](std::string_view reason) { return raw->estop(reason); }, a.what);
+      if (listener)
+        held.stop_listener = std::move(*listener);
+      else
+        std::cerr << "orthoflow arm: no stop over iceoryx: " << listener.error() << '\n';
+    }
+  }
+  return held;
 }
 
 nlohmann::json snapshot_json(const jaco::ArmSnapshot& s) {
@@ -145,6 +212,13 @@ void add_common_options(CLI::App* sub, const std::shared_ptr<ArmArgs>& a) {
                 "fault: the simulated arm never leaves NOINIT");
   sub->add_option("--serial", a->serial, "the arm's USB serial (default: the first JACO)");
   sub->add_flag("--json", a->json, "JSON output");
+  sub->add_option("--limits", a->limits,
+                  std::string("the arm's limits file (docs/SAFETY.md; default ") +
+                      DEFAULT_LIMITS_PATH + " if present, else the built-in limits)");
+  sub->add_option("--state-dir", a->state_dir,
+                  "the arm's state directory: holder lock and latched stop (default "
+                  "$ORTHOFLOW_ARM_STATE_DIR, else /var/lib/orthoflow/arm; --sim: "
+                  "/tmp/orthoflow-sim-arm-UID)");
 }
 
 }  // namespace orthoflow::apps::arm_cli

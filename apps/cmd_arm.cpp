@@ -187,27 +187,13 @@ void run_state(const ArmArgs& a) {
   }
 }
 
-void run_stop(const ArmArgs& a) {
-  // Opening the arm releases the joystick and erases the trajectory FIFO (JacoController::open);
-  // closing it hands control back to the joystick: whatever an earlier process left running stops.
-  auto arm = start_arm(a);
-  const auto s = arm->snapshot();
-  arm.reset();
-  if (a.json) {
-    std::cout
-        << nlohmann::json{{"stopped", true}, {"arm_state", jaco::to_string(s.arm_state)}}.dump()
-        << '\n';
-    return;
-  }
-  std::cout << "arm stopped (joystick released, trajectories erased)\n";
-}
-
 }  // namespace
 
 void add_arm_command(CLI::App& app) {
   auto* arm = app.add_subcommand("arm",
                                  "the Kinova JACO arm (list, info, state, home, retract, "
-                                 "move, fingers, stop); --sim for the simulated arm");
+                                 "move, fingers, stop, reset, limits); --sim for the simulated "
+                                 "arm");
   arm->require_subcommand(1);
   auto a = std::make_shared<ArmArgs>();
   auto* list = arm->add_subcommand("list", "list the JACO arms on USB");
@@ -215,7 +201,10 @@ void add_arm_command(CLI::App& app) {
   list->callback([a] { run_list(*a); });
   auto* info = arm->add_subcommand("info", "model, serial, firmware and state of the arm");
   add_common_options(info, a);
-  info->callback([a] { run_info(*a); });
+  info->callback([a] {
+    a->what = "orthoflow arm info";
+    run_info(*a);
+  });
   auto* state = arm->add_subcommand("state", "joints, pose, fingers and state (--follow: 10 Hz)");
   add_common_options(state, a);
   state->add_flag("--follow", a->follow, "keep printing until Ctrl-C, SIGTERM or --seconds");
@@ -223,11 +212,12 @@ void add_arm_command(CLI::App& app) {
   state->add_flag("--publish", a->publish,
                   "with --follow: publish every 100 Hz snapshot on the iceoryx topic "
                   "orthoflow/jaco/state (needs a running RouDi)");
-  state->callback([a] { run_state(*a); });
-  auto* stop = arm->add_subcommand("stop", "stop any motion: release the joystick, erase the FIFO");
-  add_common_options(stop, a);
-  stop->callback([a] { run_stop(*a); });
+  state->callback([a] {
+    a->what = "orthoflow arm state";
+    run_state(*a);
+  });
   add_motion_commands(arm, a);
+  add_safety_commands(arm, a);
 }
 
 }  // namespace orthoflow::apps

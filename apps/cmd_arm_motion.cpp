@@ -1,8 +1,9 @@
 // `orthoflow arm home | retract | move --joints ... | move --pose ... | fingers open|close|a,b,c`:
-// motion through orthoflow's JACO driver. The command stays the arm's controlling client until the
-// motion ends: it feeds the driver's watchdog every 20 ms, so if this process dies the arm stops
-// within 100 ms; Ctrl-C pulls the emergency stop (finger moves too). Every target is checked by the
-// driver's safety layer first; a refusal names the limit and nothing moves.
+// motion through orthoflow's JACO driver. The command holds the arm (its state directory) until the
+// motion ends and feeds the driver's watchdog every 20 ms, so if this process dies the arm stops
+// within 100 ms; SIGINT, SIGTERM, SIGHUP, SIGQUIT and `orthoflow arm stop` halt it in place and
+// latch the stop. The safety monitor checks every cycle (docs/SAFETY.md); a refusal names the
+// limit and the part, and nothing moves. Every command ends by --timeout at the latest.
 #include <atomic>
 #include <chrono>
 #include <csignal>
@@ -18,15 +19,13 @@ namespace {
 
 namespace jaco = drivers::jaco;
 
-std::atomic<bool> interrupted{false};
-extern "C" void on_interrupt(int) { interrupted.store(true); }
-
 /// What a wait loop asks after every look at the arm: nullopt to keep waiting, "" when the command
 /// is done, or why it failed.
 using DoneCheck = std::function<std::optional<std::string>(const jaco::ArmSnapshot&)>;
 
-/// Submits @p command, then waits until @p done says so, feeding the watchdog every 20 ms. Ctrl-C
-/// pulls the emergency stop; a fault or --timeout ends the wait (the timeout stops the arm).
+/// Submits @p command, then waits until @p done says so, feeding the watchdog every 20 ms. A signal
+/// (SIGINT, SIGTERM, SIGHUP, SIGQUIT: start_arm installed them) or `orthoflow arm stop` halts the
+/// arm in place and latches it; a fault or --timeout ends the wait (the timeout stops the arm).
 jaco::ArmSnapshot submit_and_wait(jaco::JacoArm& arm, const jaco::ArmCommand& command,
                                   const ArmArgs& a, const DoneCheck& done) {
   if (auto ok = arm.submit(command); !ok.has_value()) {
@@ -34,22 +33,18 @@ jaco::ArmSnapshot submit_and_wait(jaco::JacoArm& arm, const jaco::ArmCommand& co
         ok.error().code == jaco::JacoError::Code::REFUSED ? EXIT_USAGE : EXIT_FAILURE_GENERIC;
     fail(jaco::to_string(ok.error()), code);
   }
-  struct sigaction action {};
-  struct sigaction previous {};
-  action.sa_handler = on_interrupt;
-  sigemptyset(&action.sa_mask);
-  sigaction(SIGINT, &action, &previous);
-  interrupted.store(false);
   const auto deadline =
       std::chrono::steady_clock::now() + std::chrono::duration<double>(a.timeout_s);
   jaco::ArmSnapshot s = arm.snapshot();
   std::string failure;
   for (;;) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    if (interrupted.load()) {
-      arm.estop();
-      std::this_thread::sleep_for(std::chrono::milliseconds(50));
-      failure = "interrupted: emergency stop latched";
+    // A signal (the arm's guard halted it already) or a stop request from another process.
+    if (const std::string latched = arm.latch_reason(); !latched.empty()) {
+      arm.persist_latch();
+      failure = "stopped (" + latched +
+                "): the arm is halted in place and the stop latched "
+                "until `orthoflow arm reset`";
       break;
     }
     arm.keep_alive();
@@ -65,11 +60,12 @@ jaco::ArmSnapshot submit_and_wait(jaco::JacoArm& arm, const jaco::ArmCommand& co
     if (std::chrono::steady_clock::now() > deadline) {
       (void)arm.submit(jaco::ArmCommand{jaco::ArmCommand::Kind::STOP});
       std::this_thread::sleep_for(std::chrono::milliseconds(50));
-      failure = "timed out after " + std::to_string(a.timeout_s) + " s; stopped";
+      failure = "timed out after " + std::to_string(a.timeout_s) +
+                " s (raise it with --timeout); "
+                "stopped";
       break;
     }
   }
-  sigaction(SIGINT, &previous, nullptr);
   if (!failure.empty()) fail(failure);
   return s;
 }
@@ -82,8 +78,10 @@ void run_until_done(jaco::JacoArm& arm, const jaco::ArmCommand& command, const A
         if (now.control != jaco::ControlState::IDLE || now.cycle <= start_cycle + 2)
           return std::optional<std::string>{};
         if (now.last_stop == jaco::StopReason::REACHED) return std::optional<std::string>{""};
-        return std::optional<std::string>{std::string("the motion ended: ") +
-                                          jaco::to_string(now.last_stop)};
+        std::string why = std::string("the motion ended: ") + jaco::to_string(now.last_stop);
+        if (now.last_stop == jaco::StopReason::SAFETY)
+          why += " (the safety monitor: " + jaco::describe(now.violation) + ")";
+        return std::optional<std::string>{why};
       });
   if (a.json) {
     std::cout << snapshot_json(s).dump(2) << '\n';
@@ -150,6 +148,13 @@ void run_fingers(const ArmArgs& a) {
   std::cout << "fingers " << s.fingers[0] << ' ' << s.fingers[1] << ' ' << s.fingers[2] << '\n';
 }
 
+/// The options of a motion command: it holds the arm as @p what; signals halt it.
+ArmArgs moving(ArmArgs a, const char* what) {
+  a.what = what;
+  a.motion = true;
+  return a;
+}
+
 void add_motion_options(CLI::App* sub, const std::shared_ptr<ArmArgs>& a) {
   add_common_options(sub, a);
   sub->add_option("--timeout", a->timeout_s, "give up and stop after this many seconds");
@@ -164,10 +169,10 @@ void add_motion_options(CLI::App* sub, const std::shared_ptr<ArmArgs>& a) {
 void add_motion_commands(CLI::App* arm, const std::shared_ptr<ArmArgs>& a) {
   auto* home = arm->add_subcommand("home", "drive to HOME (from NOINIT too) by the virtual button");
   add_motion_options(home, a);
-  home->callback([a] { run_home(*a, false); });
+  home->callback([a] { run_home(moving(*a, "orthoflow arm home"), false); });
   auto* retract = arm->add_subcommand("retract", "drive from HOME to RETRACT");
   add_motion_options(retract, a);
-  retract->callback([a] { run_home(*a, true); });
+  retract->callback([a] { run_home(moving(*a, "orthoflow arm retract"), true); });
   auto* move = arm->add_subcommand("move", "move to joint angles or a Cartesian pose");
   add_motion_options(move, a);
   move->add_option("--joints", a->joints, "six actuator angles in degrees: a,b,c,d,e,f");
@@ -176,8 +181,8 @@ void add_motion_commands(CLI::App* arm, const std::shared_ptr<ArmArgs>& a) {
   auto* fingers = arm->add_subcommand("fingers", "open, close, or move the fingers to a,b,c");
   add_motion_options(fingers, a);
   fingers->add_option("target", a->fingers, "open | close | a,b,c")->required();
-  fingers->callback([a] { run_fingers(*a); });
-  move->callback([a] { run_move(*a); });
+  fingers->callback([a] { run_fingers(moving(*a, "orthoflow arm fingers")); });
+  move->callback([a] { run_move(moving(*a, "orthoflow arm move")); });
 }
 
 }  // namespace orthoflow::apps::arm_cli

@@ -35,9 +35,6 @@ namespace {
 
 namespace jaco = drivers::jaco;
 
-std::atomic<bool> g_stop{false};
-extern "C" void on_task_stop_signal(int /*signal*/) { g_stop.store(true); }
-
 std::int64_t now_ns() { return Clock::now().time_since_epoch().count(); }
 
 /// Takes at most 64 samples of @p in, handing each one's bytes to @p use (false: it was refused).
@@ -119,7 +116,16 @@ void run_live(const LiveArgs& a) {
   auto state_out =
       publisher(engine::ARM_STATE_TOPIC, {engine::ARM_STATE_TYPE_ID, engine::ARM_STATE_VERSION},
                 sizeof(engine::ArmStatePayload), 1);
-  auto arm = arm_cli::start_arm(*a.arm);
+  arm_cli::ArmArgs arm_args = *a.arm;
+  arm_args.what = "orthoflow task run";
+  arm_args.motion = true;
+  arm_args.base_from_camera = options.base_from_camera;
+  // A task moves over the table: it never starts without the table's keep-out (docs/SAFETY.md).
+  if (arm_cli::load_limits(arm_args).limits.find_keep_out("table") == nullptr)
+    fail("the limits have no table keep-out (removed in " + arm_cli::load_limits(arm_args).source +
+             "): a task does not start without one",
+         EXIT_USAGE);
+  auto arm = arm_cli::start_arm(arm_args);
   std::printf("task: commands on %s, status on %s, arm state on %s\n",
               graphs::task_commands_topic(a.graph).c_str(),
               graphs::task_status_topic(a.graph).c_str(), engine::ARM_STATE_TOPIC);
@@ -148,11 +154,10 @@ void run_live(const LiveArgs& a) {
   settings.options = std::move(options);
   graphs::LiveTableTask task(std::move(settings), std::move(ports));
 
-  g_stop.store(false);
-  const auto previous_int = std::signal(SIGINT, on_task_stop_signal);
-  const auto previous_term = std::signal(SIGTERM, on_task_stop_signal);
   const std::int64_t begin = now_ns();
-  std::int64_t stop_at = 0;  // a stop was asked (signal, time limit): leave once the arm is still
+  std::int64_t stop_at = 0;    // the time limit: the task is stopped, leave once the arm is still
+  std::int64_t halted_at = 0;  // a signal or a stop request halted and latched the arm
+  std::string halted_by;
   bool started = false;
   auto list = std::make_unique<engine::ObjectListPayload>();
   int code = EXIT_OK;
@@ -199,9 +204,32 @@ void run_live(const LiveArgs& a) {
         break;
       }
     }
+    // A signal or a stop request halted the arm in place (the guard, the stop listener) and
+    // latched it: the task ends where it is, no retreat; the process leaves once the arm is still.
+    if (const std::string latched = arm->latch_reason(); !latched.empty() && halted_at == 0) {
+      arm->persist_latch();
+      halted_at = now;
+      halted_by = latched;
+      task.halted(latched, now);
+    }
     task.tick(now);
     const bool time_up = a.seconds > 0.0 && 1e-9 * double(now - begin) > a.seconds;
-    if ((g_stop.load() || time_up) && stop_at == 0) {
+    const bool signalled = jaco::signal_stop_requested() != 0;
+    if (halted_at != 0 && signalled) {
+      const jaco::ArmSnapshot s = arm->snapshot();
+      if (!jaco::JacoArm::moving(s) || now - halted_at > 2'000'000'000) {
+        why_exit = "halted by " + halted_by +
+                   (jaco::JacoArm::moving(s) ? ", the arm still moving "
+                                               "2 s later"
+                                             : ", the arm at rest") +
+                   "; the stop is latched until `orthoflow "
+                   "arm reset`";
+        if (jaco::JacoArm::moving(s)) code = EXIT_FAILURE_GENERIC;
+        break;
+      }
+      continue;
+    }
+    if (time_up && stop_at == 0) {
       stop_at = now;
       if (task.running()) {
         graphs::RemoteTaskCommand stop;
@@ -222,8 +250,6 @@ void run_live(const LiveArgs& a) {
       break;
     }
   }
-  std::signal(SIGINT, previous_int);
-  std::signal(SIGTERM, previous_term);
   jaco::ArmCommand halt;
   halt.kind = jaco::ArmCommand::Kind::STOP;
   (void)arm->submit(halt);  // whatever happened, nothing moves once this process leaves

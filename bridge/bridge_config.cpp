@@ -159,7 +159,9 @@ std::string cyclone_xml(const BridgeConfig& c) {
 
 BridgeTopics bridge_topics(const BridgeConfig& c) {
   const std::string base = "rt/" + c.topic_prefix + "/" + c.graph + "/";
-  return {base + "objects", base + "points", base + "learning_commands", base + "learning_acks"};
+  const std::string arm = "rt/" + c.topic_prefix + "/arm/";
+  return {base + "objects",       base + "points", base + "learning_commands",
+          base + "learning_acks", arm + "stop",    arm + "stop_ack"};
 }
 
 }  // namespace orthoflow::bridge

@@ -55,6 +55,7 @@ struct BridgeConfig {
 /// @brief The DDS topic names (ROS 2 names with rmw_cyclonedds' "rt" prefix) of @p config.
 struct BridgeTopics {
   std::string objects, points, learning_commands, learning_acks;
+  std::string arm_stop, arm_stop_acks;  ///< rt/<prefix>/arm/stop, .../stop_ack (not per graph)
 };
 [[nodiscard]] BridgeTopics bridge_topics(const BridgeConfig& config);
 

@@ -70,6 +70,9 @@ Result<std::unique_ptr<BridgeLoop>, std::string> BridgeLoop::open(const BridgeCo
       *pools);
   if (!commands) return err(ipc("learning commands", commands.error()));
   b->commands_ = std::move(*commands);
+  auto arm_stop = ArmStopRelay::open(*pools);
+  if (!arm_stop) return err(arm_stop.error());
+  b->arm_stop_ = std::move(*arm_stop);
   auto ros = RosEndpoints::open(config);
   if (!ros) return err(ros.error());
   b->ros_ = std::move(*ros);
@@ -92,6 +95,9 @@ std::size_t BridgeLoop::pump(std::int64_t now_ns) {
   if (frames_) work += pump_frame(now_ns);
   work += pump_commands(now_ns);
   work += pump_acks(now_ns);
+  work += arm_stop_->pump(*ros_, now_ns);
+  counters_.arm_stops_in = arm_stop_->stops_in();
+  counters_.arm_stops_confirmed = arm_stop_->stops_confirmed();
   // The engine's graph row: object lists are the bridge's frames.
   stats_.elapsed_ns.store(now_ns - start_ns_, std::memory_order_relaxed);
   stats_.frames_in.store(objects_stats_->processed.load(), std::memory_order_relaxed);

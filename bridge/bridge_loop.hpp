@@ -5,11 +5,13 @@
 /// graph's acks back. One thread calls pump(); it never blocks (iceoryx and DDS takes are
 /// non-blocking) and each pass is bounded (at most 16 object lists, 1 frame, 64 commands and 64
 /// acks). The graph restarting underneath is invisible here (iceoryx reconnects its topics); a lost
-/// RouDi is the caller's to notice (engine::ipc_roudi_lost).
+/// RouDi is the caller's to notice (engine::ipc_roudi_lost). Arm stops from DDS go to the process
+/// holding the arm (arm_stop_relay.hpp).
 #include <cstdint>
 #include <memory>
 #include <string>
 
+#include "bridge/arm_stop_relay.hpp"
 #include "bridge/bridge_config.hpp"
 #include "bridge/command_relay.hpp"
 #include "bridge/ros_endpoints.hpp"
@@ -27,6 +29,7 @@ struct BridgeCounters {
   std::uint64_t commands_in = 0, commands_forwarded = 0, commands_invalid = 0;
   std::uint64_t commands_no_graph = 0, commands_queue_full = 0;
   std::uint64_t acks_out = 0, acks_timeout = 0;
+  std::uint64_t arm_stops_in = 0, arm_stops_confirmed = 0;  ///< DDS stops, and holders' answers
 };
 
 class BridgeLoop {
@@ -59,6 +62,7 @@ class BridgeLoop {
   BridgeConfig config_;
   std::unique_ptr<RosEndpoints> ros_;
   std::unique_ptr<CommandRelay> relay_;
+  std::unique_ptr<ArmStopRelay> arm_stop_;
   std::unique_ptr<engine::IpcSubscriber> objects_, frames_, acks_;
   std::unique_ptr<engine::IpcPublisher> commands_;
   std::unique_ptr<engine::ObjectListPayload> list_;  // aligned copy of the newest list

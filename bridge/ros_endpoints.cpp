@@ -83,7 +83,26 @@ Result<std::unique_ptr<RosEndpoints>, std::string> RosEndpoints::open(const Brid
         !ok)
       return err(ok.error());
   }
+  // The arm's stop: reliable, every request kept until taken (a stop is never dropped for depth).
+  const TopicQos stop_qos{true, 16, false};
+  if (auto ok =
+          topic(&orthoflow_msgs_msg_dds__ArmStop__desc, e->topics_.arm_stop, e->arm_stop_topic_);
+      !ok)
+    return err(ok.error());
+  if (auto ok = topic(&orthoflow_msgs_msg_dds__ArmStopAck__desc, e->topics_.arm_stop_acks,
+                      e->arm_stop_ack_topic_);
+      !ok)
+    return err(ok.error());
+  if (auto ok = writer(e->arm_stop_ack_topic_, stop_qos, e->topics_.arm_stop_acks,
+                       e->arm_stop_ack_writer_);
+      !ok)
+    return err(ok.error());
   if (is_loopback(config.interface) || config.accept_network_commands) {
+    const QosPtr stop(make_qos(stop_qos));
+    e->arm_stop_reader_ =
+        dds_create_reader(e->participant_, e->arm_stop_topic_, stop.get(), nullptr);
+    if (e->arm_stop_reader_ < 0)
+      return err("DDS reader " + e->topics_.arm_stop + ": " + dds_error(e->arm_stop_reader_));
     const QosPtr qos(make_qos(config.commands_qos));
     e->commands_reader_ =
         dds_create_reader(e->participant_, e->commands_topic_, qos.get(), nullptr);
@@ -136,6 +155,31 @@ std::size_t RosEndpoints::take_commands(
     if (static_cast<std::size_t>(n) < BATCH) break;
   }
   return taken;
+}
+
+std::size_t RosEndpoints::take_arm_stops(
+    std::size_t max, const std::function<void(std::string_view reason)>& on_stop) {
+  if (arm_stop_reader_ <= 0) return 0;
+  std::size_t taken = 0;
+  while (taken < max) {
+    std::array<void*, 1> sample{};
+    std::array<dds_sample_info_t, 1> info{};
+    const dds_return_t n = dds_take(arm_stop_reader_, sample.data(), info.data(), 1, 1);
+    if (n <= 0) break;
+    if (info[0].valid_data) {
+      const auto* stop = static_cast<const RosArmStop*>(sample[0]);
+      on_stop(stop->reason != nullptr ? std::string_view(stop->reason) : std::string_view());
+    }
+    (void)dds_return_loan(arm_stop_reader_, sample.data(), n);
+    ++taken;
+  }
+  return taken;
+}
+
+Result<void, std::string> RosEndpoints::write_arm_stop_ack(const RosArmStopAck& ack) {
+  const dds_return_t rc = dds_write(arm_stop_ack_writer_, &ack);
+  if (rc < 0) return err("arm stop acks: " + dds_error(rc));
+  return {};
 }
 
 Result<void, std::string> RosEndpoints::write_ack(const graphs::RemoteAck& ack,

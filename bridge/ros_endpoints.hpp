@@ -47,6 +47,12 @@ class RosEndpoints {
   /// @brief Takes at most @p max commands, handing each to @p on_command. @return how many.
   std::size_t take_commands(std::size_t max,
                             const std::function<void(const RosLearningCommand&)>& on_command);
+  /// @brief Takes at most @p max arm stops (a reader only where commands are accepted), handing
+  /// each one's reason to @p on_stop. @return how many.
+  std::size_t take_arm_stops(std::size_t max,
+                             const std::function<void(std::string_view reason)>& on_stop);
+  /// @brief Publishes an arm stop's answer.
+  Result<void, std::string> write_arm_stop_ack(const RosArmStopAck& ack);
   /// @brief Publishes the answer @p ack to @p route's sender.
   Result<void, std::string> write_ack(const graphs::RemoteAck& ack, const AckRoute& route,
                                       std::string_view problem);
@@ -60,6 +66,8 @@ class RosEndpoints {
   std::int32_t participant_ = 0;
   std::int32_t objects_topic_ = 0, points_topic_ = 0, commands_topic_ = 0, acks_topic_ = 0;
   std::int32_t objects_writer_ = 0, points_writer_ = 0, commands_reader_ = 0, acks_writer_ = 0;
+  std::int32_t arm_stop_topic_ = 0, arm_stop_ack_topic_ = 0;
+  std::int32_t arm_stop_reader_ = 0, arm_stop_ack_writer_ = 0;
   std::uint32_t domain_ = 0;
   bool frames_ = false;
   StampClock clock_;

@@ -20,6 +20,8 @@
 #include "engine/frame_payload.hpp"
 #include "engine/object_list_payload.hpp"
 #include "graphs/channels/learning_payloads.hpp"
+#include "orthoflow_msgs/msg/ArmStop.h"
+#include "orthoflow_msgs/msg/ArmStopAck.h"
 #include "orthoflow_msgs/msg/LearningAck.h"
 #include "orthoflow_msgs/msg/LearningCommand.h"
 #include "orthoflow_msgs/msg/ObjectArray.h"
@@ -33,6 +35,8 @@ using RosPointCloud2 = sensor_msgs_msg_dds__PointCloud2_;
 using RosPointField = sensor_msgs_msg_dds__PointField_;
 using RosLearningCommand = orthoflow_msgs_msg_dds__LearningCommand_;
 using RosLearningAck = orthoflow_msgs_msg_dds__LearningAck_;
+using RosArmStop = orthoflow_msgs_msg_dds__ArmStop_;
+using RosArmStopAck = orthoflow_msgs_msg_dds__ArmStopAck_;
 
 /// @brief sensor_msgs/PointField's datatype constants (not on the wire; PointField.msg).
 enum class PointFieldType : std::uint8_t {

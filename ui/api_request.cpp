@@ -45,6 +45,7 @@ constexpr Route ROUTES[] = {
     {"/api/camera.png", Kind::CAMERA, false},
     {"/api/task/start", Kind::TASK_START, true},
     {"/api/task/stop", Kind::TASK_STOP, true},
+    {"/api/arm/stop", Kind::ARM_STOP, true},
 };
 
 // "application/json", optionally followed by parameters ("; charset=utf-8"). Requiring it also
@@ -135,6 +136,12 @@ Result<ApiRequest, ApiError> decode_action(Kind kind, const RawRequest& request)
   if (body.is_discarded()) return refuse(400, "the body is not valid JSON");
   if (!body.is_object()) return refuse(400, "the body must be a JSON object");
   if (kind == Kind::TASK_START || kind == Kind::TASK_STOP) return decode_task(kind, body);
+  if (kind == Kind::ARM_STOP) {  // POST /api/arm/stop {}
+    if (auto extra = only_fields(body, {})) return err(std::move(*extra));
+    ApiRequest decoded;
+    decoded.kind = kind;
+    return decoded;
+  }
   ApiRequest decoded;
   decoded.kind = kind;
   const bool needs_track = kind != Kind::FORGET && kind != Kind::UNDO,
@@ -199,6 +206,8 @@ std::string_view to_string(ApiRequest::Kind kind) noexcept {
       return "task_start";
     case Kind::TASK_STOP:
       return "task_stop";
+    case Kind::ARM_STOP:
+      return "arm_stop";
     case Kind::ASSET:
       return "asset";
   }

@@ -63,6 +63,7 @@ struct ApiRequest {
     CAMERA,
     TASK_START,  ///< POST /api/task/start: start a table task (ui/task_link.hpp)
     TASK_STOP,   ///< POST /api/task/stop
+    ARM_STOP,    ///< POST /api/arm/stop: halt the arm in place and latch (docs/SAFETY.md)
   };
   Kind kind = Kind::STATE;
   std::uint32_t track = 0;        ///< TEACH, CORRECT, ASK: >= 1

@@ -1,5 +1,7 @@
 #include "ui/ipc_task_link.hpp"
 
+#include "graphs/services/arm_stop_service.hpp"
+
 #include <chrono>
 
 #include "engine/ipc_pubsub.hpp"
@@ -114,6 +116,21 @@ TaskReply IpcTaskLink::send(const graphs::TaskCommand& command, int timeout_ms) 
     reply.status = TaskReply::Status::ANSWERED;
     reply.answer = *newest_;
   }
+  return reply;
+}
+
+ArmStopReply IpcTaskLink::stop_arm(int timeout_ms) {
+  ArmStopReply reply;
+  auto outcome = graphs::request_arm_stop("web view", std::chrono::milliseconds(timeout_ms));
+  if (!outcome) return reply;  // the topics could not be made: as good as no answer
+  using S = graphs::ArmStopOutcome::Status;
+  reply.status = outcome->status == S::STOPPED       ? ArmStopReply::Status::STOPPED
+                 : outcome->status == S::NO_LISTENER ? ArmStopReply::Status::NO_HOLDER
+                                                     : ArmStopReply::Status::TIMEOUT;
+  reply.was_moving = outcome->was_moving;
+  reply.holder_pid = outcome->holder_pid;
+  reply.holder = outcome->holder;
+  reply.request_to_halt_ms = 1e-6 * static_cast<double>(outcome->halted_ns - outcome->request_ns);
   return reply;
 }
 

@@ -36,6 +36,8 @@ class IpcTaskLink final : public TaskLink {
   [[nodiscard]] std::optional<TaskView> view() const override;
   /// @brief NO_TASK_PROCESS at once when nobody subscribes to the command topic.
   [[nodiscard]] TaskReply send(const graphs::TaskCommand& command, int timeout_ms) override;
+  /// @brief Over orthoflow/jaco/stop (any holder), reason "web view".
+  [[nodiscard]] ArmStopReply stop_arm(int timeout_ms) override;
   /// @brief Status payloads that failed decoding (never shown).
   [[nodiscard]] std::uint64_t rejected() const noexcept { return rejected_.load(); }
 

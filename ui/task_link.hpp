@@ -31,6 +31,20 @@ struct TaskReply {
   graphs::TaskStatus answer;
 };
 
+/// @brief What became of the web view's stop button (graphs/services/arm_stop_service.hpp).
+struct ArmStopReply {
+  enum class Status : std::uint8_t {
+    STOPPED,    ///< the process holding the arm halted and latched it
+    NO_HOLDER,  ///< nobody holding an arm listens: nothing was sent
+    TIMEOUT,    ///< sent, no answer within the timeout
+  };
+  Status status = Status::TIMEOUT;
+  bool was_moving = false;
+  int holder_pid = 0;
+  std::string holder;
+  double request_to_halt_ms = 0.0;
+};
+
 /// @note Implementations are thread-safe.
 class TaskLink {
  public:
@@ -40,6 +54,8 @@ class TaskLink {
   [[nodiscard]] virtual std::optional<TaskView> view() const = 0;
   /// @brief Sends @p command and waits at most @p timeout_ms for its answer.
   [[nodiscard]] virtual TaskReply send(const graphs::TaskCommand& command, int timeout_ms) = 0;
+  /// @brief Asks whatever process holds the arm to halt it in place and latch (no task needed).
+  [[nodiscard]] virtual ArmStopReply stop_arm(int timeout_ms) = 0;
 };
 
 /// @brief @p backend's snapshot with the task's state from its task link (none without one).

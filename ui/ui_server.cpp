@@ -203,6 +203,8 @@ int UiServer::serve(mg_connection* conn, const ApiRequest& request) {
     case Kind::TASK_START:
     case Kind::TASK_STOP:
       return act_task(conn, request);
+    case Kind::ARM_STOP:
+      return act_arm_stop(conn);
     default:
       return act(conn, request);
   }
@@ -230,6 +232,28 @@ int UiServer::act_task(mg_connection* conn, const ApiRequest& request) {
                      : a == graphs::TaskAnswer::REFUSED                                    ? 409
                                                                                            : 400;
   return reply(conn, status, "application/json", task_answer_json(request.task, answered.answer));
+}
+
+// The stop button: the holder halts the arm in place and latches it; 503 when nobody holds one.
+int UiServer::act_arm_stop(mg_connection* conn) {
+  TaskLink* link = backend_.task_link();
+  if (link == nullptr)
+    return reply_error(conn, {503,
+                              "no arm control here: run the graph with --ipc-learning (or "
+                              "`orthoflow ui`) beside the process holding the arm"});
+  const ArmStopReply r = link->stop_arm(config_.ack_timeout_ms);
+  if (r.status == ArmStopReply::Status::NO_HOLDER)
+    return reply_error(conn, {503, "no process holding an arm listens for stops"});
+  if (r.status == ArmStopReply::Status::TIMEOUT)
+    return reply_error(conn, {504, "the process holding the arm did not confirm the stop"});
+  const nlohmann::json out = {{"ok", true},
+                              {"stopped", true},
+                              {"latched", true},
+                              {"was_moving", r.was_moving},
+                              {"holder", r.holder},
+                              {"holder_pid", r.holder_pid},
+                              {"request_to_halt_ms", r.request_to_halt_ms}};
+  return reply(conn, 200, "application/json", out.dump());
 }
 
 int UiServer::act(mg_connection* conn, const ApiRequest& request) {

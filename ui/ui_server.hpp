@@ -52,6 +52,7 @@ class UiServer {
   int serve(mg_connection* conn, const ApiRequest& request);
   int act(mg_connection* conn, const ApiRequest& request);
   int act_task(mg_connection* conn, const ApiRequest& request);
+  int act_arm_stop(mg_connection* conn);
 
   UiServerConfig config_;
   UiBackend& backend_;

@@ -71,7 +71,14 @@ std::string ArmStateDir::default_path(bool simulated) {
   if (const char* env = std::getenv("ORTHOFLOW_ARM_STATE_DIR"); env != nullptr && *env != '\0')
     return simulated ? std::string(env) + "/sim" : std::string(env);
   if (simulated) return "/tmp/orthoflow-sim-arm-" + std::to_string(::getuid());
-  return "/var/lib/orthoflow/arm";
+  // The package's place (created by the .deb for the robot's service user); a user the package
+  // did not set up keeps the arm's state in their own state directory instead.
+  const char* system = "/var/lib/orthoflow/arm";
+  if (::access(system, W_OK) == 0 || ::access("/var/lib/orthoflow", W_OK) == 0 || ::getuid() == 0)
+    return system;
+  const char* home = std::getenv("HOME");
+  if (home == nullptr || *home == '\0') return system;
+  return std::string(home) + "/.local/state/orthoflow/arm";
 }
 
 Result<ArmHold, std::string> ArmStateDir::hold(std::string_view what) const {
@@ -106,13 +113,14 @@ std::optional<ArmHolder> ArmStateDir::holder() const {
   return ArmHolder{to_long(field(text, "pid")), field(text, "what")};
 }
 
-Result<void, std::string> ArmStateDir::latch(std::string_view reason) const {
+Result<void, std::string> ArmStateDir::latch(std::string_view reason, bool was_moving) const {
   const std::string file = path_ + "/estop";
   const std::string temporary = file + ".tmp" + std::to_string(::getpid());
   std::string text = "reason ";
   for (const char c : reason) text += (c == '\n' ? ' ' : c);
   text += "\npid " + std::to_string(::getpid()) + "\nunix_s " +
-          std::to_string(static_cast<long long>(std::time(nullptr))) + "\n";
+          std::to_string(static_cast<long long>(std::time(nullptr))) + "\nwas_moving " +
+          (was_moving ? "1" : "0") + "\n";
   const int fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
   if (fd < 0) return err(sys_error("cannot write " + temporary));
   const bool written = ::write(fd, text.data(), text.size()) == static_cast<ssize_t>(text.size());
@@ -134,6 +142,7 @@ std::optional<ArmLatch> ArmStateDir::latched() const {
   if (latch.reason.empty()) latch.reason = "(unreadable latch file: treated as latched)";
   latch.pid = to_long(field(text, "pid"));
   latch.unix_s = to_long(field(text, "unix_s"));
+  latch.was_moving = field(text, "was_moving") == "1";
   return latch;
 }
 

@@ -8,8 +8,10 @@
 /// - `estop`: a latched stop, written atomically by whoever stopped the arm, with the reason and
 ///   the time. A process that takes the arm while it exists starts latched and refuses to move;
 ///   only `orthoflow arm reset` (a person) removes it.
-/// The default place is $ORTHOFLOW_ARM_STATE_DIR, else /var/lib/orthoflow/arm (a simulated arm:
-/// the same under /tmp/orthoflow-sim-arm-<uid>, so the two never share a latch).
+/// The default place is $ORTHOFLOW_ARM_STATE_DIR, else /var/lib/orthoflow/arm where this user may
+/// write there (the package's service user, root), else ~/.local/state/orthoflow/arm (a simulated
+/// arm: $ORTHOFLOW_ARM_STATE_DIR/sim, else /tmp/orthoflow-sim-arm-<uid>, so a real and a simulated
+/// arm never share a latch).
 /// Not for the frame path: every call is a few system calls. Thread-safe: each call is
 /// self-contained (the holder's lock lives in its ArmHold).
 #include <optional>
@@ -31,6 +33,7 @@ struct ArmLatch {
   std::string reason;  ///< e.g. "SIGTERM", "orthoflow arm stop (pid 1234)", "web view"
   long pid = 0;        ///< the process that latched it
   long long unix_s = 0;
+  bool was_moving = false;  ///< the arm was moving when it was stopped
 };
 
 /// @brief Holding the arm: the lock is released when this is destroyed (or the process ends).
@@ -64,7 +67,8 @@ class ArmStateDir {
   /// @brief The process holding the arm now, if any. @pre none.
   [[nodiscard]] std::optional<ArmHolder> holder() const;
   /// @brief Writes the latch (atomically: a complete file or none). @pre none.
-  [[nodiscard]] Result<void, std::string> latch(std::string_view reason) const;
+  [[nodiscard]] Result<void, std::string> latch(std::string_view reason,
+                                                bool was_moving = false) const;
   /// @brief The latch, if one is set. @pre none.
   [[nodiscard]] std::optional<ArmLatch> latched() const;
   /// @brief Removes the latch (a person's reset). @pre none.

@@ -14,6 +14,7 @@ namespace orthoflow::drivers::jaco {
 namespace {
 
 std::atomic<int> g_signal_stop{0};
+std::atomic<std::uint32_t> g_signal_count{0};  // every request, so each one latches anew
 
 void on_stop_signal(int signal_number) { request_signal_stop(signal_number); }
 
@@ -44,6 +45,7 @@ bool make_realtime(std::thread& thread) noexcept {
 
 void request_signal_stop(int signal_number) noexcept {
   g_signal_stop.store(signal_number == 0 ? -1 : signal_number, std::memory_order_release);
+  g_signal_count.fetch_add(1, std::memory_order_acq_rel);
 }
 
 int signal_stop_requested() noexcept { return g_signal_stop.load(std::memory_order_acquire); }
@@ -90,6 +92,7 @@ Result<std::unique_ptr<JacoArm>, JacoError> JacoArm::start(std::unique_ptr<UsbTr
   if (arm->state_dir_) {
     if (auto latch = arm->state_dir_->latched()) {  // latched by an earlier process: stay still
       arm->latch_reason_ = latch->reason;
+      arm->latch_was_moving_ = latch->was_moving;
       arm->controller_->estop();
     }
   }
@@ -106,18 +109,38 @@ JacoArm::~JacoArm() {
   cycles_.notify_all();
   for (std::thread* t : {&notifier_, &guard_, &thread_})
     if (t->joinable()) t->join();
+  persist_latch();
   controller_.reset();  // stops the arm on this thread, now that the USB thread is gone
 }
 
 bool JacoArm::estop(std::string_view reason) {
   const bool was_moving = moving(controller_->snapshot());
   controller_->estop();
-  std::lock_guard lock(latch_mutex_);
-  if (latch_reason_.empty()) {
-    latch_reason_ = std::string(reason);
-    if (state_dir_) (void)state_dir_->latch(reason);
-  }
+  latch_in_memory(reason, was_moving);
+  persist_latch();
   return was_moving;
+}
+
+void JacoArm::latch_in_memory(std::string_view reason, bool was_moving) {
+  std::lock_guard lock(latch_mutex_);
+  if (!latch_reason_.empty()) return;  // the first reason stands
+  latch_reason_ = std::string(reason);
+  latch_was_moving_ = was_moving;
+  latch_persisted_ = false;
+}
+
+void JacoArm::persist_latch() {
+  std::string reason;
+  bool was_moving = false;
+  {
+    // Copied under the lock, written outside it: the guard's latch_in_memory never waits on I/O.
+    std::lock_guard lock(latch_mutex_);
+    if (latch_persisted_ || latch_reason_.empty()) return;
+    reason = latch_reason_;
+    was_moving = latch_was_moving_;
+    latch_persisted_ = true;
+  }
+  if (state_dir_) (void)state_dir_->latch(reason, was_moving);
 }
 
 Result<void, JacoError> JacoArm::reset_estop() {
@@ -125,6 +148,7 @@ Result<void, JacoError> JacoArm::reset_estop() {
   if (!reset) return reset;
   std::lock_guard lock(latch_mutex_);
   latch_reason_.clear();
+  latch_persisted_ = true;
   if (state_dir_) (void)state_dir_->clear_latch();
   return {};
 }
@@ -137,10 +161,15 @@ std::string JacoArm::latch_reason() const {
 void JacoArm::run_guard() noexcept {
   const MonotonicClock& clock = transport_->clock();
   auto next = std::chrono::steady_clock::now();
+  std::uint32_t seen = 0;  // a request made before this arm started latches it too
   while (!stop_.load(std::memory_order_acquire)) {
     controller_->guard(clock.now_ns());
-    if (const int s = signal_stop_requested(); s != 0) {
-      if (latch_reason().empty()) estop(signal_name(s));
+    if (const std::uint32_t count = g_signal_count.load(std::memory_order_acquire); count != seen) {
+      // Halt now; the file is written by the holder's thread or the destructor (no I/O here).
+      seen = count;
+      const bool was_moving = moving(controller_->snapshot());
+      controller_->estop();
+      latch_in_memory(signal_name(signal_stop_requested()), was_moving);
     }
     next += std::chrono::nanoseconds(GUARD_PERIOD_NS);
     std::this_thread::sleep_until(next);

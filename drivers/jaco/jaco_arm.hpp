@@ -47,7 +47,8 @@ struct ArmOptions {
 };
 
 /// @brief Asks every JacoArm of this process to latch its stop, with @p signal_number as the
-/// reason. Async-signal-safe (one atomic store): for SIGINT / SIGTERM / SIGHUP / SIGQUIT handlers.
+/// reason; every request latches anew (after a reset). Async-signal-safe (lock-free atomics): for
+/// SIGINT / SIGTERM / SIGHUP / SIGQUIT handlers.
 void request_signal_stop(int signal_number) noexcept;
 /// @brief The signal a handler asked to stop for (0: none). @pre none.
 [[nodiscard]] int signal_stop_requested() noexcept;
@@ -74,6 +75,10 @@ class JacoArm {
   /// @brief Latches the stop now (wait-free on the arm), then records it in the state directory
   /// with @p reason. @return true if the arm was moving when asked (commanded or measured).
   bool estop(std::string_view reason = "emergency stop");
+  /// @brief Writes a latch that only the guard has recorded (a signal's stop) to the state
+  /// directory: the guard never does file I/O; the holder's thread (its wait loop) or the
+  /// destructor does. @pre none.
+  void persist_latch();
   /// @brief A person's reset: clears the latch in the controller and in the state directory.
   [[nodiscard]] Result<void, JacoError> reset_estop();
   /// @brief Why the arm is latched (empty if it is not). @pre none.
@@ -104,6 +109,9 @@ class JacoArm {
   ArmHold hold_;
   mutable std::mutex latch_mutex_;
   std::string latch_reason_;
+  bool latch_was_moving_ = false;
+  bool latch_persisted_ = true;
+  void latch_in_memory(std::string_view reason, bool was_moving);
   std::atomic<bool> stop_{false};
   std::atomic<bool> realtime_{false};
   std::atomic<std::uint64_t> cycles_{0};

@@ -125,8 +125,8 @@ JacoController::~JacoController() {
   (void)link_->command(Command::STOP_API_CONTROL);
 }
 
-Result<void, JacoError> JacoController::validate(const ArmCommand& command,
-                                                 const ArmSnapshot& now) const {
+Result<void, JacoError> JacoController::validate(const ArmCommand& command, const ArmSnapshot& now,
+                                                 FirmwareProof* proof) const {
   using Kind = ArmCommand::Kind;
   const SafetyLimits& limits = options_.limits;
   if (command.kind == Kind::STOP || command.kind == Kind::KEEP_ALIVE) return {};
@@ -179,10 +179,19 @@ Result<void, JacoError> JacoController::validate(const ArmCommand& command,
       return {};
     }
     case Kind::HOME:
-      return {};
     case Kind::RETRACT: {
-      const ButtonAction first = next_button_action(now.arm_state, ArmGoal::RETRACT, false);
-      if (first == ButtonAction::REFUSE) return error_of(JacoError::Code::INVALID_STATE);
+      if (command.kind == Kind::RETRACT &&
+          next_button_action(now.arm_state, ArmGoal::RETRACT, false) == ButtonAction::REFUSE)
+        return error_of(JacoError::Code::INVALID_STATE);
+      // The firmware's motion runs to its pose even if the link fails: all of it must be clear.
+      double closed = limits.max_finger;
+      for (double f : now.fingers) closed = std::min(closed, f);
+      const double open = std::clamp(1.0 - closed / limits.max_finger, 0.0, 1.0);
+      const JointAngles& goal =
+          command.kind == Kind::RETRACT ? options_.retract_joints : options_.home_joints;
+      auto ok = prove_firmware_motion(limits, now.joints, goal, open, now.held);
+      if (!ok) return refused(ok.error());
+      if (proof != nullptr) *proof = *ok;
       return {};
     }
     default:
@@ -191,8 +200,9 @@ Result<void, JacoError> JacoController::validate(const ArmCommand& command,
 }
 
 Result<ArmCommand, JacoError> JacoController::check_command(const ArmCommand& command,
+                                                            FirmwareProof* proof,
                                                             const ArmSnapshot& now) const {
-  auto ok = validate(command, now);
+  auto ok = validate(command, now, proof);
   if (!ok) return err(ok.error());
   ArmCommand accepted = command;
   if (command.kind == ArmCommand::Kind::MOVE_POSE) {
@@ -220,7 +230,8 @@ Result<void, JacoError> JacoController::submit(const ArmCommand& command) {
     std::lock_guard lock(mutex_);
     now = published_;
   }
-  auto checked = check_command(command, now);
+  FirmwareProof proof;
+  auto checked = check_command(command, &proof, now);
   std::lock_guard lock(mutex_);
   if (!checked) {
     ++published_.refused;
@@ -239,6 +250,8 @@ Result<void, JacoError> JacoController::submit(const ArmCommand& command) {
     }
   }
   last_client_ns_.store(clock_->now_ns(), std::memory_order_release);
+  if (command.kind == ArmCommand::Kind::HOME || command.kind == ArmCommand::Kind::RETRACT)
+    firmware_proof_ = proof;
   switch (command.kind) {
     case ArmCommand::Kind::KEEP_ALIVE:
       break;

@@ -113,7 +113,10 @@ struct ArmSnapshot {
   std::int64_t stamp_ns = 0;  ///< transport clock when the joints were read
   std::uint64_t cycle = 0;
   JointAngles joints{};
-  JointVelocity velocity{};   ///< from successive readings, deg/s
+  JointVelocity velocity{};  ///< from successive readings, deg/s
+  /// The same over the oldest reading kept (at least 50 ms when there is one): a step miscounted
+  /// is a fifth at most, so the firmware's speed is judged on it, not on `velocity`.
+  JointVelocity span_velocity{};
   JointVelocity commanded{};  ///< the last velocity point sent, deg/s
   std::array<double, FINGERS> fingers{};
   bool fingers_moving = false;   ///< a finger goal is under way
@@ -189,8 +192,10 @@ class JacoController {
  private:
   JacoController(UsbTransport& transport, ControllerOptions options) noexcept;
   Result<void, JacoError> start_up(const UsbDeviceInfo& device);
-  Result<void, JacoError> validate(const ArmCommand& command, const ArmSnapshot& now) const;
-  Result<ArmCommand, JacoError> check_command(const ArmCommand& command,
+  /// @p proof: where HOME / RETRACT's whole motion was proven clear (those two only).
+  Result<void, JacoError> validate(const ArmCommand& command, const ArmSnapshot& now,
+                                   FirmwareProof* proof = nullptr) const;
+  Result<ArmCommand, JacoError> check_command(const ArmCommand& command, FirmwareProof* proof,
                                               const ArmSnapshot& now) const;
   void read_state() noexcept;
   void run_motion(std::int64_t now) noexcept;
@@ -232,6 +237,7 @@ class JacoController {
   std::atomic<bool> silent_{false};  ///< set by guard(): the arm stopped answering
   std::atomic<bool> linked_{false};  ///< start-up done: the guard watches
   HeldCapsule held_{};               ///< guarded by mutex_; copied into state_ each cycle
+  FirmwareProof firmware_proof_{};   ///< guarded by mutex_: the accepted HOME / RETRACT's proof
 
   // USB thread only.
   ArmSnapshot state_{};

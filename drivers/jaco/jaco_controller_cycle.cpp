@@ -39,6 +39,15 @@ void JacoController::read_state() noexcept {
     const double dt = static_cast<double>(now - base->t_ns) * 1e-9;
     for (std::size_t j = 0; j < JOINTS; ++j) state_.velocity[j] = (q[j] - base->q[j]) / dt;
   }
+  // The oldest reading kept, when it is at least 50 ms old: the span the firmware's speed is judged
+  // over (a loaded host's late reply does not make a step look like two).
+  const Reading& oldest = readings_[reading_next_];
+  if (have_previous_ && oldest.t_ns != 0 && now - oldest.t_ns >= 5 * ARM_PERIOD_NS) {
+    const double dt = static_cast<double>(now - oldest.t_ns) * 1e-9;
+    for (std::size_t j = 0; j < JOINTS; ++j) state_.span_velocity[j] = (q[j] - oldest.q[j]) / dt;
+  } else {
+    state_.span_velocity = state_.velocity;
+  }
   readings_[reading_next_] = {now, q};
   reading_next_ = (reading_next_ + 1) % readings_.size();
   have_previous_ = true;

@@ -108,6 +108,8 @@ bool JacoController::monitor_allows(const JointVelocity& v, bool firmware) noexc
   CycleIntent intent;
   intent.joints = state_.joints;
   intent.velocity = state_.velocity;
+  intent.span_velocity = state_.span_velocity;
+  intent.span_measured = true;
   intent.command = v;
   intent.previous = last_velocity_;
   intent.firmware = firmware;
@@ -120,8 +122,13 @@ bool JacoController::monitor_allows(const JointVelocity& v, bool firmware) noexc
     finger = std::min(finger, *std::min_element(finger_goal_->begin(), finger_goal_->end()));
   intent.finger_open = std::clamp(1.0 - finger / limits.max_finger, 0.0, 1.0);
   intent.held = state_.held;
+  FirmwareProof proof;
+  if (firmware) {
+    std::lock_guard lock(mutex_);
+    proof = firmware_proof_;
+  }
   MonitorCost cost;
-  auto verdict = check_cycle(limits, intent, &cost);
+  auto verdict = check_cycle(limits, intent, &cost, firmware ? &proof : nullptr);
   state_.monitor_nodes = cost.nodes;
   if (verdict) return true;
   state_.violation = verdict.error();

@@ -14,8 +14,9 @@ namespace {
 
 constexpr double RAD = std::numbers::pi / 180.0;
 constexpr double PERIOD_S = static_cast<double>(ARM_PERIOD_NS) * 1e-9;
-// Measured speeds come from position differences over two or three of the arm's 10 ms steps (a
-// step more or less than the span's time: up to a third off): allow that before calling a
+// A firmware cycle's speed is measured over at least five of the arm's 10 ms steps
+// (ArmSnapshot::span_velocity; a step more or less than the span's time: a fifth off at most), or
+// over two or three where no longer span is known yet (a third): allow that before calling a
 // firmware-driven motion too fast.
 constexpr double MEASURED_SPEED_SLACK = 1.4;
 
@@ -91,7 +92,8 @@ Unexpected<Violation> body_violation(const NodeResult& r, double ahead) {
 // A path halves along its segment (both ends move together); a box halves its widest joint.
 Result<void, Violation> sweep(const SafetyLimits& limits, const Stretch& whole, bool path,
                               double envelope_s, double finger_open, const HeldCapsule& held,
-                              MonitorCost* cost) noexcept {
+                              MonitorCost* cost,
+                              std::size_t max_nodes = MAX_MONITOR_NODES) noexcept {
   std::array<Stretch, 64> stack{};
   std::size_t top = 0, nodes = 0;
   stack[top++] = whole;
@@ -100,14 +102,16 @@ Result<void, Violation> sweep(const SafetyLimits& limits, const Stretch& whole, 
   while (top > 0) {
     const Stretch s = stack[--top];
     const NodeResult r = examine(limits, s, finger_open, held);
-    if (cost != nullptr) cost->nodes = ++nodes;
+    ++nodes;  // counted whether or not the caller asks for the cost: it bounds the work
+    if (cost != nullptr) cost->nodes = nodes;
     if (!r.split && r.worst.margin_m >= 0.0) continue;
     double widest_m = 0.0;
     for (std::size_t j = 0; j < JOINTS; ++j)
       widest_m = std::max(widest_m, std::abs(s.hi[j] - s.lo[j]));
     widest_m *= 0.5 * RAD;  // the largest half-turn in radians, times a metre of reach
     if (!r.split && widest_m <= 0.5 * limits.sweep_resolution_m) return body_violation(r, ahead(s));
-    if (nodes >= MAX_MONITOR_NODES || top + 2 > stack.size()) {
+    // Every stretch on the stack will be examined: split only while all of them fit the budget.
+    if (nodes + top + 2 > max_nodes || top + 2 > stack.size()) {
       Violation v;
       v.limit = Violation::Limit::UNPROVEN;
       v.depth_m = widest_m;
@@ -135,7 +139,7 @@ bool finite(const JointVelocity& values) noexcept {
 Result<void, Violation> check_rates(const SafetyLimits& limits, const CycleIntent& in) noexcept {
   for (std::size_t j = 0; j < JOINTS; ++j) {
     if (in.firmware) {
-      const double speed = std::abs(in.velocity[j]);
+      const double speed = std::abs(in.span_measured ? in.span_velocity[j] : in.velocity[j]);
       if (speed > HARDWARE_SPEED_DEG_S[j] * MEASURED_SPEED_SLACK)
         return joint_violation(Violation::Limit::SPEED, j, speed, HARDWARE_SPEED_DEG_S[j]);
       continue;
@@ -206,14 +210,35 @@ JointRange envelope_range(const SafetyLimits& limits, const CycleIntent& in,
   return {range.lo - early, range.hi + early};
 }
 
+namespace {
+bool finite_held(const HeldCapsule& h) noexcept {
+  return h.a.allFinite() && h.b.allFinite() && std::isfinite(h.radius_m);
+}
+bool same_held(const HeldCapsule& a, const HeldCapsule& b) noexcept {
+  return a.a == b.a && a.b == b.b && a.radius_m == b.radius_m;
+}
+}  // namespace
+
 Result<void, SafetyViolation> check_cycle(const SafetyLimits& limits, const CycleIntent& intent,
-                                          MonitorCost* cost) noexcept {
+                                          MonitorCost* cost, const FirmwareProof* proof) noexcept {
   CycleIntent in = intent;
   if (in.firmware) in.command = in.velocity;
   if (!finite(in.joints) || !finite(in.velocity) || !finite(in.command) || !finite(in.previous) ||
-      !std::isfinite(in.finger_open))
+      !finite(in.span_velocity) || !std::isfinite(in.finger_open) || !finite_held(in.held))
     return joint_violation(Violation::Limit::NOT_FINITE, 0, 0.0, 0.0);
   if (auto rates = check_rates(limits, in); !rates) return rates;
+  if (in.firmware && proof != nullptr && proof->valid && same_held(proof->held, in.held) &&
+      in.finger_open <= proof->finger_open + 1e-9) {
+    constexpr double SLACK_DEG = 0.5;  // a reading's noise
+    bool inside = true;
+    for (std::size_t j = 0; j < JOINTS; ++j)
+      inside = inside && in.joints[j] >= proof->lo[j] - SLACK_DEG &&
+               in.joints[j] <= proof->hi[j] + SLACK_DEG;
+    if (inside) {
+      if (cost != nullptr) cost->nodes = 0;
+      return {};
+    }
+  }
   Stretch box;
   double longest = 0.0;
   for (std::size_t j = 0; j < JOINTS; ++j) {
@@ -243,8 +268,37 @@ Result<void, SafetyViolation> check_joint_move(const SafetyLimits& limits, const
     if (to[j] > limits.joints.upper[j])
       return joint_violation(Violation::Limit::JOINT_LIMIT, j, to[j], limits.joints.upper[j]);
   }
-  if (!std::isfinite(finger_open)) return joint_violation(Violation::Limit::NOT_FINITE, 0, 0, 0);
+  if (!std::isfinite(finger_open) || !finite_held(held))
+    return joint_violation(Violation::Limit::NOT_FINITE, 0, 0, 0);
   return sweep(limits, Stretch{from, to, 0.0, 1.0}, true, 0.0, finger_open, held, cost);
+}
+
+Result<FirmwareProof, SafetyViolation> prove_firmware_motion(
+    const SafetyLimits& limits, const JointAngles& from, const JointAngles& goal,
+    double finger_open, const HeldCapsule& held, MonitorCost* cost) noexcept {
+  if (!std::isfinite(finger_open) || !finite_held(held))
+    return joint_violation(Violation::Limit::NOT_FINITE, 0, 0.0, 0.0);
+  Stretch box;
+  for (std::size_t j = 0; j < JOINTS; ++j) {
+    if (!std::isfinite(from[j]) || !std::isfinite(goal[j]))
+      return joint_violation(Violation::Limit::NOT_FINITE, j, goal[j], 0.0);
+    box.lo[j] = std::min(from[j], goal[j]);
+    box.hi[j] = std::max(from[j], goal[j]);
+    if (box.lo[j] < limits.joints.lower[j])
+      return joint_violation(Violation::Limit::JOINT_LIMIT, j, box.lo[j], limits.joints.lower[j]);
+    if (box.hi[j] > limits.joints.upper[j])
+      return joint_violation(Violation::Limit::JOINT_LIMIT, j, box.hi[j], limits.joints.upper[j]);
+  }
+  if (auto clear = sweep(limits, box, false, 0.0, finger_open, held, cost, MAX_FIRMWARE_NODES);
+      !clear)
+    return err(clear.error());
+  FirmwareProof proof;
+  proof.valid = true;
+  proof.lo = box.lo;
+  proof.hi = box.hi;
+  proof.finger_open = finger_open;
+  proof.held = held;
+  return proof;
 }
 
 }  // namespace orthoflow::drivers::jaco

@@ -22,9 +22,12 @@
 ///   everywhere; one that is not is halved along its widest joint until its half-turns move the
 ///   body less than sweep_resolution_m, and one still not clear is a violation.
 /// A straight move (check_joint_move) is swept the same way along its segment.
-/// Work is bounded: at most MAX_MONITOR_NODES stretches per check; a motion not shown clear
-/// within them is refused as UNPROVEN (fast motion near a keep-out: slow down). Pure; no
-/// allocation; deterministic.
+/// Work is bounded: at most MAX_MONITOR_NODES stretches per cycle's check (about 2.6 us each on
+/// the bench machine, bench/RESULTS.md); a motion not shown clear within them is refused as
+/// UNPROVEN (fast motion near a keep-out: slow down). The firmware's own motion (HOME, RETRACT) is
+/// proven whole before it starts (prove_firmware_motion, MAX_FIRMWARE_NODES, on the submitting
+/// thread); each of its cycles then only checks that the arm stays inside what was proven. Pure;
+/// no allocation; deterministic.
 #include <cstddef>
 
 #include "core/result.hpp"
@@ -35,12 +38,27 @@
 namespace orthoflow::drivers::jaco {
 
 /// @brief The stretches of motion one check may examine.
-inline constexpr std::size_t MAX_MONITOR_NODES = 512;
+inline constexpr std::size_t MAX_MONITOR_NODES = 1024;
+/// @brief The stretches the proof of a whole firmware motion may examine (once, at submit).
+inline constexpr std::size_t MAX_FIRMWARE_NODES = 8192;
+
+/// @brief A firmware motion proven clear as a whole: every configuration in [lo, hi] with the
+/// fingers no wider than finger_open and this held object.
+struct FirmwareProof {
+  bool valid = false;
+  JointAngles lo{}, hi{};
+  double finger_open = 0.0;
+  HeldCapsule held{};
+};
 
 /// @brief What the next control cycle would do: every motion mode reduces to this.
 struct CycleIntent {
   JointAngles joints{};      ///< measured at the cycle's start (deg)
   JointVelocity velocity{};  ///< measured (deg/s)
+  /// Measured over a longer span (ArmSnapshot::span_velocity) when span_measured: what a firmware
+  /// cycle's speed is judged on (the envelope still uses `velocity`).
+  JointVelocity span_velocity{};
+  bool span_measured = false;
   JointVelocity command{};   ///< what this cycle streams (deg/s); firmware motion: the measured
   JointVelocity previous{};  ///< what the last cycle streamed (deg/s)
   bool firmware = false;     ///< HOME / RETRACT: the arm drives itself (hardware speed bounds)
@@ -69,9 +87,12 @@ struct MonitorCost {
 
 /// @brief Checks the next cycle as the file comment says. @return the first violation found.
 /// @pre limits.geometry set; period > 0.
-[[nodiscard]] Result<void, SafetyViolation> check_cycle(const SafetyLimits& limits,
-                                                        const CycleIntent& intent,
-                                                        MonitorCost* cost = nullptr) noexcept;
+/// A firmware cycle (intent.firmware) inside a valid @p proof (its joints within the proof's box by
+/// half a degree, the same held object, the fingers no wider) needs no sweep: the rates are
+/// checked.
+[[nodiscard]] Result<void, SafetyViolation> check_cycle(
+    const SafetyLimits& limits, const CycleIntent& intent, MonitorCost* cost = nullptr,
+    const FirmwareProof* proof = nullptr) noexcept;
 
 /// @brief Checks a straight joint-space move from @p from to @p to (the path a streamed move
 /// follows) with the fingers at @p finger_open and @p held: finite values, the target inside the
@@ -80,6 +101,15 @@ struct MonitorCost {
 /// check_cycle is what guards every cycle of it. @pre none.
 [[nodiscard]] Result<void, SafetyViolation> check_joint_move(
     const SafetyLimits& limits, const JointAngles& from, const JointAngles& to,
+    double finger_open = 0.0, const HeldCapsule& held = {}, MonitorCost* cost = nullptr) noexcept;
+
+/// @brief Checks the firmware's own motion (HOME, RETRACT) from @p from to @p goal before it
+/// starts: each joint is taken to move monotonically toward its goal (docs/SAFETY.md), so the whole
+/// box of joint ranges between the two must be clear, swept as check_cycle sweeps. Once started,
+/// the firmware runs to its pose even if the link fails (the virtual button stays latched in the
+/// arm), so the host starts it only when all of it is proven clear. @pre none.
+[[nodiscard]] Result<FirmwareProof, SafetyViolation> prove_firmware_motion(
+    const SafetyLimits& limits, const JointAngles& from, const JointAngles& goal,
     double finger_open = 0.0, const HeldCapsule& held = {}, MonitorCost* cost = nullptr) noexcept;
 
 /// @brief Distance in degrees joint @p j travels braking from @p speed at @p decel. @pre decel > 0.

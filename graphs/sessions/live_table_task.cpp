@@ -111,6 +111,12 @@ void LiveTableTask::answer(std::uint64_t client, std::uint64_t request, TaskAnsw
   publish(now_ns);
 }
 
+void LiveTableTask::halted(const std::string& why, std::int64_t now_ns) {
+  if (!running()) return;
+  runner_->request_stop(now_ns, "halted: " + why, ports_.submit);
+  answer(client_, request_, TaskAnswer::STOPPING, "halted: " + why, now_ns);
+}
+
 void LiveTableTask::tick(std::int64_t now_ns) {
   const jaco::ArmSnapshot arm = ports_.snapshot();
   manipulation::HeldObject held;

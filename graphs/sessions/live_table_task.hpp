@@ -10,7 +10,8 @@
 /// The caller owns the arm, the clock and the transport: it hands in every object list
 /// (on_objects) and command (command, invalid) and calls tick() once per arm cycle (10 ms).
 /// Everything runs on that one thread. The arm moves only by the runner's checked jobs; a stop
-/// (command, signal) makes the running job back away, as any abort does.
+/// command makes the running job back away, as any abort does; a halt (a signal, a stop request:
+/// the arm latched) ends the task where the arm stands.
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -62,6 +63,9 @@ class LiveTableTask {
   TaskAnswer command(const RemoteTaskCommand& command, std::int64_t now_ns);
   /// @brief A command that failed validation: answered INVALID with its reason.
   void invalid(const TaskCommandProblem& problem, std::int64_t now_ns);
+  /// @brief The arm was halted and latched (a signal, a stop request): the task ends where it is.
+  /// The arm refuses motion while latched, so nothing backs away; @p why goes into the report.
+  void halted(const std::string& why, std::int64_t now_ns);
   /// @brief One arm cycle at @p now_ns (the clock of the object lists' host stamps).
   void tick(std::int64_t now_ns);
 

@@ -1,15 +1,24 @@
-"""`orthoflow arm list|info|state|home|retract|move|fingers|stop --sim`: the JACO driver's commands on
-the simulated arm (no USB on this machine; it runs in real time), their refusals and the e-stop."""
+"""`orthoflow arm list|info|state|home|retract|move|fingers|stop|reset|limits --sim`: the JACO
+driver's commands on the simulated arm (no USB on this machine; it runs in real time), their
+refusals, the limits file, and the stop that every signal and a second process reach, latched
+until `arm reset` (docs/SAFETY.md)."""
 import json
+import os
 import signal
 import subprocess
 import sys
+import tempfile
 import time
 
 from cli_check import expect, run
 
 cli = sys.argv[1]
 EXIT_USAGE = 106
+EXIT_BAD_INPUT = 2
+EXIT_UNREACHABLE = 31
+# The arm's holder lock and latch live here for this test alone (drivers/jaco/arm_state_dir.hpp).
+state_dir = tempfile.mkdtemp(prefix="orthoflow_arm_cli_")
+os.environ["ORTHOFLOW_ARM_STATE_DIR"] = state_dir
 
 arms = json.loads(run(cli, "arm", "list", "--sim", "--json").stdout)
 expect(len(arms) == 1, f"list: {arms}")
@@ -68,22 +77,76 @@ f = json.loads(run(cli, "arm", "fingers", "--sim", "close", "--json").stdout)
 expect(all(v > 6000 for v in f["fingers"]), f"fingers: {f}")
 p = run(cli, "arm", "fingers", "--sim", "9000,0,0", code=EXIT_USAGE)
 expect("finger 1 target 9000.00" in p.stderr, f"fingers limit: {p.stderr}")
-expect("stopped" in run(cli, "arm", "stop", "--sim").stdout, "stop")
 
-# An arm that never initialises: HOME gives up after --timeout, with the button released.
+# A stop with no holder opens the arm itself, halts it and latches; motion is refused until reset.
+p = run(cli, "arm", "stop", "--sim")
+expect("no process held the arm" in p.stdout and "latched" in p.stdout, f"stop: {p.stdout}")
+p = run(cli, "arm", "move", "--sim", "--joints", ",".join(map(str, target)), code=1)
+expect("latched" in p.stderr and "orthoflow arm reset" in p.stderr, f"latched: {p.stderr}")
+expect("cleared" in run(cli, "arm", "reset", "--sim").stdout, "reset")
+expect("no stop is latched" in run(cli, "arm", "reset", "--sim").stdout, "reset twice")
+
+# An arm that never initialises: HOME gives up after --timeout, with the button released; fingers
+# are refused at once (a NOINIT arm ignores them).
 p = run(cli, "arm", "home", "--sim", "--sim-start", "noinit", "--sim-never-init", "--timeout", "1",
         code=1)
 expect("timed out" in p.stderr, f"never init: {p.stderr}")
+t0 = time.monotonic()
+p = run(cli, "arm", "fingers", "--sim", "--sim-start", "noinit", "close", code=1)
+expect("invalid_state" in p.stderr and time.monotonic() - t0 < 5, f"fingers in noinit: {p.stderr}")
 
-# Ctrl-C during a move pulls the emergency stop.
-far = list(home)
-far[0] += 60
-proc = subprocess.Popen([cli, "arm", "move", "--sim", "--joints", ",".join(map(str, far))],
-                        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-time.sleep(0.8)
-proc.send_signal(signal.SIGINT)
+# The user's report: a 5 mm plate across a 90 degree base turn is refused, and nothing moves.
+p = run(cli, "arm", "move", "--sim", "--joints", "185,167.5,57.5,240,82.5,75",
+        "--keep-out", "0.2,-0.025,0.4,0.5,-0.020,0.6,plate", code=EXIT_USAGE)
+expect("keep-out box 'plate'" in p.stderr, f"plate: {p.stderr}")
+p = run(cli, "arm", "move", "--sim", "--joints", "185,167.5,57.5,240,82.5,75",
+        "--keep-out", "0.5,-0.020,0.6,0.2,-0.025,0.4,plate", code=EXIT_USAGE)
+expect("inverted" in p.stderr, f"inverted box: {p.stderr}")
+
+# The limits: the defaults keep the table and the base out; a file that widens the hardware's
+# range is refused naming the key.
+limits = run(cli, "arm", "limits", "--sim", "--json").stdout
+names = [b["name"] for b in json.loads(limits)["keep_out"]]
+expect(names == ["table", "base"], f"limits: {limits}")
+wide = os.path.join(state_dir, "wide.yaml")
+with open(wide, "w") as f:
+    f.write("speed_deg_s: 90\n")
+p = run(cli, "arm", "move", "--sim", "--limits", wide, "--joints", ",".join(map(str, target)),
+        code=EXIT_BAD_INPUT)
+expect("speed_deg_s" in p.stderr, f"wide limits: {p.stderr}")
+
+
+def moving_arm():
+    """A long move on the simulated arm, in the background, holding the arm."""
+    far = list(home)
+    far[0] += 80
+    proc = subprocess.Popen([cli, "arm", "move", "--sim", "--speed", "0.5", "--joints",
+                             ",".join(map(str, far))],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(0.8)
+    return proc
+
+
+# Every signal to the holder halts the arm in place (no retreat) and latches the stop.
+for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP, signal.SIGQUIT):
+    proc = moving_arm()
+    proc.send_signal(sig)
+    out, errs = proc.communicate(timeout=10)
+    expect(proc.returncode == 1 and f"stopped ({sig.name})" in errs and "latched" in errs,
+           f"{sig.name}: {proc.returncode} {errs}")
+    expect(sig.name in run(cli, "arm", "reset", "--sim").stdout, f"reset after {sig.name}")
+
+# A second process: `arm stop` reaches the holder (no RouDi here: by SIGTERM), says the arm was
+# moving; a second holder is refused, naming the first.
+proc = moving_arm()
+p = run(cli, "arm", "move", "--sim", "--joints", ",".join(map(str, target)), code=1)
+expect("not free" in p.stderr and "held by pid" in p.stderr, f"two holders: {p.stderr}")
+p = run(cli, "arm", "stop", "--sim", "--json")
+stop = json.loads(p.stdout)
+expect(stop["stopped"] and stop["was_moving"] and stop["holder_pid"] == proc.pid, f"stop: {stop}")
 out, errs = proc.communicate(timeout=10)
-expect(proc.returncode == 1 and "emergency stop" in errs, f"SIGINT: {proc.returncode} {errs}")
+expect(proc.returncode == 1 and "latched" in errs, f"stopped holder: {errs}")
+run(cli, "arm", "reset", "--sim")
 
 # No arm on this machine's USB: a clear message.
 p = run(cli, "arm", "info", code=None)

@@ -86,6 +86,9 @@ std::string enter_private_mounts() {
   if (!keep_visible(ORTHOFLOW_SOURCE_DIR) || !keep_visible(ORTHOFLOW_BINARY_DIR)) {
     return setup_error("bind the source and build directories back under /tmp");
   }
+  // The arm's holder lock and latched stop (drivers/jaco/arm_state_dir.hpp): fresh for each
+  // scenario, as its RouDi is.
+  ::setenv("ORTHOFLOW_ARM_STATE_DIR", "/tmp/arm_state", 1);
   return {};
 }
 

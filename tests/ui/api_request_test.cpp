@@ -234,6 +234,11 @@ TEST(ApiRequest, BadTaskCommandsAre400WithTheReason) {
   EXPECT_EQ(status_of(decode("GET", "/api/task/start")), 405);
   EXPECT_EQ(status_of(decode("POST", "/api/task/stop", "{}", "", {})), 415);
   EXPECT_EQ(status_of(decode("POST", "/api/task")), 404);
+  auto arm_stop = decode("POST", "/api/arm/stop", "{}");
+  ASSERT_TRUE(arm_stop);
+  EXPECT_EQ(arm_stop->kind, Kind::ARM_STOP);
+  EXPECT_EQ(reason("/api/arm/stop", R"({"reason": "x"})"), "400 unknown field 'reason'");
+  EXPECT_EQ(status_of(decode("GET", "/api/arm/stop")), 405);
 }
 
 }  // namespace

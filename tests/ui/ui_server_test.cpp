@@ -319,11 +319,41 @@ class RecordingTaskLink : public TaskLink {
     sent.push_back(command);
     return reply;
   }
+  ArmStopReply stop_arm(int /*timeout_ms*/) override {
+    std::lock_guard<std::mutex> guard(lock_);
+    ++stops;
+    return stop_reply;
+  }
   mutable std::mutex lock_;
   std::optional<TaskView> shown;
   TaskReply reply;
   std::vector<graphs::TaskCommand> sent;
+  ArmStopReply stop_reply;
+  int stops = 0;
 };
+
+// POST /api/arm/stop (the stop button): 503 without a link or a holder, 504 when the holder does
+// not confirm, 200 with what the holder said; extra fields refused before anything is sent.
+TEST_F(UiServerTest, ArmStopReachesTheHolderAndSaysWhatItStopped) {
+  start();
+  EXPECT_EQ(post_json(port_, "/api/arm/stop", "{}").status, 503);
+  RecordingTaskLink link;
+  backend_.set_task_link(&link);
+  link.stop_reply.status = ArmStopReply::Status::NO_HOLDER;
+  EXPECT_EQ(post_json(port_, "/api/arm/stop", "{}").status, 503);
+  link.stop_reply.status = ArmStopReply::Status::TIMEOUT;
+  EXPECT_EQ(post_json(port_, "/api/arm/stop", "{}").status, 504);
+  link.stop_reply = {ArmStopReply::Status::STOPPED, true, 4242, "orthoflow task run", 3.5};
+  const auto stopped = post_json(port_, "/api/arm/stop", "{}");
+  ASSERT_EQ(stopped.status, 200) << stopped.body;
+  const auto doc = nlohmann::json::parse(stopped.body);
+  EXPECT_EQ(doc["was_moving"], true);
+  EXPECT_EQ(doc["holder_pid"], 4242);
+  EXPECT_EQ(doc["latched"], true);
+  EXPECT_EQ(post_json(port_, "/api/arm/stop", R"({"now": 1})").status, 400);
+  EXPECT_EQ(link.stops, 3);
+  backend_.set_task_link(nullptr);
+}
 
 // POST /api/task/start and /api/task/stop: without a task link 503; with one, the task process's
 // answer (started / stopping 200, refused 409, invalid 400), no task process 503, no answer 504;

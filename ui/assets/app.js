@@ -209,6 +209,15 @@ async function task(which) {
   $('task-answer').className = answer.ok ? 'good' : 'bad';
 }
 
+// The arm's stop button (POST /api/arm/stop): the process holding the arm halts it and latches.
+$('arm-stop').addEventListener('click', async () => {
+  const answer = await postJson('/api/arm/stop', {}, 'arm-stop-answer', 'stopping the arm');
+  if (answer === null) return;
+  $('arm-stop-answer').textContent = answer.error ? `arm stop: ${answer.error}`
+    : `arm halted (${answer.was_moving ? 'was moving' : 'was still'}); latched until orthoflow arm reset`;
+  $('arm-stop-answer').className = answer.ok ? 'good' : 'bad';
+});
+
 for (const button of document.querySelectorAll('#task button')) {
   button.addEventListener('click', () => task(button.dataset.task));
 }

@@ -17,13 +17,13 @@
 //    SEND_BASIC_TRAJECTORY leaving on the wire (the OUT transfer's start; it reaches the arm 1 ms
 //    later), over every 1 ms submit phase between one cycle's end and the next cycle's start, after
 //    0..9 idle cycles (every slow-read slot). Deterministic. BM_Submit: CPU of submit() itself:
-//    MOVE_JOINTS (32 FK samples of the path), MOVE_POSE near (IK from the seed, then the path) and
+//    MOVE_JOINTS (the swept path check), MOVE_POSE near (IK from the seed, then the path) and
 //    far (a base turn of 120 degrees: the IK's 12 restarts run).
 // 3. BM_StateStreamJitter: the threaded JacoArm with pace_to_wall_clock on a SimJacoTransport for
 //    2 s of wall time, streaming moves, a subscriber stamping every snapshot with steady_clock:
 //    mean period and p50 / p99 / max |period - 10 ms|. Wall clock, one iteration.
 // 4. BM_ForwardKinematics, BM_FkToPose, BM_InverseKinematics (near, far, unreachable),
-//    BM_CheckJointMove (the 32-sample path check submit() runs).
+//    BM_CheckJointMove (the swept path check submit() runs).
 #include <benchmark/benchmark.h>
 #include <time.h>
 
