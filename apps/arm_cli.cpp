@@ -13,6 +13,7 @@
 #include "apps/arm_cli.hpp"
 #include "drivers/usb/libusb_transport.hpp"
 #include "engine/ipc_runtime.hpp"
+#include "manipulation/robot_frames.hpp"
 #include "simulation/devices/sim_jaco_transport.hpp"
 
 namespace orthoflow::apps::arm_cli {
@@ -125,8 +126,14 @@ manipulation::ArmLimitsFile load_limits(const ArmArgs& a) {
     if (!limits.add_keep_out(b))
       fail("at most " + std::to_string(jaco::MAX_KEEP_OUT) + " keep-out boxes", EXIT_USAGE);
   }
-  if (a.base_from_camera) {
-    if (auto placed = manipulation::place_camera_keep_out(file, *a.base_from_camera); !placed)
+  std::optional<Eigen::Isometry3d> camera = a.base_from_camera;
+  if (!camera && !a.frames.empty()) {
+    const auto frames = manipulation::load_robot_frames(a.frames);
+    if (!frames) fail(frames.error(), EXIT_BAD_INPUT);
+    camera = frames->base_from_camera;
+  }
+  if (camera) {
+    if (auto placed = manipulation::place_camera_keep_out(file, *camera); !placed)
       fail(placed.error(), EXIT_USAGE);
   }
   return file;
@@ -152,6 +159,9 @@ HeldArm start_arm(const ArmArgs& a, std::vector<jaco::StateCallback> subscribers
   }
   HeldArm held;
   held.arm = std::move(arm).value();
+  if (a.motion && !limits.camera_removed && limits.limits.find_keep_out("camera") == nullptr)
+    std::cerr << "orthoflow arm: warning: no camera keep-out: give --frames ROBOT_FRAMES to place "
+                 "it, or say `remove: [camera]` in the limits file (docs/SAFETY.md)\n";
   if (a.motion && !held->realtime_guard())
     std::cerr << "orthoflow arm: note: the guard thread runs without SCHED_FIFO (it needs "
                  "CAP_SYS_NICE or an rtprio limit, docs/SAFETY.md); it still runs every 2 ms\n";

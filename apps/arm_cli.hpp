@@ -40,7 +40,7 @@ struct ArmArgs {
   std::string workspace;               ///< x0,y0,z0,x1,y1,z1
   std::string limits;                  ///< --limits FILE (default: DEFAULT_LIMITS_PATH if present)
   std::string state_dir;               ///< --state-dir (default: ArmStateDir::default_path)
-  std::string frames;                  ///< arm limits --frames: place the camera's keep-out
+  std::string frames;                  ///< --frames: place the camera's keep-out
   std::string what = "orthoflow arm";  ///< what the holder file says this process is
   /// The camera's pose in the base frame, when the command knows it (task run): its keep-out.
   std::optional<Eigen::Isometry3d> base_from_camera;

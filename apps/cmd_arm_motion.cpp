@@ -162,6 +162,7 @@ void add_motion_options(CLI::App* sub, const std::shared_ptr<ArmArgs>& a) {
                   "a box the hand must not enter: x0,y0,z0,x1,y1,z1[,name] (m, base frame; "
                   "repeatable)");
   sub->add_option("--workspace", a->workspace, "the box the hand must stay in: x0,y0,z0,x1,y1,z1");
+  sub->add_option("--frames", a->frames, "robot frames file: places the camera's keep-out");
 }
 
 }  // namespace

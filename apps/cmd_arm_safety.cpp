@@ -15,7 +15,6 @@
 
 #include "apps/arm_cli.hpp"
 #include "engine/ipc_runtime.hpp"
-#include "manipulation/robot_frames.hpp"
 
 namespace orthoflow::apps::arm_cli {
 namespace {
@@ -134,12 +133,7 @@ void run_reset(ArmArgs a) {
             << "); the arm may move again\n";
 }
 
-void run_limits(ArmArgs a) {
-  if (!a.frames.empty()) {
-    const auto frames = manipulation::load_robot_frames(a.frames);
-    if (!frames) fail(frames.error(), EXIT_BAD_INPUT);
-    a.base_from_camera = frames->base_from_camera;
-  }
+void run_limits(const ArmArgs& a) {
   const manipulation::ArmLimitsFile file = load_limits(a);
   if (!a.json) {
     std::cout << manipulation::describe_limits(file);

@@ -115,6 +115,17 @@ p = run(cli, "arm", "move", "--sim", "--limits", wide, "--joints", ",".join(map(
         code=EXIT_BAD_INPUT)
 expect("speed_deg_s" in p.stderr, f"wide limits: {p.stderr}")
 
+# The camera's keep-out: a motion command without robot frames says it has none; with them, it is
+# placed (and `arm limits --frames` lists it).
+p = run(cli, "arm", "move", "--sim", "--joints", ",".join(map(str, home)))
+expect("no camera keep-out" in p.stderr, f"camera warning: {p.stderr}")
+frames = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "config",
+                      "robot_frames_synthetic.yaml")
+p = run(cli, "arm", "move", "--sim", "--frames", frames, "--joints", ",".join(map(str, home)))
+expect("no camera keep-out" not in p.stderr, f"camera placed: {p.stderr}")
+placed = json.loads(run(cli, "arm", "limits", "--sim", "--json", "--frames", frames).stdout)
+expect("camera" in [b["name"] for b in placed["keep_out"]], f"limits --frames: {placed}")
+
 
 def moving_arm():
     """A long move on the simulated arm, in the background, holding the arm."""
