@@ -132,6 +132,26 @@ Result<void, Violation> sweep(const SafetyLimits& limits, const Stretch& whole, 
   return {};
 }
 
+bool finite_held(const HeldCapsule& h) noexcept {
+  return h.a.allFinite() && h.b.allFinite() && std::isfinite(h.radius_m);
+}
+bool same_held(const HeldCapsule& a, const HeldCapsule& b) noexcept {
+  return a.a == b.a && a.b == b.b && a.radius_m == b.radius_m;
+}
+
+// A firmware cycle within what its proof showed clear: the joints inside the proven box (half a
+// degree for a reading's noise), the same held object, the fingers no wider.
+bool inside_proof(const FirmwareProof* proof, const CycleIntent& in) noexcept {
+  if (proof == nullptr || !proof->valid || !same_held(proof->held, in.held) ||
+      in.finger_open > proof->finger_open + 1e-9)
+    return false;
+  constexpr double SLACK_DEG = 0.5;
+  for (std::size_t j = 0; j < JOINTS; ++j)
+    if (in.joints[j] < proof->lo[j] - SLACK_DEG || in.joints[j] > proof->hi[j] + SLACK_DEG)
+      return false;
+  return true;
+}
+
 bool finite(const JointVelocity& values) noexcept {
   return std::all_of(values.begin(), values.end(), [](double x) { return std::isfinite(x); });
 }
@@ -161,64 +181,6 @@ Result<void, Violation> check_rates(const SafetyLimits& limits, const CycleInten
 
 }  // namespace
 
-JointRange envelope_range(const SafetyLimits& limits, const CycleIntent& in,
-                          std::size_t j) noexcept {
-  // The model: the measured velocity for the latency; then, for a period, the command (reached at
-  // once when it speeds the joint up, reached by braking at brake_decel when it slows or reverses
-  // it, a reversal then jumping to the new direction); then braking to rest. The real arm brakes at
-  // least as hard and speeds up no faster than at once, so it stays between these extremes; an
-  // earlier reaction than the latency assumed adds at most the velocity change times the latency.
-  const double latency = static_cast<double>(limits.command_latency_ns) * 1e-9;
-  const double d = limits.brake_decel_deg_s2;
-  const double v0 = in.velocity[j], vc = in.command[j];
-  if (in.firmware) {
-    // The firmware drives the joint toward its goal (speeding up to the hardware's speed at most
-    // for the latency and a period, then braking) and settles on it within a degree: the braking
-    // that would carry it past the goal is cut there. A joint moving away from its goal brakes.
-    const double q0 = in.joints[j], goal = in.firmware_goal[j];
-    const double dir = goal > q0 ? 1.0 : -1.0;
-    const double toward = std::max(0.0, dir * v0);
-    const double run = std::max(toward, HARDWARE_SPEED_DEG_S[j]);
-    const double far =
-        std::min(run * (latency + PERIOD_S) + run * run / (2.0 * d), std::abs(goal - q0) + 1.0);
-    const double away = std::max(0.0, -dir * v0);
-    const double back = away * (latency + PERIOD_S) + away * away / (2.0 * d) + 1.0;
-    return {std::min(q0 + dir * far, q0 - dir * back), std::max(q0 + dir * far, q0 - dir * back)};
-  }
-  double q = in.joints[j] + v0 * latency;
-  JointRange range{std::min(in.joints[j], q), std::max(in.joints[j], q)};
-  const auto reach = [&](double x) {
-    range.lo = std::min(range.lo, x);
-    range.hi = std::max(range.hi, x);
-  };
-  double v = v0;
-  double left = PERIOD_S;
-  if (v * vc < 0.0 || std::abs(vc) < std::abs(v)) {  // slow down toward the command (or to 0)
-    const double target = v * vc < 0.0 ? 0.0 : vc;
-    const double t = std::min(left, std::abs(v - target) / d);
-    q += v * t - std::copysign(0.5 * d * t * t, v);
-    v = t < left ? v - std::copysign(d * t, v) : target;
-    left -= t;
-    reach(q);
-  }
-  if (left > 0.0 && (v == 0.0 || v * vc > 0.0)) v = vc;  // speeding up: at once
-  q += v * left;
-  reach(q);
-  q += std::copysign(v * v / (2.0 * d), v);  // then braking to rest
-  reach(q);
-  const double early = std::abs(vc - v0) * latency;
-  return {range.lo - early, range.hi + early};
-}
-
-namespace {
-bool finite_held(const HeldCapsule& h) noexcept {
-  return h.a.allFinite() && h.b.allFinite() && std::isfinite(h.radius_m);
-}
-bool same_held(const HeldCapsule& a, const HeldCapsule& b) noexcept {
-  return a.a == b.a && a.b == b.b && a.radius_m == b.radius_m;
-}
-}  // namespace
-
 Result<void, SafetyViolation> check_cycle(const SafetyLimits& limits, const CycleIntent& intent,
                                           MonitorCost* cost, const FirmwareProof* proof) noexcept {
   CycleIntent in = intent;
@@ -227,17 +189,9 @@ Result<void, SafetyViolation> check_cycle(const SafetyLimits& limits, const Cycl
       !finite(in.span_velocity) || !std::isfinite(in.finger_open) || !finite_held(in.held))
     return joint_violation(Violation::Limit::NOT_FINITE, 0, 0.0, 0.0);
   if (auto rates = check_rates(limits, in); !rates) return rates;
-  if (in.firmware && proof != nullptr && proof->valid && same_held(proof->held, in.held) &&
-      in.finger_open <= proof->finger_open + 1e-9) {
-    constexpr double SLACK_DEG = 0.5;  // a reading's noise
-    bool inside = true;
-    for (std::size_t j = 0; j < JOINTS; ++j)
-      inside = inside && in.joints[j] >= proof->lo[j] - SLACK_DEG &&
-               in.joints[j] <= proof->hi[j] + SLACK_DEG;
-    if (inside) {
-      if (cost != nullptr) cost->nodes = 0;
-      return {};
-    }
+  if (in.firmware && inside_proof(proof, in)) {
+    if (cost != nullptr) cost->nodes = 0;
+    return {};
   }
   Stretch box;
   double longest = 0.0;
