@@ -8,8 +8,10 @@
 #include <gtest/gtest.h>
 
 #include <csignal>
+#include <cstdio>
 #include <cstdlib>
 #include <string>
+#include <thread>
 
 #include "bridge/bridge_config.hpp"
 #include "tests/ipc/roudi_sandbox.hpp"
@@ -21,6 +23,7 @@ using namespace std::chrono_literals;
 
 constexpr const char* DOMAIN_ID = "211";  // no other test uses it
 const std::string SUBSCRIBER = ORTHOFLOW_BINARY_DIR "/tests/bridge/dds_plain_subscriber";
+const std::string ARM_STOPPER = ORTHOFLOW_BINARY_DIR "/tests/bridge/dds_plain_arm_stop";
 
 ProcResult plain(Sandbox& box, const std::string& name, std::vector<std::string> args) {
   std::vector<std::string> argv{SUBSCRIBER, "--domain", DOMAIN_ID};
@@ -98,6 +101,66 @@ TEST(DdsBridge, ObjectsFramesAndLessonsCrossToAPlainDdsNodeAndBack) {
         (void)box.wait(run, 60s);
       },
       300s);
+  if (outcome.skipped) GTEST_SKIP() << outcome.reason;
+  EXPECT_EQ(outcome.failures, "");
+}
+
+// The arm's stop from DDS (docs/SAFETY.md section 4): a plain DDS node (plain_arm_stop.c) writes
+// an ArmStop; with no process holding an arm, the bridge answers at once that none listens; with
+// `orthoflow arm move --sim` holding a moving arm, the bridge passes the stop over iceoryx, the
+// holder halts the arm in place and latches the stop, and the ArmStopAck says so, with the holder
+// and the time from the request to the halt.
+TEST(DdsBridge, AStopFromAPlainDdsNodeHaltsTheArmsHolderAndIsLatched) {
+  const Outcome outcome = run_isolated(
+      [](Sandbox& box) {
+        if (box.start_roudi() < 0) return;
+        const std::string xml = bridge::cyclone_xml(bridge::BridgeConfig{});
+        ::setenv("CYCLONEDDS_URI", xml.c_str(), 1);
+        const pid_t bridge = box.spawn_orthoflow(
+            "bridge", {"bridge", "dds", "--domain", DOMAIN_ID, "--seconds", "120"});
+        box.check(box.wait_for_output(bridge, "rt/orthoflow/tabletop/objects", 30s),
+                  "the bridge names its topics");
+        const auto stop = [&](const std::string& name, const std::string& reason) {
+          return box.wait(box.spawn_program(name, {ARM_STOPPER, "--domain", DOMAIN_ID, "--reason",
+                                                   reason, "--seconds", "20"}),
+                          30s);
+        };
+        const ProcResult nobody = stop("nobody", "nobody home");
+        box.check(nobody.exit_code == 0 && has(nobody, "stopped 0") &&
+                      has(nobody, "no process holding an arm listens for stops"),
+                  "with no holder the bridge says so at once", nobody);
+
+        const pid_t move = box.spawn_orthoflow("move", {"arm", "move", "--sim", "--speed", "0.3",
+                                                        "--joints", "355,167.5,57.5,240,82.5,75"});
+        std::this_thread::sleep_for(1500ms);
+        const ProcResult stopped = stop("stop", "dds test");
+        box.check(stopped.exit_code == 0 && has(stopped, "stopped 1 was_moving 1") &&
+                      has(stopped, "holder_pid " + std::to_string(move) + " ") &&
+                      has(stopped, "holder 'orthoflow arm move'"),
+                  "the holder halted the moving arm and said so over DDS", stopped);
+        double halt_ms = 1e9, round_trip_ms = 1e9;
+        const std::size_t at = stopped.out.find("request_to_halt_ms");
+        if (at != std::string::npos)
+          (void)std::sscanf(stopped.out.c_str() + at, "request_to_halt_ms %lf round_trip_ms %lf",
+                            &halt_ms, &round_trip_ms);
+        box.check(halt_ms < 100.0, "halted within 100 ms of the bridge's request", stopped);
+        std::printf("DDS stop: request to halt %.3f ms, DDS round trip %.3f ms\n", halt_ms,
+                    round_trip_ms);
+        const ProcResult m = box.wait(move, 20s);
+        box.check(m.exit_code == 1 && m.err.find("dds test") != std::string::npos &&
+                      m.err.find("latched") != std::string::npos,
+                  "the move ends: stopped from DDS, latched", m);
+        const ProcResult again = box.wait(
+            box.spawn_orthoflow("again",
+                                {"arm", "move", "--sim", "--joints", "280,167.5,57.5,240,82.5,75"}),
+            20s);
+        box.check(again.exit_code == 1 && again.err.find("latched") != std::string::npos,
+                  "the next holder refuses to move while latched", again);
+        ::kill(bridge, SIGTERM);
+        const ProcResult b = box.wait(bridge, 30s);
+        box.check(b.exit_code == 0, "the bridge stops on SIGTERM", b);
+      },
+      120s);
   if (outcome.skipped) GTEST_SKIP() << outcome.reason;
   EXPECT_EQ(outcome.failures, "");
 }
