@@ -11,8 +11,9 @@
 // 2 a stop request over iceoryx (graphs/services/arm_stop_service.hpp, the path of `orthoflow arm
 // stop`, the stop button and the DDS stop topic; needs a running RouDi, else skipped with a
 // message), 3 the watchdog (the client stops feeding it: the time counted from the last feed, so
-// the 100 ms timeout is in it). BM_MonitorCheck: the monitor's CPU per control cycle (check_cycle)
-// on a velocity stream near a keep-out and on the firmware's HOME from RETRACT.
+// the 100 ms timeout is in it), 4 SIGINT and 5 SIGHUP (the same handler as SIGTERM).
+// BM_MonitorCheck: the monitor's CPU per control cycle (check_cycle) on a velocity stream near a
+// keep-out and on the firmware's HOME from RETRACT.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -133,12 +134,13 @@ double erase_after(const Arm& a, std::int64_t since) {
 
 void BM_StopLatency(benchmark::State& state) {
   const int path = static_cast<int>(state.range(0));
-  const char* names[] = {"estop() call", "SIGTERM", "iceoryx stop request", "watchdog"};
+  const char* names[] = {"estop() call", "SIGTERM", "iceoryx stop request",
+                         "watchdog",     "SIGINT",  "SIGHUP"};
   state.SetLabel(names[path]);
   std::unique_ptr<orthoflow::graphs::ArmStopListener> listener;
   Arm a = start_arm();
   if (!a.arm) return state.SkipWithError("the simulated arm did not start");
-  if (path == 1) jaco::install_stop_signals();
+  if (path == 1 || path >= 4) jaco::install_stop_signals();
   if (path == 2) {
     if (!orthoflow::engine::probe_roudi())
       return state.SkipWithError("no RouDi running: start `iox-roudi -c config/roudi_test.toml`");
@@ -166,6 +168,12 @@ void BM_StopLatency(benchmark::State& state) {
           break;
         case 2:
           (void)orthoflow::graphs::request_arm_stop("bench", std::chrono::milliseconds(500));
+          break;
+        case 4:
+          std::raise(SIGINT);
+          break;
+        case 5:
+          std::raise(SIGHUP);
           break;
         default:
           since = steady_ns();  // the last feed was the last submit, just now
@@ -253,7 +261,7 @@ void BM_StoppingDistance(benchmark::State& state) {
 
 BENCHMARK(BM_StoppingDistance)->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_StopLatency)
-    ->DenseRange(0, 3)
+    ->DenseRange(0, 5)
     ->ArgName("path")
     ->Iterations(1)
     ->Unit(benchmark::kMillisecond)
