@@ -156,10 +156,9 @@ Result<void, JacoError> JacoController::validate(const ArmCommand& command, cons
     }
     case Kind::VELOCITY: {
       if (!homed) return error_of(JacoError::Code::INVALID_STATE);
-      auto ok = check_joint_velocity(limits, command.velocity, now.commanded, 0.01);
-      if (!ok) return refused(ok.error());
-      // An early refusal of what the first periods would do; the monitor checks every cycle of
-      // the stream as it runs.
+      // An early refusal of what the first period would do, by the monitor's own rules (finite,
+      // the speed cap, speeding up held to the acceleration cap, slowing down always allowed);
+      // the monitor checks every cycle of the stream as it runs.
       CycleIntent intent;
       intent.joints = now.joints;
       intent.velocity = now.velocity;

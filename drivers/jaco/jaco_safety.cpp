@@ -126,24 +126,6 @@ std::string describe(const SafetyViolation& v) {
   return std::string("safety: ") + to_string(v.limit) + ": " + text;
 }
 
-Result<void, SafetyViolation> check_joint_velocity(const SafetyLimits& limits,
-                                                   const std::array<double, JOINTS>& velocity,
-                                                   const std::array<double, JOINTS>& previous,
-                                                   double dt_s) noexcept {
-  for (std::size_t j = 0; j < JOINTS; ++j) {
-    if (!std::isfinite(velocity[j])) return violation(Violation::Limit::NOT_FINITE, j, 0.0, 0.0);
-    if (std::abs(velocity[j]) > limits.max_joint_speed_deg_s) {
-      return violation(Violation::Limit::SPEED, j, std::abs(velocity[j]),
-                       limits.max_joint_speed_deg_s);
-    }
-    const double accel = std::abs(velocity[j] - previous[j]) / dt_s;
-    if (accel > limits.max_joint_accel_deg_s2 * (1.0 + 1e-9)) {
-      return violation(Violation::Limit::ACCELERATION, j, accel, limits.max_joint_accel_deg_s2);
-    }
-  }
-  return {};
-}
-
 Result<void, SafetyViolation> check_fingers(const SafetyLimits& limits,
                                             const std::array<double, FINGERS>& fingers) noexcept {
   for (std::size_t f = 0; f < FINGERS; ++f) {

@@ -103,11 +103,6 @@ struct SafetyViolation {
 /// 313.0 deg". @note Allocates (CLI, logs).
 [[nodiscard]] std::string describe(const SafetyViolation& violation);
 
-/// @brief Checks a joint velocity command against the speed cap and, from @p previous over
-/// @p dt_s, the acceleration cap. @pre dt_s > 0.
-[[nodiscard]] Result<void, SafetyViolation> check_joint_velocity(
-    const SafetyLimits& limits, const std::array<double, JOINTS>& velocity,
-    const std::array<double, JOINTS>& previous, double dt_s) noexcept;
 /// @brief Checks finger targets: finite and within [0, max_finger]. @pre none.
 [[nodiscard]] Result<void, SafetyViolation> check_fingers(
     const SafetyLimits& limits, const std::array<double, FINGERS>& fingers) noexcept;

@@ -366,6 +366,27 @@ TEST(JacoControllerSim, ClientStreamedVelocityMovesAndStopsWithTheStream) {
   EXPECT_EQ(rig.controller->snapshot().last_stop, jaco::StopReason::WATCHDOG);
 }
 
+// A stream may always slow down at once (a stop is never refused): the submit's early check
+// follows the monitor's rule, so 10 deg/s -> 1 deg/s in one period is accepted, while speeding up
+// as fast is refused.
+TEST(JacoControllerSim, AStreamMaySlowDownAtOnceButNotSpeedUpAtOnce) {
+  JacoRig rig;
+  ArmCommand v;
+  v.kind = Kind::VELOCITY;
+  for (int i = 1; i <= 30; ++i) {
+    v.velocity = {0.0, 0.0, 0.0, 0.0, 0.0, std::min(10.0, 0.4 * i)};
+    ASSERT_TRUE(rig.controller->submit(v).has_value()) << i;
+    rig.cycle(false);
+  }
+  v.velocity = {0.0, 0.0, 0.0, 0.0, 0.0, 1.0};
+  EXPECT_TRUE(rig.controller->submit(v).has_value());
+  rig.cycle(false);
+  v.velocity = {0.0, 0.0, 0.0, 0.0, 0.0, 10.0};
+  auto fast = rig.controller->submit(v);
+  ASSERT_FALSE(fast.has_value());
+  EXPECT_EQ(fast.error().violation.limit, jaco::SafetyViolation::Limit::ACCELERATION);
+}
+
 TEST(JacoControllerSim, HomesFromNoinitAndRefusesMotionBefore) {
   simulation::SimJacoConfig config;  // power-up: NOINIT
   JacoRig rig(config);
