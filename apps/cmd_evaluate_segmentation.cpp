@@ -58,8 +58,8 @@ void run_evaluate_segmentation(const SegEvalArgs& a) {
     options.progress = progress.get();
   }
   auto report = evaluation::evaluate_segmentation(
-      *frames, "orthoflow", evaluation::make_chain_segmenter(seg->stages, seg->candidates),
-      options);
+      *frames, "orthoflow",
+      evaluation::make_chain_segmenter(seg->stages, seg->candidates, &seg->table.verdict), options);
   if (progress) progress->finish();
   if (!report) fail(report.error().to_string(), EXIT_FAILURE_GENERIC);
   const std::vector<evaluation::SegReport> reports{*report};

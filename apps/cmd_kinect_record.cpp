@@ -66,7 +66,7 @@ void record(const RecordArgs& a) {
 
   std::ofstream index(dir / "INDEX.txt", std::ios::app);
   std::vector<std::uint8_t> rgb(kinect::DEPTH_PIXELS * 3);
-  std::uint64_t depth_records = 0, colour_records = 0;
+  std::uint64_t depth_records = 0, colour_records = 0, tilt_records = 0, tilt_written = 0;
   const auto start = std::chrono::steady_clock::now();
   const auto deadline =
       start + std::chrono::milliseconds(static_cast<std::int64_t>(a.frames) * 67 + 3000);
@@ -77,6 +77,19 @@ void record(const RecordArgs& a) {
       continue;
     }
     const double now = wall_seconds();
+    // The accelerometer, as libfreenect's recorder writes it: an a- record of the raw state before
+    // the frame, whenever the driver read a new one (about every 100 ms).
+    if (const kinect::RawTiltReading t = d.raw_tilt(); t.sequence != tilt_written) {
+      tilt_written = t.sequence;
+      const formats::FakenectTilt tilt{t.accel_counts[0], t.accel_counts[1], t.accel_counts[2],
+                                       t.tilt_raw, t.status_raw};
+      const std::string name =
+          formats::fakenect_name('a', now, static_cast<std::uint32_t>(f->device_ticks));
+      if (auto ok = formats::write_fakenect_tilt(dir / name, tilt); !ok)
+        fail(ok.error().to_string());
+      index << name << '\n';
+      ++tilt_records;
+    }
     if (f->has_colour) {
       kernels::demosaic_grbg(f->bayer, kinect::DEPTH_WIDTH, kinect::DEPTH_HEIGHT, rgb);
       const std::string name =
@@ -95,9 +108,10 @@ void record(const RecordArgs& a) {
   }
   const kinect::CameraHealth h = d.health();
   std::cout << "recorded " << depth_records << " depth and " << colour_records
-            << " colour frames to " << a.dir << " (camera: " << h.frames_degraded << " degraded, "
-            << h.frames_dropped << " dropped, " << h.frames_overwritten
-            << " not taken in time; lost packets " << h.depth.lost_packets << ")\n";
+            << " colour frames and " << tilt_records << " accelerometer records to " << a.dir
+            << " (camera: " << h.frames_degraded << " degraded, " << h.frames_dropped
+            << " dropped, " << h.frames_overwritten << " not taken in time; lost packets "
+            << h.depth.lost_packets << ")\n";
   if (depth_records < a.frames)
     fail("the camera delivered " + std::to_string(depth_records) + " of " +
          std::to_string(a.frames) + " frames in time");

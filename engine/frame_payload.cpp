@@ -1,6 +1,7 @@
 #include "engine/frame_payload.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 
 namespace orthoflow::engine {
@@ -147,12 +148,33 @@ Result<std::size_t, FrameError> write_frame(std::span<std::byte> bytes,
   f.header->frame_id = cloud.info.frame_id;
   f.header->sensor_stamp_ns = cloud.info.sensor_stamp_ns;
   f.header->host_stamp_ns = cloud.info.host_stamp_ns;
+  const auto& up = cloud.info.up;
+  const float norm = std::sqrt(up[0] * up[0] + up[1] * up[1] + up[2] * up[2]);
+  if (std::isfinite(norm) && norm > 0.5F && norm < 1.5F) {
+    for (int k = 0; k < 3; ++k)
+      f.header->up_q[k] = static_cast<std::int16_t>(std::lround(32767.0F * up[k] / norm));
+    f.header->up_age_ms =
+        static_cast<std::uint16_t>(std::min<std::uint32_t>(cloud.info.up_age_ms, 65535));
+  }
   std::ranges::copy(cloud.x(), f.points.x.begin());
   std::ranges::copy(cloud.y(), f.points.y.begin());
   std::ranges::copy(cloud.z(), f.points.z.begin());
   if (!f.rgb.empty()) { std::ranges::copy(cloud.rgb(), f.rgb.begin()); }
   if (!f.label.empty()) { std::ranges::copy(cloud.label(), f.label.begin()); }
   return static_cast<std::size_t>(f.header->payload_bytes);
+}
+
+bool frame_up(const FrameHeader& header, std::array<float, 3>& up) noexcept {
+  std::array<float, 3> v{};
+  float sq = 0.0F;
+  for (int k = 0; k < 3; ++k) {
+    v[k] = static_cast<float>(header.up_q[k]) / 32767.0F;
+    sq += v[k] * v[k];
+  }
+  if (!(sq > 0.81F && sq < 1.21F)) return false;  // none (all zero), or not a unit vector
+  const float norm = std::sqrt(sq);
+  for (int k = 0; k < 3; ++k) up[k] = v[k] / norm;
+  return true;
 }
 
 }  // namespace orthoflow::engine

@@ -7,6 +7,7 @@
 /// Layout: FrameHeader (64 bytes), then x[n], y[n], z[n] (float), then rgb[n] and label[n] (uint32)
 /// when the header's `fields` has the bit, each array starting on a 64-byte boundary; n = width *
 /// height. Every reader validates type id, version and sizes before touching a point.
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -37,8 +38,16 @@ struct alignas(64) FrameHeader {
   std::int64_t host_stamp_ns = 0;
   std::uint64_t payload_bytes =
       0;  ///< header included; equals frame_payload_bytes(width, height, fields)
+  /// "up" in the sensor frame (kernels::FrameInfo::up) as int16 / 32767 per axis; all zero (what
+  /// writers before it left in these bytes) = unknown.
+  std::array<std::int16_t, 3> up_q{};
+  std::uint16_t up_age_ms = 0;  ///< age of the reading behind up_q, saturated at 65535
 };
 static_assert(sizeof(FrameHeader) == 64);
+
+/// @brief The unit "up" vector a frame carries into @p up; false (up untouched) when it carries
+/// none or the stored vector is not close to unit length.
+[[nodiscard]] bool frame_up(const FrameHeader& header, std::array<float, 3>& up) noexcept;
 
 /// @brief Bytes a frame of this shape occupies (header included), or 0 if the shape overflows
 /// (more than 2^28 points). @note constexpr-friendly, no allocation.

@@ -53,7 +53,11 @@ struct alignas(64) ObjectListPayload {
   std::uint16_t version;
   std::uint16_t reserved0;
   std::uint32_t count;  ///< objects[0, count) are valid; <= OBJECT_LIST_CAPACITY
-  std::uint32_t reserved1;
+  /// The frame's table verdict: kernels::TableReason + 1 (1 accepted, 2 held, 3 no_plane,
+  /// 4 not_level, 5 out_of_range, 6 too_small); 0: not reported (reserved before issue 50).
+  std::uint8_t table_reason;
+  std::uint8_t gravity;  ///< graphs::Gravity + 1 (1 none, 2 sensor, 3 configured); 0: not reported
+  std::uint16_t reserved1;
   std::uint64_t frame_id;
   std::int64_t sensor_stamp_ns;
   std::int64_t host_stamp_ns;
@@ -71,6 +75,8 @@ struct alignas(64) ObjectListPayload {
     version = OBJECT_LIST_VERSION;
     reserved0 = 0;
     count = 0;
+    table_reason = 0;
+    gravity = 0;
     reserved1 = 0;
     frame_id = 0;
     sensor_stamp_ns = 0;

@@ -23,9 +23,12 @@ namespace orthoflow::evaluation {
 namespace fs = std::filesystem;
 
 Segmenter make_chain_segmenter(const kernels::SegmentationParams& params,
-                               const kernels::CandidateParams& candidates) {
+                               const kernels::CandidateParams& candidates,
+                               const kernels::TableVerdictParams* verdict) {
   auto chain = std::make_shared<std::optional<kernels::SegmentationChain>>();
   auto capacity = std::make_shared<std::size_t>(0);
+  const std::optional<kernels::TableVerdictParams> judge =
+      verdict ? std::optional(*verdict) : std::nullopt;
   return [=](const kernels::PointCloud& cloud) {
     SegmenterOutput out;
     if (!chain->has_value() || cloud.size() > *capacity) {
@@ -36,6 +39,22 @@ Segmenter make_chain_segmenter(const kernels::SegmentationParams& params,
     if (!seg) {
       out.error = seg.error().to_string();
       return out;
+    }
+    if (judge) {
+      const auto& up = cloud.info.up;
+      const bool has_up = up[0] != 0.0F || up[1] != 0.0F || up[2] != 0.0F;
+      const kernels::TableJudgement j =
+          kernels::judge_table(seg->plane.plane, seg->plane.inliers, seg->plane_sample, seg->hull_u,
+                               seg->hull_v, has_up ? &up : nullptr, *judge);
+      if (j.reason != kernels::TableReason::ACCEPTED) {
+        char why[160];
+        std::snprintf(why, sizeof why,
+                      "table refused: %s (share %.3f, area %.3f m2, height %.3f m)",
+                      std::string(kernels::table_reason_name(j.reason)).c_str(), double(j.share),
+                      double(j.area_m2), double(j.height_m));
+        out.error = why;
+        return out;
+      }
     }
     if (!seg->organized) {
       out.error = "per-point labels need the organized chain (an organized frame, use_organized)";

@@ -18,6 +18,7 @@
 #include "evaluation/segmentation_score.hpp"
 #include "kernels/object_candidates.hpp"
 #include "kernels/point_cloud.hpp"
+#include "kernels/table_verdict.hpp"
 #include "kernels/tabletop_stages.hpp"
 
 namespace orthoflow::evaluation {
@@ -36,8 +37,12 @@ using Segmenter = std::function<SegmenterOutput(const kernels::PointCloud&)>;
 
 /// @brief The product's chain (kernels::SegmentationChain) with these parameters, as a segmenter.
 /// Frames larger than any before resize the chain (off the frame path: this is offline scoring).
+/// @param verdict the table node's verdict (kernels/table_verdict.hpp), or null for none: a frame
+/// whose plane it refuses is a failed frame ("table refused: REASON ..."), as the product would
+/// report no table and no objects. "Up" is the frame's own (FrameInfo::up) when it carries one.
 [[nodiscard]] Segmenter make_chain_segmenter(const kernels::SegmentationParams& params,
-                                             const kernels::CandidateParams& candidates);
+                                             const kernels::CandidateParams& candidates,
+                                             const kernels::TableVerdictParams* verdict = nullptr);
 
 struct SegFrameRow {
   std::string name;      ///< file stem

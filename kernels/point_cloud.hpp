@@ -55,6 +55,10 @@ struct FrameInfo {
   std::int64_t host_stamp_ns = 0;    ///< host steady clock when the frame reached orthoflow
   std::uint64_t frame_id = 0;        ///< strictly increasing per source
   Viewpoint viewpoint{};
+  /// Where "up" (against gravity) points in the sensor frame, a unit vector, when a source knows it
+  /// (the Kinect's accelerometer, a simulated camera's pose); all zero: unknown.
+  std::array<float, 3> up{};
+  std::uint32_t up_age_ms = 0;  ///< how old the reading behind `up` was when the frame was taken
   bool operator==(const FrameInfo&) const = default;
 };
 

@@ -1,6 +1,7 @@
 #include "kernels/ransac_plane.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 
 #include "core/rng.hpp"
@@ -109,6 +110,13 @@ Result<RansacPlane, RansacError> ransac_impl(PointsView pts, const RansacParams&
   }
   if (finite < 3) { return err(RansacError{Code::TOO_FEW_POINTS, double(finite)}); }
   core::Rng rng(prm.seed);
+  const auto& up = prm.up;
+  const bool prior = up[0] != 0.0F || up[1] != 0.0F || up[2] != 0.0F;
+  const float min_cos = std::cos(std::clamp(prm.max_tilt_deg, 0.0F, 90.0F) * 0.0174532925F);
+  const auto level = [&](const Plane& h) {
+    return !prior ||
+           std::fabs(h.normal[0] * up[0] + h.normal[1] * up[1] + h.normal[2] * up[2]) >= min_cos;
+  };
   Plane best;
   std::size_t best_count = 0;
   std::uint32_t it = 0;
@@ -117,7 +125,7 @@ Result<RansacPlane, RansacError> ransac_impl(PointsView pts, const RansacParams&
     Plane hypothesis;
     bool ok = false;
     for (int attempt = 0; attempt < 100 && !ok; ++attempt) {
-      ok = draw_hypothesis(pts, rng, hypothesis);
+      ok = draw_hypothesis(pts, rng, hypothesis) && level(hypothesis);
     }
     if (!ok) { continue; }
     const std::size_t c = count(pts, hypothesis, prm.tau);
@@ -133,7 +141,12 @@ Result<RansacPlane, RansacError> ransac_impl(PointsView pts, const RansacParams&
     }
   }
   if (best_count < 3) { return err(RansacError{Code::NO_HYPOTHESIS, double(it)}); }
-  return refine(pts, best, prm.tau, it, out);
+  auto refined = refine(pts, best, prm.tau, it, out);
+  // A near-collinear draw can pass the prior and score a strip of a wall, whose refit is the wall.
+  if (refined && !level(refined->plane)) {
+    return err(RansacError{Code::NO_HYPOTHESIS, double(it)});
+  }
+  return refined;
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 /// non-collinear points drawn by the portable Rng, score = points within tau, optional early stop
 /// at a stated confidence, then a least-squares (PCA) refit on the inliers and the final inlier
 /// indices.
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -22,6 +23,12 @@ struct RansacParams {
   std::uint32_t max_iterations = 200;  ///< hypotheses drawn at most
   double confidence = 0.0;  ///< in (0, 1): stop when this sure of an outlier-free sample; 0: never
   std::uint64_t seed = 0x0f5eed5eedULL;  ///< Rng seed: same seed, same plane
+  /// Gravity prior: when `up` is a unit vector (not all zero), a hypothesis whose normal is more
+  /// than max_tilt_deg from it (either sign) is redrawn like a degenerate one, never scored: only
+  /// near-level planes are found, and the non-level draws cost no scoring pass. A refit plane
+  /// beyond the angle is no plane (NO_HYPOTHESIS).
+  std::array<float, 3> up{};
+  float max_tilt_deg = 90.0F;
 };
 
 /// @brief The refit plane (unit normal oriented so that d >= 0, i.e. the origin, where the sensor

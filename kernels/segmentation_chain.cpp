@@ -61,7 +61,10 @@ Result<SegmentationResult, SegmentationError> SegmentationChain::run(CloudView c
                             objects_result->labels,
                             std::span<const std::int32_t>(slot_of_).first(clusters.size()),
                             takes_organized_path(cloud, params_),
-                            t};
+                            t,
+                            table_result->hull_u,
+                            table_result->hull_v,
+                            input_result->dense.size()};
 }
 
 }  // namespace orthoflow::kernels

@@ -43,6 +43,8 @@ struct SegmentationResult {
   std::span<const std::int32_t> candidate_of;
   bool organized = false;
   SegmentationTimings timings;
+  std::span<const double> hull_u, hull_v;  ///< the support polygon (make_plane_basis of the plane)
+  std::size_t plane_sample = 0;            ///< the dense plane-input points (the verdict's share)
 };
 
 /// @brief Pre-sized tabletop segmentation. @note Not thread-safe; one instance per thread.

@@ -71,6 +71,8 @@ UiSnapshot GraphBackend::snapshot() const {
     if (have_latest_) {
       s.frame_id = latest_->frame_id;
       s.age_ns = latest_->age_ns;
+      s.table_reason = latest_->table_reason;
+      s.gravity = latest_->gravity;
     }
     s.objects = objects_locked();
   }

@@ -161,6 +161,8 @@ UiSnapshot IpcBackend::snapshot() const {
   if (objects_at_ns_ != 0 && now - objects_at_ns_ < STALE_AFTER_NS) {
     s.frame_id = latest_->frame_id;
     s.age_ns = latest_->age_ns;
+    s.table_reason = latest_->table_reason;
+    s.gravity = latest_->gravity;
     s.objects = object_views(*latest_);
   }
   if (status_at_ns_ != 0 && now - status_at_ns_ < STALE_AFTER_NS) {

@@ -70,6 +70,9 @@ struct CameraBoxes {
 struct UiSnapshot {
   std::uint64_t frame_id = 0;  ///< of the objects; 0 before the first frame
   std::int64_t age_ns = 0;     ///< that frame's age at decision
+  /// That frame's table verdict and where its up came from, as ObjectListPayload carries them
+  /// (kernels::TableReason + 1 and graphs::Gravity + 1; 0: not reported).
+  std::uint8_t table_reason = 0, gravity = 0;
   std::vector<ObjectView> objects;
   std::vector<CategoryView> memory;
   std::vector<EventView> events;  ///< oldest first

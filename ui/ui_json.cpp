@@ -83,6 +83,18 @@ std::string_view refusal_text(Outcome outcome) {
 }
 
 // The objects' boxes in the last camera image, or null before one was served.
+/// The frame's table verdict (docs/SEGMENTATION.md, "The table verdict"): null when not reported.
+Json table_json(const UiSnapshot& s) {
+  static constexpr const char* REASONS[] = {"accepted",  "held",         "no_plane",
+                                            "not_level", "out_of_range", "too_small"};
+  static constexpr const char* GRAVITY[] = {"none", "sensor", "configured"};
+  if (s.table_reason == 0 || s.table_reason > 6) return nullptr;
+  return {
+      {"found", s.table_reason <= 2},
+      {"reason", REASONS[s.table_reason - 1]},
+      {"gravity", s.gravity >= 1 && s.gravity <= 3 ? Json(GRAVITY[s.gravity - 1]) : Json(nullptr)}};
+}
+
 Json camera_json(const CameraBoxes& c) {
   if (c.frame_id == 0) return nullptr;
   Json boxes = Json::array();
@@ -137,6 +149,7 @@ std::string state_json(const UiSnapshot& s) {
   for (const EventView& e : s.events) events.push_back(event_json(e));
   const Json doc = {{"frame", s.frame_id},
                     {"age_ms", static_cast<double>(s.age_ns) * 1e-6},
+                    {"table", table_json(s)},
                     {"durable", s.durable},
                     {"objects", std::move(objects)},
                     {"memory", std::move(memory)},

@@ -84,7 +84,8 @@ int main(int argc, char** argv) {
   auto seg = orthoflow::graphs::segmentation_of_graph(*spec);
   if (!seg) return 2;
   auto ours = oe::evaluate_segmentation(
-      *frames, "orthoflow", oe::make_chain_segmenter(seg->stages, seg->candidates), options);
+      *frames, "orthoflow",
+      oe::make_chain_segmenter(seg->stages, seg->candidates, &seg->table.verdict), options);
   auto theirs = oe::evaluate_segmentation(*frames, "PCL 1.13", pcl_segmenter, options);
   if (!ours || !theirs) return 1;
   const std::vector<oe::SegReport> reports{*ours, *theirs};

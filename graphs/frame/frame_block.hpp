@@ -22,6 +22,7 @@
 #include "engine/frame_payload.hpp"
 #include "kernels/cluster_stats.hpp"
 #include "kernels/plane_distance.hpp"
+#include "kernels/table_verdict.hpp"
 #include "kernels/tabletop_stages.hpp"
 
 namespace orthoflow::graphs {
@@ -115,6 +116,12 @@ struct FrameError {
   [[nodiscard]] std::string to_string() const;
 };
 
+/// @brief Where a frame's "up" came from: its sensor (the Kinect's accelerometer, a simulated
+/// camera's pose), the table node's configured camera pose, or nowhere.
+enum class Gravity : std::uint8_t { NONE, SENSOR, CONFIGURED };
+/// @brief "none", "sensor", "configured".
+[[nodiscard]] std::string_view gravity_name(Gravity g) noexcept;
+
 /// @brief Per-frame results of every stage; lives in the block after the raw frame.
 struct FrameState {
   std::uint32_t truth_count = 0;
@@ -131,6 +138,13 @@ struct FrameState {
   kernels::Plane plane{};
   std::uint32_t plane_inliers = 0;
   kernels::PlaneCheck plane_check{};  ///< how sure the table stage is of the plane
+  /// The table verdict (kernels/table_verdict.hpp): table_found is true for ACCEPTED and HELD
+  /// only; `judged` is what the verdict measured on this frame's own plane (when it had one).
+  kernels::TableReason table_reason = kernels::TableReason::NO_PLANE;
+  kernels::TableJudgement judged{};
+  Gravity gravity = Gravity::NONE;  ///< where this frame's "up" came from
+  std::array<float, 3> up{};        ///< unit "up" in the sensor frame (gravity != NONE)
+  std::uint32_t up_age_ms = 0;      ///< age of the sensor reading behind it (Gravity::SENSOR)
   std::uint32_t hull_count = 0;
   std::uint32_t clusters = 0;           ///< clusters before the candidate constraints
   std::uint32_t rejected_size = 0;      ///< failed C_size

@@ -1,10 +1,22 @@
 // FrameError (graphs/frame/frame_block.hpp): the typed per-frame error and its one rule (first
-// error wins).
+// error wins); the names of the Gravity sources.
 #include <string>
 
 #include "graphs/frame/frame_block.hpp"
 
 namespace orthoflow::graphs {
+
+std::string_view gravity_name(Gravity g) noexcept {
+  switch (g) {
+    case Gravity::NONE:
+      return "none";
+    case Gravity::SENSOR:
+      return "sensor";
+    case Gravity::CONFIGURED:
+      return "configured";
+  }
+  return "none";
+}
 
 std::string_view FrameError::name(Code code) noexcept {
   switch (code) {

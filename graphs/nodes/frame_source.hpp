@@ -52,6 +52,12 @@ class FrameSource : public engine::Node {
       s.truth[k].category.assign(simulation::category_name(objects[k].model.category));
     }
   }
+  /// A simulated camera knows its pose: "up" is the simulated table's normal (the table is level).
+  static void take_up(kernels::PointCloud& cloud, const simulation::TableSpec& table) noexcept {
+    const auto n = simulation::table_frame(table).normal;
+    cloud.info.up = {static_cast<float>(n[0]), static_cast<float>(n[1]), static_cast<float>(n[2])};
+    cloud.info.up_age_ms = 0;
+  }
   /// Writes @p cloud into the message's block and clears the per-frame state.
   bool emit_cloud(engine::Message& out, const kernels::PointCloud& cloud) noexcept {
     const FrameBlock block = block_of(out, capacity_);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <thread>
 
 #include "drivers/kinect/kinect_depth.hpp"
@@ -58,6 +59,9 @@ class KinectSource final : public FrameSource {
     // 60 MHz ticks to ns: x 50 / 3, exact in integers.
     cloud_.info.sensor_stamp_ns = static_cast<std::int64_t>(frame->device_ticks * 50 / 3);
     cloud_.info.host_stamp_ns = std::chrono::steady_clock::now().time_since_epoch().count();
+    const auto gravity = device_->gravity();  // the USB thread's latest accelerometer reading
+    cloud_.info.up = gravity ? gravity->up : std::array<float, 3>{};
+    cloud_.info.up_age_ms = gravity ? gravity->age_ms : 0;
     emit_cloud(out, cloud_);
     return engine::SourceStatus::FRAME;
   }
@@ -115,6 +119,9 @@ NodeResult make_kinect(const ParamMap& params, const engine::NodeContext& contex
                                 : "kinect_source: no Kinect v1 camera with serial " + serial);
     return err("kinect_source: cannot start the camera: " + kinect::to_string(why));
   }
+  if (!device.value()->no_accelerometer().empty())
+    std::fprintf(stderr, "kinect_source: no accelerometer, frames carry no gravity: %s\n",
+                 device.value()->no_accelerometer().c_str());
   return std::unique_ptr<engine::Node>(new KinectSource(
       *capacity, context, std::move(device.value()), std::chrono::milliseconds(wait_ms)));
 }

@@ -68,6 +68,8 @@ void fill_object_list(const FrameBlock& block, std::uint64_t frame_id, std::int6
     out.host_stamp_ns = frame->header->host_stamp_ns;
     out.age_ns = out.host_stamp_ns != 0 ? decided_ns - out.host_stamp_ns : 0;
   }
+  out.table_reason = static_cast<std::uint8_t>(static_cast<unsigned>(s.table_reason) + 1U);
+  out.gravity = static_cast<std::uint8_t>(static_cast<unsigned>(s.gravity) + 1U);
   out.count = std::min<std::uint32_t>(s.object_count, engine::OBJECT_LIST_CAPACITY);
   for (std::uint32_t k = 0; k < out.count; ++k) {
     const ObjectRecord& o = s.objects[k];

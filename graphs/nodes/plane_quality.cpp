@@ -36,9 +36,22 @@ void PlaneQualityCounters::record(const kernels::PlaneCheck& check) noexcept {
   raise_to(max_rms_um_, rms);
 }
 
+void PlaneQualityCounters::record_verdict(kernels::TableReason verdict, kernels::TableReason own,
+                                          bool gravity) noexcept {
+  using R = kernels::TableReason;
+  constexpr auto relaxed = std::memory_order_relaxed;
+  if (!gravity) no_gravity_.fetch_add(1, relaxed);
+  if (verdict == R::ACCEPTED || verdict == R::HELD) tables_.fetch_add(1, relaxed);
+  if (verdict == R::HELD) held_.fetch_add(1, relaxed);
+  if (own == R::NOT_LEVEL) not_level_.fetch_add(1, relaxed);
+  if (own == R::OUT_OF_RANGE) out_of_range_.fetch_add(1, relaxed);
+  if (own == R::TOO_SMALL) too_small_.fetch_add(1, relaxed);
+}
+
 std::size_t PlaneQualityCounters::read(std::span<engine::DeviceCounter> out) const noexcept {
   const std::uint64_t min_share = min_share_ppm_.load(std::memory_order_relaxed);
-  const std::array<engine::DeviceCounter, 7> all{{
+  constexpr auto relaxed = std::memory_order_relaxed;
+  const std::array<engine::DeviceCounter, 13> all{{
       {"frames", frames_.load(std::memory_order_relaxed)},
       {"switched", switched_.load(std::memory_order_relaxed)},
       {"doubtful", doubtful_.load(std::memory_order_relaxed)},
@@ -46,6 +59,12 @@ std::size_t PlaneQualityCounters::read(std::span<engine::DeviceCounter> out) con
       {"near_share_last_ppm", last_share_ppm_.load(std::memory_order_relaxed)},
       {"rms_max_um", max_rms_um_.load(std::memory_order_relaxed)},
       {"rms_last_um", last_rms_um_.load(std::memory_order_relaxed)},
+      {"tables", tables_.load(relaxed)},
+      {"held", held_.load(relaxed)},
+      {"refused_not_level", not_level_.load(relaxed)},
+      {"refused_out_of_range", out_of_range_.load(relaxed)},
+      {"refused_too_small", too_small_.load(relaxed)},
+      {"no_gravity", no_gravity_.load(relaxed)},
   }};
   const std::size_t k = std::min(out.size(), all.size());
   std::copy_n(all.begin(), k, out.begin());

@@ -4,13 +4,15 @@
 /// many frames had a plane, how many of those the table stage took another level for (the floor
 /// below the table or an object's top: PlaneCheck::switched, the fallbacks), how many were doubtful
 /// (fewer than DOUBTFUL_SHARE of the plane's tau inliers within 1 cm of it: a tilted plane), and
-/// the worst and the last inlier share and residual. Written from the frame path with relaxed
-/// atomics; read from any thread.
+/// the worst and the last inlier share and residual; and the table verdicts: tables (accepted or
+/// held), held, the refusals by reason, and the frames that knew no "up". Written from the frame
+/// path with relaxed atomics; read from any thread.
 #include <atomic>
 #include <cstdint>
 #include <span>
 
 #include "engine/telemetry.hpp"
+#include "kernels/table_verdict.hpp"
 #include "kernels/tabletop_stages.hpp"
 
 namespace orthoflow::graphs {
@@ -26,6 +28,10 @@ class PlaneQualityCounters {
  public:
   /// @brief Counts one frame's plane.
   void record(const kernels::PlaneCheck& check) noexcept;
+  /// @brief Counts one frame's table verdict: @p verdict the frame's (HELD when the hysteresis kept
+  /// the last table), @p own what its own plane got, @p gravity whether it knew where up is.
+  void record_verdict(kernels::TableReason verdict, kernels::TableReason own,
+                      bool gravity) noexcept;
   /// @brief Writes the counters (names with static storage) into @p out; @return how many.
   /// Shares are in parts per million, residuals in micrometres; the worst values are 0 before the
   /// first plane.
@@ -35,6 +41,8 @@ class PlaneQualityCounters {
   std::atomic<std::uint64_t> frames_{0}, switched_{0}, doubtful_{0};
   std::atomic<std::uint64_t> last_share_ppm_{0}, last_rms_um_{0};
   std::atomic<std::uint64_t> min_share_ppm_{UINT64_MAX}, max_rms_um_{0};
+  std::atomic<std::uint64_t> tables_{0}, held_{0}, not_level_{0}, out_of_range_{0}, too_small_{0};
+  std::atomic<std::uint64_t> no_gravity_{0};
 };
 
 }  // namespace orthoflow::graphs

@@ -1,10 +1,14 @@
 #include "graphs/nodes/replay_source.hpp"
 
+#include <algorithm>
 #include <chrono>
+#include <cstdio>
+#include <optional>
 #include <thread>
 
 #include "drivers/kinect/kinect_camera.hpp"
 #include "drivers/kinect/kinect_depth.hpp"
+#include "drivers/kinect/kinect_gravity.hpp"
 #include "formats/fakenect.hpp"
 #include "formats/file_bytes.hpp"
 #include "graphs/nodes/decode_ahead.hpp"
@@ -22,6 +26,63 @@ using engine::ParamMap;
 using Clock = std::chrono::steady_clock;
 namespace kinect = drivers::kinect;
 
+/// "Up" for one depth record: from the last usable accelerometer record before it in INDEX.txt.
+struct RecordedUp {
+  std::array<float, 3> up{};  // all zero: none
+  std::uint32_t age_ms = 0;
+};
+
+/// What a recording lacks, counted once at start-up.
+struct RecordingStats {
+  std::uint64_t frames_missing = 0, without_gravity = 0, accel_skipped = 0;
+};
+
+/// Frames missing between consecutive depth records: device-time gaps of more than one and a
+/// half 30 Hz periods (2,000,000 ticks of the 60 MHz clock each), rounded to whole frames.
+std::uint64_t frames_missing(const std::vector<formats::FakenectEntry>& depth) {
+  std::uint64_t missing = 0;
+  for (std::size_t k = 1; k < depth.size(); ++k) {
+    const std::uint32_t gap = depth[k].device_ticks - depth[k - 1].device_ticks;  // wraps
+    if (gap > 3'000'000U) missing += (gap + 1'000'000U) / 2'000'000U - 1U;
+  }
+  return missing;
+}
+
+/// The depth records' "up" from the recording's accelerometer records (read once, at start-up).
+/// A record that does not read, or whose reading is not a plausible gravity (all zero, a Kinect
+/// being moved), is skipped and counted in @p unusable; frames before the first usable one have
+/// none.
+Result<std::vector<RecordedUp>, std::string> recorded_ups(
+    const std::filesystem::path& dir, const std::vector<formats::FakenectEntry>& index,
+    std::size_t& accel_records, std::size_t& unusable) {
+  std::vector<RecordedUp> out;
+  std::optional<std::array<float, 3>> last;
+  double last_seconds = 0.0;
+  for (const auto& e : index) {
+    if (e.kind == 'a') {
+      ++accel_records;
+      auto tilt = formats::read_fakenect_tilt(dir / e.file);
+      auto up =
+          tilt ? kinect::up_from_accel(tilt->accel_x, tilt->accel_y, tilt->accel_z) : std::nullopt;
+      if (!up) {
+        ++unusable;
+        continue;
+      }
+      last = up;
+      last_seconds = e.host_seconds;
+    } else if (e.kind == 'd') {
+      RecordedUp r;
+      if (last) {
+        r.up = *last;
+        const double age = std::max(0.0, (e.host_seconds - last_seconds) * 1000.0);
+        r.age_ms = static_cast<std::uint32_t>(std::min(age, 4.0e9));
+      }
+      out.push_back(r);
+    }
+  }
+  return out;
+}
+
 /// The depth records of a fakenect recording (ours or libfreenect's fakenect-record), read and
 /// converted ahead on the decoder thread with the same code as the live camera (the device's
 /// raw-to-metres table and pinhole, kinect_source), then emitted at the recorded pace (the host
@@ -32,10 +93,13 @@ class ReplaySource final : public FrameSource {
   static constexpr std::int64_t MAX_GAP_NS = 1'000'000'000;  // a pause in the recording: cut to 1 s
 
   ReplaySource(std::size_t capacity, const engine::NodeContext& context,
-               std::vector<formats::FakenectEntry> entries, std::filesystem::path dir,
+               std::vector<formats::FakenectEntry> entries, std::vector<RecordedUp> ups,
+               const RecordingStats& stats, std::filesystem::path dir,
                const kinect::Calibration& calibration, bool paced, bool loop)
       : FrameSource(capacity, context),
         entries_(std::move(entries)),
+        ups_(std::move(ups)),
+        stats_(stats),
         dir_(std::move(dir)),
         paced_(paced),
         raw_(kinect::DEPTH_PIXELS) {
@@ -47,6 +111,20 @@ class ReplaySource final : public FrameSource {
         std::move(files), loop, 3, [this](std::size_t i, DecodeAhead::Slot& s) { decode(i, s); });
   }
   ~ReplaySource() override { decoder_.reset(); }  // the decoder thread uses the members above
+
+  /// The recording's account: depth records, frames missing between them (gaps in the device's
+  /// 60 MHz timestamps of more than one 30 Hz frame period), depth records with no accelerometer
+  /// reading before them, and accelerometer records skipped (unreadable or implausible).
+  const char* counter_group() const noexcept override { return "recording"; }
+  std::size_t device_counters(std::span<engine::DeviceCounter> out) const noexcept override {
+    const std::array<engine::DeviceCounter, 4> all{{{"depth_records", entries_.size()},
+                                                    {"frames_missing", stats_.frames_missing},
+                                                    {"without_gravity", stats_.without_gravity},
+                                                    {"accel_skipped", stats_.accel_skipped}}};
+    const std::size_t k = std::min(out.size(), all.size());
+    std::copy_n(all.begin(), k, out.begin());
+    return k;
+  }
 
   engine::SourceStatus produce(Message& out) noexcept override {
     DecodeAhead::Slot* slot = decoder_->next(DECODE_TIMEOUT);
@@ -98,6 +176,8 @@ class ReplaySource final : public FrameSource {
     ticks_ += static_cast<std::uint32_t>(e.device_ticks - last_ticks_);  // unwrap the 32-bit clock
     last_ticks_ = e.device_ticks;
     slot.cloud.info.sensor_stamp_ns = static_cast<std::int64_t>(ticks_ * 50 / 3);
+    slot.cloud.info.up = ups_[index].up;  // all zero when no usable accelerometer record came yet
+    slot.cloud.info.up_age_ms = ups_[index].age_ms;
     slot.schedule_ns = static_cast<std::int64_t>((e.host_seconds - first_seconds_) * 1e9);
     slot.ok = true;
   }
@@ -116,6 +196,8 @@ class ReplaySource final : public FrameSource {
   }
 
   std::vector<formats::FakenectEntry> entries_;
+  std::vector<RecordedUp> ups_;  // one per entry
+  RecordingStats stats_;
   std::filesystem::path dir_;
   bool paced_;
   std::array<float, kernels::DISPARITY_TABLE_SIZE> table_m_{};
@@ -147,10 +229,23 @@ NodeResult make_replay(const ParamMap& params, const engine::NodeContext& contex
     return err(full_frame_too_large("replay_source", *capacity, context));
   auto index = formats::read_fakenect_index(dir);
   if (!index) return err("replay_source: " + index.error().to_string());
+  std::size_t accel_records = 0, unusable = 0;
+  auto ups = recorded_ups(dir, *index, accel_records, unusable);
+  if (!ups) return err("replay_source: " + ups.error());
+  if (unusable > 0)
+    std::fprintf(stderr,
+                 "replay_source: %zu of %zu accelerometer records skipped (unreadable, or not a "
+                 "plausible gravity reading)\n",
+                 unusable, accel_records);
   std::vector<formats::FakenectEntry> depth;
   for (auto& entry : *index) {
     if (entry.kind == 'd') depth.push_back(std::move(entry));
   }
+  RecordingStats stats;
+  stats.frames_missing = frames_missing(depth);
+  stats.accel_skipped = unusable;
+  for (const RecordedUp& u : *ups)
+    stats.without_gravity += u.up == std::array<float, 3>{} ? 1U : 0U;
   if (depth.empty()) return err("replay_source: '" + dir + "/INDEX.txt' lists no depth record");
   // device.json is optional in fakenect (older recordings lack it): the typical device then.
   kinect::Calibration calibration;
@@ -159,8 +254,9 @@ NodeResult make_replay(const ParamMap& params, const engine::NodeContext& contex
     if (!device) return err("replay_source: " + device.error().to_string());
     calibration = *device;
   }
-  return std::unique_ptr<engine::Node>(new ReplaySource(
-      *capacity, context, std::move(depth), dir, calibration, pace == "recorded", loop == 1));
+  return std::unique_ptr<engine::Node>(new ReplaySource(*capacity, context, std::move(depth),
+                                                        std::move(*ups), stats, dir, calibration,
+                                                        pace == "recorded", loop == 1));
 }
 
 }  // namespace

@@ -3,14 +3,13 @@
 // segment`, the benchmarks and the PCL agreement tests) runs. Each node runs one stage on the
 // frame's block:
 //   preprocess: PlaneInputStage  -> the plane input in voxels() (dense sample, then the sparse one)
-//   table:      TableStage       -> plane and support polygon in the state and hull_u/hull_v
+//   table:      table_node.cpp   (TableStage, the table verdict and its hysteresis)
 //   objects:    objects_node.cpp (ObjectStage and the candidate constraints)
 #include "graphs/nodes/segment_nodes.hpp"
 
 #include <new>
 
 #include "graphs/nodes/node_support.hpp"
-#include "graphs/nodes/plane_quality.hpp"
 #include "graphs/nodes/segment_params.hpp"
 
 namespace orthoflow::graphs {
@@ -74,55 +73,12 @@ class Preprocess final : public FrameStage {
   kernels::PlaneInputStage stage_;
 };
 
-class Table final : public FrameStage {
- public:
-  Table(std::size_t capacity, std::string name, const kernels::SegmentationParams& params)
-      : FrameStage(capacity, std::move(name)), params_(params), stage_(capacity) {}
-
-  void process(const Message& in, Emitter& out) noexcept override {
-    const FrameBlock block = block_of(in, capacity_);
-    FrameState& s = block.state();
-    s.table_found = false;
-    s.hull_count = 0;
-    if (s.error.empty()) {
-      if (auto table = stage_.run(plane_input(block), params_, block.hull_u(), block.hull_v())) {
-        s.plane = table->plane.plane;
-        s.plane_inliers = static_cast<std::uint32_t>(table->plane.inliers);
-        s.plane_check = table->check;
-        s.hull_count = static_cast<std::uint32_t>(table->hull_u.size());
-        s.table_found = true;
-        quality_.record(table->check);
-      } else {
-        s.error.set(name_, table.error());
-      }
-    }
-    out.emit(0, in);
-  }
-  const char* counter_group() const noexcept override { return "plane"; }
-  std::size_t device_counters(std::span<engine::DeviceCounter> out) const noexcept override {
-    return quality_.read(out);
-  }
-
- private:
-  kernels::SegmentationParams params_;
-  kernels::TableStage stage_;
-  PlaneQualityCounters quality_;
-};
-
 NodeResult make_preprocess(const ParamMap& params, const engine::NodeContext& context) {
   auto capacity = frame_capacity(context);
   if (!capacity) return err(capacity.error());
   kernels::SegmentationParams p = TabletopSegmentation::defaults();
   if (auto ok = parse_preprocess_params(params, p); !ok) return err(ok.error());
   return std::unique_ptr<engine::Node>(new Preprocess(*capacity, std::string(context.name), p));
-}
-
-NodeResult make_table(const ParamMap& params, const engine::NodeContext& context) {
-  auto capacity = frame_capacity(context);
-  if (!capacity) return err(capacity.error());
-  kernels::SegmentationParams p = TabletopSegmentation::defaults();
-  if (auto ok = parse_table_params(params, p); !ok) return err(ok.error());
-  return std::unique_ptr<engine::Node>(new Table(*capacity, std::string(context.name), p));
 }
 
 }  // namespace
@@ -137,7 +93,9 @@ kernels::PlaneInput plane_input(const FrameBlock& block) noexcept {
   return kernels::PlaneInput{part(0, s.voxels), part(s.voxels, s.sparse), s.kept};
 }
 
-// The objects kind is long enough for its own file (objects_node.cpp).
+// The table and objects kinds are long enough for their own files (table_node.cpp,
+// objects_node.cpp).
+NodeResult make_table_node(const ParamMap& params, const engine::NodeContext& context);
 NodeResult make_objects_node(const ParamMap& params, const engine::NodeContext& context,
                              LabelsWriter* labels);
 
@@ -149,8 +107,10 @@ void add_segment_nodes(engine::NodeRegistry& registry, LabelsWriter* labels) {
       "roi_min_x..roi_max_z (m), leaf (m, 0 = off), organized_stride (pixels, 0 = voxel grid)",
       make_preprocess);
   registry.add("table",
-               "RANSAC table plane + support polygon: tau (m), iterations, confidence, seed",
-               make_table);
+               "RANSAC table plane + support polygon, then the table verdict: tau (m), "
+               "iterations, confidence, seed, max_tilt_deg, min_height, max_height (m), min_share, "
+               "min_area (m^2), hold_frames, up (\"x,y,z\" or none)",
+               make_table_node);
   registry.add("objects",
                "prism + Euclidean clusters + footprint merge + C_size/C_edge: h_min, h_max, "
                "tolerance, min_points, "

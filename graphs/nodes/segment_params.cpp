@@ -1,6 +1,8 @@
 #include "graphs/nodes/segment_params.hpp"
 
+#include <cmath>
 #include <cstdint>
+#include <cstdio>
 
 #include "graphs/nodes/node_support.hpp"
 
@@ -33,17 +35,54 @@ Result<void, std::string> parse_preprocess_params(const engine::ParamMap& params
   return {};
 }
 
+namespace {
+
+/// "x,y,z" -> a unit vector; an error for anything else (three finite numbers, not all zero).
+Result<std::array<float, 3>, std::string> parse_up(const std::string& text) {
+  std::array<float, 3> v{};
+  char tail = 0;
+  if (std::sscanf(text.c_str(), "%f,%f,%f%c", &v[0], &v[1], &v[2], &tail) != 3)
+    return err("table: up must be \"x,y,z\" (the camera's up in the sensor frame), not '" + text +
+               "'");
+  const float norm = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+  if (!std::isfinite(norm) || norm < 1e-3F)
+    return err("table: up '" + text + "' is not a direction");
+  for (float& c : v) c /= norm;
+  return v;
+}
+
+}  // namespace
+
 Result<void, std::string> parse_table_params(const engine::ParamMap& params,
-                                             kernels::SegmentationParams& p) {
-  if (auto ok = params.only({"tau", "iterations", "confidence", "seed"}); !ok)
+                                             TabletopSegmentation& out) {
+  if (auto ok =
+          params.only({"tau", "iterations", "confidence", "seed", "max_tilt_deg", "min_height",
+                       "max_height", "min_share", "min_area", "hold_frames", "up"});
+      !ok)
     return err(ok.error());
-  kernels::RansacParams& r = p.ransac;
+  kernels::RansacParams& r = out.stages.ransac;
+  kernels::TableVerdictParams& v = out.table.verdict;
   std::string e;
   take(params.number("tau", r.tau, 1e-4, 1.0), r.tau, e);
   take(params.integer("iterations", r.max_iterations, 1, 100000), r.max_iterations, e);
   take(params.number("confidence", r.confidence, 0.0, 0.999999), r.confidence, e);
   take(params.integer("seed", static_cast<std::int64_t>(r.seed), 0, INT64_MAX), r.seed, e);
+  take(params.number("max_tilt_deg", v.max_tilt_deg, 0.0, 90.0), v.max_tilt_deg, e);
+  take(params.number("min_height", v.min_height_m, 0.0, 100.0), v.min_height_m, e);
+  take(params.number("max_height", v.max_height_m, 0.0, 100.0), v.max_height_m, e);
+  take(params.number("min_share", v.min_share, 0.0, 1.0), v.min_share, e);
+  take(params.number("min_area", v.min_area_m2, 0.0, 100.0), v.min_area_m2, e);
+  take(params.integer("hold_frames", out.table.hold_frames, 0, 30), out.table.hold_frames, e);
+  std::string up = "none";
+  take(params.text("up", "none"), up, e);
   if (!e.empty()) return err(e);
+  if (v.min_height_m > v.max_height_m)
+    return err(std::string("table: min_height must not exceed max_height"));
+  if (up != "none") {
+    auto parsed = parse_up(up);
+    if (!parsed) return err(parsed.error());
+    out.table.up = *parsed;
+  }
   return {};
 }
 
@@ -116,7 +155,7 @@ Result<TabletopSegmentation, std::string> segmentation_of_graph(const engine::Gr
                  "')");
     seen[kind] = true;
     Result<void, std::string> ok = kind == 0   ? parse_preprocess_params(node.params, out.stages)
-                                   : kind == 1 ? parse_table_params(node.params, out.stages)
+                                   : kind == 1 ? parse_table_params(node.params, out)
                                                : parse_objects_params(node.params, out);
     if (!ok) return err("node '" + node.name + "': " + ok.error());
   }

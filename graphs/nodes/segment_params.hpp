@@ -3,20 +3,36 @@
 /// @brief The parameters of the preprocess, table and objects node kinds, parsed into the one
 /// kernels::SegmentationParams / CandidateParams pair the chain takes, so that a graph file and
 /// `orthoflow segment --graph FILE` mean the same segmentation (start-up only: these allocate).
+#include <array>
+#include <optional>
 #include <string>
 
 #include "core/result.hpp"
 #include "engine/graph.hpp"
 #include "engine/params.hpp"
 #include "kernels/segmentation_chain.hpp"
+#include "kernels/table_verdict.hpp"
 
 namespace orthoflow::graphs {
 
-/// @brief The segmentation of the tabletop graph: the stage parameters and the candidate
-/// constraints.
+/// @brief The table node's verdict (kernels/table_verdict.hpp) and where "up" comes from when a
+/// frame does not carry it.
+struct TableSettings {
+  kernels::TableVerdictParams verdict{};
+  /// `up: "x,y,z"`: the camera's configured pose says where up is in the sensor frame (used only
+  /// for frames that carry no reading of their own); nullopt: nothing configured.
+  std::optional<std::array<float, 3>> up;
+  /// Frames the last accepted table is kept through when a frame's plane fails the verdict (a
+  /// hand or an arm in front of the table for a moment). 0: no hysteresis.
+  std::uint32_t hold_frames = 2;
+};
+
+/// @brief The segmentation of the tabletop graph: the stage parameters, the candidate
+/// constraints and the table verdict.
 struct TabletopSegmentation {
   kernels::SegmentationParams stages = defaults();
   kernels::CandidateParams candidates{};
+  TableSettings table{};
   /// @brief The node kinds' defaults (where they differ from the chain's PCL-baseline ones: the
   /// footprint merge is on, clusters need 50 points with a 2-pixel window).
   [[nodiscard]] static kernels::SegmentationParams defaults() noexcept;
@@ -26,9 +42,10 @@ struct TabletopSegmentation {
 /// grid).
 [[nodiscard]] Result<void, std::string> parse_preprocess_params(const engine::ParamMap& params,
                                                                 kernels::SegmentationParams& out);
-/// @brief table: tau (m), iterations, confidence, seed.
+/// @brief table: tau (m), iterations, confidence, seed; the verdict's max_tilt_deg, min_height,
+/// max_height (m), min_share, min_area (m^2), hold_frames and up ("x,y,z", normalised).
 [[nodiscard]] Result<void, std::string> parse_table_params(const engine::ParamMap& params,
-                                                           kernels::SegmentationParams& out);
+                                                           TabletopSegmentation& out);
 /// @brief objects: h_min, h_max, tolerance, min_points, max_points, pixel_radius, merge_overlap and
 /// the candidate constraints min_size, max_size, edge_margin.
 [[nodiscard]] Result<void, std::string> parse_objects_params(const engine::ParamMap& params,

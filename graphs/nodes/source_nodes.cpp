@@ -44,6 +44,7 @@ class SyntheticSource final : public FrameSource {
     if (!sequence_.next(cloud_)) return engine::SourceStatus::END;
     if (!take_block(out)) return engine::SourceStatus::FRAME;
     cloud_.info.host_stamp_ns = Clock::now().time_since_epoch().count();
+    take_up(cloud_, sequence_.scene().table);
     emit_cloud(out, cloud_);
     write_truth(out, sequence_.scene().objects);
     return engine::SourceStatus::FRAME;

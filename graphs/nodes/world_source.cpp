@@ -19,6 +19,7 @@ class WorldSource final : public FrameSource {
     const simulation::Scene* scene = feed_.next_frame(cloud_);
     if (scene == nullptr) return engine::SourceStatus::END;
     if (!take_block(out)) return engine::SourceStatus::FRAME;
+    take_up(cloud_, scene->table);
     emit_cloud(out, cloud_);
     write_truth(out, scene->objects);
     return engine::SourceStatus::FRAME;

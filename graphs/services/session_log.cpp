@@ -104,10 +104,22 @@ void SessionLog::write_json(const FrameBlock& block, std::uint64_t frame_id) noe
   const std::int64_t stamp = frame ? frame->header->sensor_stamp_ns : 0;
   char* out = line_.data();
   const std::size_t cap = line_.size();
-  std::size_t n = static_cast<std::size_t>(
-      std::snprintf(out, cap, R"({"frame":%llu,"stamp_ns":%lld,"table":%s,)",
-                    static_cast<unsigned long long>(frame_id), static_cast<long long>(stamp),
-                    s.table_found ? "true" : "false"));
+  const std::string_view verdict = kernels::table_reason_name(s.table_reason);
+  const std::string_view gravity = gravity_name(s.gravity);
+  char tilt[24] = "null";  // the own plane's angle from up: known only with a plane and an up
+  if (std::isfinite(s.judged.tilt_deg) && s.judged.height_m > 0.0F)
+    std::snprintf(tilt, sizeof tilt, "%.2f", static_cast<double>(s.judged.tilt_deg));
+  std::size_t n = static_cast<std::size_t>(std::snprintf(
+      out, cap,
+      R"({"frame":%llu,"stamp_ns":%lld,"table":%s,"table_reason":"%.*s","gravity":"%.*s","tilt_deg":%s,)",
+      static_cast<unsigned long long>(frame_id), static_cast<long long>(stamp),
+      s.table_found ? "true" : "false", static_cast<int>(verdict.size()), verdict.data(),
+      static_cast<int>(gravity.size()), gravity.data(), tilt));
+  if (s.judged.height_m > 0.0F)  // what the verdict measured on this frame's own plane
+    n += static_cast<std::size_t>(std::snprintf(
+        out + n, cap - n, R"("support":{"share":%.4f,"area_m2":%.4f,"height_m":%.4f},)",
+        static_cast<double>(s.judged.share), static_cast<double>(s.judged.area_m2),
+        static_cast<double>(s.judged.height_m)));
   n += write_plane(s, out + n, cap - n);
   for (std::uint32_t k = 0; k < s.object_count && n + 2048 < cap; ++k) {
     const ObjectRecord& o = s.objects[k];

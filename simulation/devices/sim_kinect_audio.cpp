@@ -159,8 +159,8 @@ void SimKinectDevice::firmware_command(std::span<const std::byte> data,
     motor_.target_deg = std::clamp(wanted, -AUDIO_TILT_LIMIT_DEG, AUDIO_TILT_LIMIT_DEG);
     motor_.clamped = motor_.target_deg != wanted;
   } else if (a.cmd == 0x8032 && arg1 == 0x68) {
-    // Gravity in the camera frame pitched by `angle` (no roll), as the 1414 model: Y up at level.
-    const double rad = angle * 3.14159265358979323846 / 180.0;
+    // Gravity in the camera frame pitched by the mount plus `angle` (no roll), as the 1414 model.
+    const double rad = (angle + mount_pitch_deg()) * 3.14159265358979323846 / 180.0;
     a.block.fill(std::byte{0});
     sim_put_le32(a.block, 16, 0);
     sim_put_le32(a.block, 20,

@@ -79,6 +79,11 @@ struct SimKinectConfig {
   SimBayerSource bayer_source{};  ///< empty: that scene's colours as GRBG
   SimIrSource ir_source{};        ///< empty: an intensity falling with depth squared
   std::uint64_t scene_seed = 42;
+  /// The head's pitch at motor angle 0 (degrees, negative: looking down), the Kinect standing on a
+  /// pitched bracket: the accelerometer reads gravity for the motor angle plus this, so that "up"
+  /// agrees with the scene the camera sees. nullopt: the default scene's own pitch (its table is
+  /// level), or 0 with a depth_source.
+  std::optional<double> mount_pitch_deg{};
   double motor_slew_deg_per_s = 15.0;
   std::int64_t audio_reenumerate_delay_ns = 1'500'000'000;  ///< execute -> reappearance
   bool audio_firmware_running = false;  ///< start (and replug) with the firmware already running

@@ -144,6 +144,8 @@ class SimKinectDevice {
   /// @brief Motor angle at @p now_ns (degrees, slewing toward target_tilt_deg()).
   [[nodiscard]] double tilt_deg(std::int64_t now_ns) noexcept;
   [[nodiscard]] double target_tilt_deg() const noexcept { return motor_.target_deg; }
+  /// @brief The head's pitch at motor angle 0 (SimKinectConfig::mount_pitch_deg, resolved).
+  [[nodiscard]] double mount_pitch_deg() noexcept;
   [[nodiscard]] std::uint8_t led() const noexcept { return motor_.led; }
 
   [[nodiscard]] const SimKinectFaults& faults() const noexcept { return faults_; }
@@ -228,6 +230,7 @@ class SimKinectDevice {
   std::vector<std::uint8_t> scene_bayer_;
   std::vector<std::uint16_t> scene_ir_;
   Motor motor_{};
+  std::optional<double> mount_pitch_{};  // resolved on first use
   Audio audio_{};
 };
 

@@ -49,6 +49,17 @@ double SimKinectDevice::tilt_deg(std::int64_t now_ns) noexcept {
   return motor_.angle_deg;
 }
 
+double SimKinectDevice::mount_pitch_deg() noexcept {
+  if (!mount_pitch_) {
+    mount_pitch_ = config_.mount_pitch_deg ? *config_.mount_pitch_deg
+                   : config_.depth_source
+                       ? 0.0
+                       : -make_scene(SceneConfig{}, config_.scene_seed).table.tilt_rad * 180.0 /
+                             3.14159265358979323846;
+  }
+  return *mount_pitch_;
+}
+
 SimControlReply SimKinectDevice::motor_control(const drivers::UsbControlSetup& setup,
                                                std::span<std::byte> data,
                                                std::int64_t now_ns) noexcept {
@@ -69,8 +80,9 @@ SimControlReply SimKinectDevice::motor_control(const drivers::UsbControlSetup& s
     return {SimControlOutcome::OK, 1};
   }
   if (setup.request_type == 0xC0 && setup.request == 0x32 && data.size() >= 10) {  // state
-    // Gravity in the camera frame when the head is pitched by `angle` (no roll): Y up at level.
-    const double rad = angle * 3.14159265358979323846 / 180.0;
+    // Gravity in the camera frame when the head is pitched by the mount plus `angle` (no roll): Y
+    // up at level. The tilt byte reports the motor angle alone.
+    const double rad = (angle + mount_pitch_deg()) * 3.14159265358979323846 / 180.0;
     std::fill(data.begin(), data.begin() + 10, std::byte{0});
     put_be16(data, 2, 0);
     put_be16(data, 4, static_cast<std::int16_t>(std::lround(ACCEL_COUNTS_PER_G * std::cos(rad))));

@@ -16,11 +16,21 @@ os.makedirs(work)
 rec = os.path.join(work, "rec")
 
 p = run(cli, "kinect", "record", rec, "--sim", "--frames", "15")
-expect("recorded 15 depth and 15 colour frames" in p.stdout, f"record: {p.stdout}")
+expect("recorded 15 depth and 15 colour frames and " in p.stdout, f"record: {p.stdout}")
 index = open(os.path.join(rec, "INDEX.txt")).read().split()
 depth = [n for n in index if n.startswith("d-")]
 colour = [n for n in index if n.startswith("r-")]
+accel = [n for n in index if n.startswith("a-")]
 expect(len(depth) == 15 and len(colour) == 15, f"index: {index[:4]}")
+# The accelerometer, read by the driver about every 100 ms: 12-byte freenect_raw_tilt_state dumps,
+# one before the first frame, reading 1 g (819 counts) pitched like the simulated scene.
+expect(len(accel) >= 2 and index[0].startswith("a-"), f"accelerometer records: {index[:4]}")
+expect(f"and {len(accel)} accelerometer records" in p.stdout, f"record: {p.stdout}")
+with open(os.path.join(rec, accel[0]), "rb") as f:
+    data = f.read()
+expect(len(data) == 12, f"a- record: {len(data)} bytes")
+ax, ay, az, tilt, status = struct.unpack("<hhhbxi", data)
+expect(abs((ax * ax + ay * ay + az * az) ** 0.5 - 819) < 5 and az < -300, f"a- record: {ax} {ay} {az}")
 with open(os.path.join(rec, depth[0]), "rb") as f:
     data = f.read()
 expect(data.startswith(b"P5 640 480 65535\n") and len(data) == 17 + 640 * 480 * 2, "d- record")
@@ -49,8 +59,12 @@ expect("already holds a recording" in p.stderr, p.stderr)
 # Replay at the recorded pace (15 frames ~ 0.5 s) and as fast as possible.
 p = run(cli, "run", "--source", "replay:" + rec, "--threads", "1")
 expect("15 processed" in p.stdout and "15 with a table" in p.stdout, f"replay: {p.stdout}")
-p = run(cli, "run", "--source", "replay:" + rec, "--rate", "max", "--threads", "1")
+p = run(cli, "run", "--source", "replay:" + rec, "--rate", "max", "--threads", "1",
+        "--json-out", os.path.join(work, "replay.jsonl"))
 expect("15 processed" in p.stdout, f"replay max: {p.stdout}")
+rows = [json.loads(line) for line in open(os.path.join(work, "replay.jsonl"))]
+expect(all(r["gravity"] == "sensor" and r["table_reason"] == "accepted" and r["tilt_deg"] < 2
+           for r in rows), f"replay gravity: {rows[0]}")
 
 # A truncated record: that frame is an error naming the file, the others run.
 bad = os.path.join(work, "bad")

@@ -72,13 +72,15 @@ TEST(TabletopAllocations, SteadyStateAllocatesNothingPerFrame) {
   // warm-up: 20 frames, then count over the remaining 40
   std::atomic<bool> stop{false};
   std::thread arm = count_after_warm_up(log, stop);
-  std::uint64_t lists = 0, answers = 0;
+  std::uint64_t lists = 0, answers = 0, judged = 0;
   std::thread consumer([&] {
     engine::ObjectListPayload list;
     LearningAck ack;
     while (!stop.load()) {
       while (objects->poll(list)) {
         ++lists;
+        // The table verdict travels with the objects: accepted (1), up from the sensor (2).
+        judged += list.table_reason == 1 && list.gravity == 2 ? 1U : 0U;
         if (list.count > 0) {
           LearningCommand ask;
           ask.kind = LearningCommand::Kind::ASK;
@@ -96,6 +98,7 @@ TEST(TabletopAllocations, SteadyStateAllocatesNothingPerFrame) {
   arm.join();
   consumer.join();
   EXPECT_GT(lists, 40U);
+  EXPECT_EQ(judged, lists);
   EXPECT_GT(answers, 20U);
   EXPECT_EQ(log.summary().frames, 60U);
   EXPECT_GT(log.summary().object_views, 100U);

@@ -98,6 +98,9 @@ void teach_ask_forget(graphs::LearningService& learning, const std::string& lear
       60);
   ASSERT_TRUE(seen) << "no still, described object appeared";
   EXPECT_TRUE(object_of(*seen, track)->at("label").is_null());  // nothing is known yet
+  // The table verdict of the frame (issue 50): the synthetic camera knows where up is.
+  EXPECT_EQ((*seen)["table"],
+            (Json{{"found", true}, {"reason", "accepted"}, {"gravity", "sensor"}}));
 
   const Json unknown = post(port, "/api/ask", {{"track", track}}, 200);
   EXPECT_EQ(unknown["outcome"], "answered");

@@ -226,7 +226,11 @@ function render(s) {
   state = s;
   renderTask(s);
   refreshCamera(s);
-  $('frame').textContent = `frame ${s.frame} (${fmt(s.age_ms, 1)} ms old)`;
+  // The table verdict: a robot that sees no table says so, and why (docs/SEGMENTATION.md).
+  const t = s.table;
+  const table = !t ? '' : t.found ? ` · table ${t.reason} (up: ${t.gravity})`
+                                  : ` · NO TABLE: ${t.reason} (up: ${t.gravity})`;
+  $('frame').textContent = `frame ${s.frame} (${fmt(s.age_ms, 1)} ms old)${table}`;
   renderObjects(s);
   renderMemory(s);
   renderEvents(s);

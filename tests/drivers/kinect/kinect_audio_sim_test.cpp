@@ -222,7 +222,9 @@ TEST(KinectAudioSim, BadImageAndMissingAudioSendNothing) {
 TEST(KinectAudioSim, MotorRefusesUntilTheFirmwareRunsThenTiltsLedsAndReads) {
   for (const KinectModel model : {KinectModel::K1473, KinectModel::K4W}) {
     SimUsbTransport usb;
-    usb.add_kinect(config(model));
+    SimKinectConfig level = config(model);
+    level.mount_pitch_deg = 0.0;  // the accelerometer then reads the motor angle alone
+    usb.add_kinect(level);
     auto refused = KinectMotor::open(usb, first_camera(usb));
     ASSERT_FALSE(refused.has_value());
     EXPECT_EQ(refused.error().usb.code, UsbError::Code::NOT_SUPPORTED);

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "drivers/kinect/kinect_camera.hpp"
 #include "drivers/kinect/kinect_motor.hpp"
@@ -94,7 +95,9 @@ TEST(KinectMotorSim, TiltsToTwentyDegreesReportingMovingThenStopped) {
 
 TEST(KinectMotorSim, AccelerometerIsOneGAndAgreesWithTheTilt) {
   SimUsbTransport usb;
-  usb.add_kinect(SimKinectConfig{});
+  SimKinectConfig level;
+  level.mount_pitch_deg = 0.0;  // the accelerometer then reads the motor angle alone
+  usb.add_kinect(level);
   auto motor = open_motor(usb, first_camera(usb));
   ASSERT_NE(motor, nullptr);
   for (const double deg : {0.0, 20.0, -27.5}) {
@@ -240,6 +243,32 @@ TEST(KinectMotorSim, NoMatchingMotorIsNotFound) {
   auto motor = KinectMotor::open(usb, stray);
   ASSERT_FALSE(motor.has_value());
   EXPECT_EQ(motor.error().usb.code, UsbError::Code::NOT_FOUND);
+}
+
+// The simulated Kinect stands on a bracket pitched like the default scene's camera, so that its
+// accelerometer's "up" agrees with the table it renders (the table verdict, issue 50, uses it).
+TEST(KinectMotorSim, AccelerometerAddsTheMountPitch) {
+  for (const std::optional<double> mount :
+       {std::optional<double>(-40.0), std::optional<double>()}) {
+    SimUsbTransport usb;
+    SimKinectConfig config;
+    config.mount_pitch_deg = mount;  // nullopt: the default scene's own pitch
+    usb.add_kinect(config);
+    auto motor = open_motor(usb, first_camera(usb));
+    ASSERT_NE(motor, nullptr);
+    auto s = motor->wait_until_still(5000ms);
+    ASSERT_TRUE(s.has_value()) << to_string(s.error());
+    const double pitch = std::atan2(s->accel_g[2], s->accel_g[1]) * 180.0 / PI;
+    const double expected = usb.kinect(0).mount_pitch_deg();
+    EXPECT_NEAR(pitch, expected, 0.2);
+    EXPECT_NEAR(*s->tilt_deg, 0.0, 0.5);  // the tilt byte is the motor angle alone
+    if (mount) {
+      EXPECT_DOUBLE_EQ(expected, -40.0);
+    } else {  // the default scene looks 30-60 degrees down at its table
+      EXPECT_LT(expected, -29.9);
+      EXPECT_GT(expected, -60.1);
+    }
+  }
 }
 
 }  // namespace
