@@ -11,7 +11,13 @@
 // 2 a stop request over iceoryx (graphs/services/arm_stop_service.hpp, the path of `orthoflow arm
 // stop`, the stop button and the DDS stop topic; needs a running RouDi, else skipped with a
 // message), 3 the watchdog (the client stops feeding it: the time counted from the last feed, so
-// the 100 ms timeout is in it), 4 SIGINT and 5 SIGHUP (the same handler as SIGTERM).
+// the 100 ms timeout is in it), 4 SIGINT and 5 SIGHUP (the same handler as SIGTERM), 6 the web
+// view's STOP ARM: an authenticated HTTP POST /api/arm/stop to a UiServer on loopback, which sends
+// the stop request over iceoryx (ui/ipc_task_link.hpp) to the holder's listener and answers once
+// the holder confirmed (needs a running RouDi, as path 2), 7 a stop from DDS: an
+// orthoflow_msgs/ArmStop written on rt/orthoflow/arm/stop by a plain Cyclone DDS writer in this
+// process, taken by the bridge's loop (bridge/bridge_loop.hpp, pumped as `orthoflow bridge dds`
+// pumps it) and sent to the holder over iceoryx (needs a RouDi; built with Cyclone DDS only).
 // BM_MonitorCheck: the monitor's CPU per control cycle (check_cycle) on a velocity stream near a
 // keep-out and on the firmware's HOME from RETRACT.
 #include <benchmark/benchmark.h>
@@ -31,6 +37,15 @@
 #include "graphs/services/arm_stop_service.hpp"
 #include "simulation/devices/forwarding_transport.hpp"
 #include "simulation/devices/sim_jaco_transport.hpp"
+#include "ui/ipc_task_link.hpp"
+#ifdef ORTHOFLOW_BENCH_DDS
+#include <dds/dds.h>
+
+#include "bridge/bridge_loop.hpp"
+#include "orthoflow_msgs/msg/ArmStop.h"
+#endif
+#include "ui/ui_client.hpp"
+#include "ui/ui_server.hpp"
 
 namespace jaco = orthoflow::drivers::jaco;
 namespace sim = orthoflow::simulation;
@@ -73,6 +88,16 @@ class StallingTransport final : private Owned, public sim::ForwardingTransport {
 
  private:
   mutable std::minstd_rand rng_{7};
+};
+
+// The web view's server for path 6: no graph behind it (nothing to show), only the task link.
+class StopOnlyBackend final : public orthoflow::ui::UiBackend {
+ public:
+  orthoflow::ui::UiSnapshot snapshot() const override { return {}; }
+  orthoflow::ui::UiAnswer submit(const orthoflow::ui::UiAction& /*action*/,
+                                 int /*timeout_ms*/) override {
+    return {};
+  }
 };
 
 struct Arm {
@@ -132,16 +157,82 @@ double erase_after(const Arm& a, std::int64_t since) {
   return -1.0;
 }
 
+#ifdef ORTHOFLOW_BENCH_DDS
+// Path 7: the bridge's loop on its own thread, pumped as `orthoflow bridge dds` pumps it (again at
+// once after work, else after 1 ms), and a plain DDS writer of ArmStop matched to it.
+class DdsStopper {
+ public:
+  static constexpr std::uint32_t DOMAIN = 212;  // no test uses it
+  ~DdsStopper() {
+    stop_.store(true);
+    if (pump_.joinable()) pump_.join();
+    if (participant_ > 0) dds_delete(participant_);
+  }
+  /// @return "" once the writer matched the bridge's reader, else why not.
+  std::string start() {
+    orthoflow::bridge::BridgeConfig config;
+    config.domain = DOMAIN;
+    auto loop = orthoflow::bridge::BridgeLoop::open(config, 0x57095709ULL);
+    if (!loop) return loop.error();
+    loop_ = std::move(*loop);
+    pump_ = std::thread([this] {
+      while (!stop_.load())
+        if (loop_->pump(steady_ns()) == 0)
+          std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    });
+    participant_ = dds_create_participant(DOMAIN, nullptr, nullptr);  // the bridge's domain
+    const dds_entity_t topic =
+        dds_create_topic(participant_, &orthoflow_msgs_msg_dds__ArmStop__desc,
+                         "rt/orthoflow/arm/stop", nullptr, nullptr);
+    dds_qos_t* q = dds_create_qos();
+    dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
+    dds_qset_history(q, DDS_HISTORY_KEEP_LAST, 16);
+    writer_ = dds_create_writer(participant_, topic, q, nullptr);
+    dds_delete_qos(q);
+    if (participant_ < 0 || topic < 0 || writer_ < 0) return "cannot create the DDS writer";
+    for (int i = 0; i < 2000; ++i) {
+      dds_publication_matched_status_t matched;
+      if (dds_get_publication_matched_status(writer_, &matched) == DDS_RETCODE_OK &&
+          matched.current_count > 0)
+        return "";
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    return "the bridge's ArmStop reader did not match within 10 s";
+  }
+  bool send() {
+    orthoflow_msgs_msg_dds__ArmStop_ stop;
+    stop.reason = const_cast<char*>("stop bench");
+    return dds_write(writer_, &stop) == DDS_RETCODE_OK;
+  }
+
+ private:
+  std::unique_ptr<orthoflow::bridge::BridgeLoop> loop_;
+  std::thread pump_;
+  std::atomic<bool> stop_{false};
+  dds_entity_t participant_ = 0, writer_ = 0;
+};
+#endif
+
 void BM_StopLatency(benchmark::State& state) {
   const int path = static_cast<int>(state.range(0));
-  const char* names[] = {"estop() call", "SIGTERM", "iceoryx stop request",
-                         "watchdog",     "SIGINT",  "SIGHUP"};
+  const char* names[] = {
+      "estop() call", "SIGTERM", "iceoryx stop request",        "watchdog",
+      "SIGINT",       "SIGHUP",  "web view POST /api/arm/stop", "DDS ArmStop through the bridge"};
   state.SetLabel(names[path]);
   std::unique_ptr<orthoflow::graphs::ArmStopListener> listener;
   Arm a = start_arm();
   if (!a.arm) return state.SkipWithError("the simulated arm did not start");
   if (path == 1 || path >= 4) jaco::install_stop_signals();
-  if (path == 2) {
+  StopOnlyBackend backend;
+  std::unique_ptr<orthoflow::ui::IpcTaskLink> link;
+  std::unique_ptr<orthoflow::ui::UiServer> server;
+  orthoflow::ui::ClientTarget web;
+#ifdef ORTHOFLOW_BENCH_DDS
+  std::unique_ptr<DdsStopper> dds;
+#else
+  if (path == 7) return state.SkipWithError("built without Cyclone DDS: no bridge");
+#endif
+  if (path == 2 || path >= 6) {
     if (!orthoflow::engine::probe_roudi())
       return state.SkipWithError("no RouDi running: start `iox-roudi -c config/roudi_test.toml`");
     (void)orthoflow::engine::init_ipc_runtime("orthoflow_stop_bench");
@@ -151,9 +242,28 @@ void BM_StopLatency(benchmark::State& state) {
     if (!l) return state.SkipWithError(l.error().c_str());
     listener = std::move(*l);
   }
+#ifdef ORTHOFLOW_BENCH_DDS
+  if (path == 7) {
+    dds = std::make_unique<DdsStopper>();
+    if (const std::string why = dds->start(); !why.empty()) return state.SkipWithError(why.c_str());
+  }
+#endif
+  if (path == 6) {
+    auto opened = orthoflow::ui::IpcTaskLink::open("tabletop");
+    if (!opened) return state.SkipWithError(opened.error().c_str());
+    link = std::move(*opened);
+    backend.set_task_link(link.get());
+    orthoflow::ui::UiServerConfig config;  // loopback, an ephemeral port
+    config.token = orthoflow::ui::generate_token();
+    config.rate = {1000.0, 1000.0, 64};  // this bench posts 1,000 stops in a row
+    auto started = orthoflow::ui::UiServer::start(config, backend);
+    if (!started) return state.SkipWithError(started.error().c_str());
+    server = std::move(*started);
+    web = {"127.0.0.1", server->port(), config.token, 5000};
+  }
   std::minstd_rand rng(11);
   Latencies lat;
-  int failures = 0;
+  int failures = 0, refused = 0;
   const int trials = 1000;
   for (auto _ : state) {
     for (int t = 0; t < trials; ++t) {
@@ -175,6 +285,16 @@ void BM_StopLatency(benchmark::State& state) {
         case 5:
           std::raise(SIGHUP);
           break;
+#ifdef ORTHOFLOW_BENCH_DDS
+        case 7:
+          if (!dds->send()) ++refused;
+          break;
+#endif
+        case 6:
+          if (auto r = orthoflow::ui::send_ui_request(web, "POST", "/api/arm/stop", "{}");
+              !r || r->status != 200)
+            ++refused;
+          break;
         default:
           since = steady_ns();  // the last feed was the last submit, just now
           break;
@@ -188,6 +308,13 @@ void BM_StopLatency(benchmark::State& state) {
   }
   lat.report(state);
   state.counters["lost"] = failures;
+  if (path == 6) state.counters["http_not_200"] = refused;
+  if (path == 7) state.counters["write_failed"] = refused;
+#ifdef ORTHOFLOW_BENCH_DDS
+  dds.reset();
+#endif
+  server.reset();
+  link.reset();
   listener.reset();
 }
 
@@ -261,7 +388,7 @@ void BM_StoppingDistance(benchmark::State& state) {
 
 BENCHMARK(BM_StoppingDistance)->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_StopLatency)
-    ->DenseRange(0, 5)
+    ->DenseRange(0, 7)
     ->ArgName("path")
     ->Iterations(1)
     ->Unit(benchmark::kMillisecond)
