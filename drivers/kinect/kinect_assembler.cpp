@@ -150,12 +150,10 @@ void FrameAssembler::push(std::span<const std::uint8_t> packet, std::int64_t hos
     ++stats_.wrong_stream;
     return;
   }
+  // Bytes 6-7 as a packet size are inferred (KINECT_V1.md 13, row 11) and libfreenect ignores
+  // them: a disagreement is counted, never a reason to drop (the length checks below decide).
   const std::size_t size_field = (std::size_t{packet[6]} << 8U) | packet[7];
-  if (size_field != packet.size()) {
-    // A packet whose own length field disagrees is corrupt somewhere we cannot see: drop it.
-    ++stats_.bad_size_field;
-    return;
-  }
+  if (size_field != packet.size()) ++stats_.bad_size_field;
   const std::uint8_t kind = flag & 0x0FU;
   const std::uint8_t seq = packet[5];
   const std::uint32_t ticks = static_cast<std::uint32_t>(packet[8]) |

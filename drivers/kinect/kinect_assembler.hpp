@@ -52,12 +52,14 @@ struct AssembledFrame {
 
 /// @brief Health counters of one stream (STYLE rule 16).
 struct AssemblerStats {
-  std::uint64_t packets = 0;            ///< packets seen, empty ones included
-  std::uint64_t empty_packets = 0;      ///< zero-length (idle microframes)
-  std::uint64_t short_header = 0;       ///< 1..11 bytes
-  std::uint64_t bad_magic = 0;          ///< not "RB"
-  std::uint64_t wrong_stream = 0;       ///< flag of another stream
-  std::uint64_t bad_size_field = 0;     ///< header size field disagrees with the packet length
+  std::uint64_t packets = 0;        ///< packets seen, empty ones included
+  std::uint64_t empty_packets = 0;  ///< zero-length (idle microframes)
+  std::uint64_t short_header = 0;   ///< 1..11 bytes
+  std::uint64_t bad_magic = 0;      ///< not "RB"
+  std::uint64_t wrong_stream = 0;   ///< flag of another stream
+  /// Header bytes 6-7 (an inferred size field) disagree with the packet length: counted only, the
+  /// packet is judged by its length as libfreenect judges it.
+  std::uint64_t bad_size_field = 0;
   std::uint64_t unsynced = 0;           ///< dropped while waiting for a start of frame
   std::uint64_t lost_packets = 0;       ///< sequence gaps of 1..5 (the slots became holes)
   std::uint64_t late_packets = 0;       ///< arrived 1..5 behind and filled their empty slot

@@ -114,7 +114,7 @@ struct HealthCounter {
   const char* name = "";
   std::uint64_t value = 0;
 };
-inline constexpr std::size_t HEALTH_COUNTERS = 19;
+inline constexpr std::size_t HEALTH_COUNTERS = 20;
 /// @brief The counters of @p health that people read (CLI, telemetry), named once, here.
 /// @note Never allocates.
 [[nodiscard]] std::array<HealthCounter, HEALTH_COUNTERS> health_counters(

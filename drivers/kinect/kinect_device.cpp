@@ -30,6 +30,8 @@ Result<std::unique_ptr<KinectDevice>, KinectError> KinectDevice::start(
   } else {
     device->no_accel_ = "accelerometer reads are off (accel_period 0)";
   }
+  device->steady_minus_transport_ns_ = std::chrono::steady_clock::now().time_since_epoch().count() -
+                                       device->transport_->clock().now_ns();
   KinectDevice* self = device.get();
   device->thread_ = std::thread([self] { self->run(); });
   return device;
@@ -73,6 +75,11 @@ void KinectDevice::read_accelerometer() noexcept {
   }
   up_read_ns_.store(now.time_since_epoch().count(), std::memory_order_relaxed);
   up_packed_.store(packed, std::memory_order_release);
+}
+
+std::int64_t KinectDevice::steady_ns_of(std::int64_t transport_ns) const noexcept {
+  const std::int64_t now = std::chrono::steady_clock::now().time_since_epoch().count();
+  return std::min(now, transport_ns + steady_minus_transport_ns_);
 }
 
 RawTiltReading KinectDevice::raw_tilt() const noexcept {

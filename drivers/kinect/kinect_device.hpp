@@ -73,6 +73,10 @@ class KinectDevice {
   [[nodiscard]] std::optional<GravityReading> gravity() const noexcept;
   /// @brief The latest motor state read (sequence 0: none yet). Any thread; wait-free.
   [[nodiscard]] RawTiltReading raw_tilt() const noexcept;
+  /// @brief A time on the transport's clock (DepthFrame::host_ns: the last packet's arrival) on
+  /// the host's steady clock: the offset measured at start (0 for libusb's steady clock; the
+  /// pacing offset of a simulated transport), the result never later than now.
+  [[nodiscard]] std::int64_t steady_ns_of(std::int64_t transport_ns) const noexcept;
   /// @brief Why the device reads no accelerometer (empty when it does). @pre none.
   [[nodiscard]] const std::string& no_accelerometer() const noexcept { return no_accel_; }
   /// @brief Accelerometer reads that failed or were not a plausible gravity. Any thread.
@@ -103,6 +107,7 @@ class KinectDevice {
   std::atomic<std::uint64_t> accel_failures_{0};
   std::atomic<std::uint64_t> raw_packed_{0};  // int16 x, y, z, then int8 tilt, uint8 status
   std::atomic<std::uint64_t> raw_sequence_{0};
+  std::int64_t steady_minus_transport_ns_ = 0;  // measured once, at start
   std::thread thread_;
 };
 

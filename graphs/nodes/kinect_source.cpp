@@ -58,7 +58,8 @@ class KinectSource final : public FrameSource {
     cloud_.info.frame_id = frames_++;
     // 60 MHz ticks to ns: x 50 / 3, exact in integers.
     cloud_.info.sensor_stamp_ns = static_cast<std::int64_t>(frame->device_ticks * 50 / 3);
-    cloud_.info.host_stamp_ns = std::chrono::steady_clock::now().time_since_epoch().count();
+    // Stamped with its arrival (the last packet's), not the time the graph took it.
+    cloud_.info.host_stamp_ns = device_->steady_ns_of(frame->host_ns);
     const auto gravity = device_->gravity();  // the USB thread's latest accelerometer reading
     cloud_.info.up = gravity ? gravity->up : std::array<float, 3>{};
     cloud_.info.up_age_ms = gravity ? gravity->age_ms : 0;

@@ -114,7 +114,7 @@ std::size_t SimIsoStreamGenerator::packet(std::int64_t microframe, const SimPack
   const Pending p = queue_[head_];
   head_ = (head_ + 1) % QUEUE;
   --count_;
-  return emit(p, out);
+  return emit(p, out, faults.size_field_zero);
 }
 
 void SimIsoStreamGenerator::generate(std::int64_t microframe, const SimPacketFaults& faults,
@@ -180,7 +180,8 @@ void SimIsoStreamGenerator::load(std::uint64_t frame) noexcept {
   loaded_[frame % 2] = frame;
 }
 
-std::size_t SimIsoStreamGenerator::emit(const Pending& p, std::span<std::byte> out) noexcept {
+std::size_t SimIsoStreamGenerator::emit(const Pending& p, std::span<std::byte> out,
+                                        bool zero_size) noexcept {
   load(p.frame);
   const std::size_t frame_bytes = stream_frame_bytes(mode_);
   const std::size_t payload = stream_payload_bytes(mode_);
@@ -200,8 +201,8 @@ std::size_t SimIsoStreamGenerator::emit(const Pending& p, std::span<std::byte> o
       static_cast<std::uint8_t>(stream_flag_ | kind),
       0x00,
       seq,
-      static_cast<std::uint8_t>(total >> 8),
-      static_cast<std::uint8_t>(total & 0xFFU),
+      static_cast<std::uint8_t>(zero_size ? 0U : total >> 8),
+      static_cast<std::uint8_t>(zero_size ? 0U : total & 0xFFU),
       static_cast<std::uint8_t>(ticks & 0xFFU),
       static_cast<std::uint8_t>((ticks >> 8) & 0xFFU),
       static_cast<std::uint8_t>((ticks >> 16) & 0xFFU),

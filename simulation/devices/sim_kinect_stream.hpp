@@ -60,6 +60,9 @@ struct SimPacketFaults {
   double duplicate_rate = 0.0;  ///< the packet arrives twice in consecutive microframes
   double corrupt_rate = 0.0;    ///< one byte of header or payload is XORed with a nonzero value
   double reorder_rate = 0.0;    ///< the packet and the next one of its frame arrive swapped
+  /// Header bytes 6-7 (read as a packet size, KINECT_V1.md 13 row 11) are written as zero: a
+  /// device that fills them differently from the brief's inference.
+  bool size_field_zero = false;
 };
 
 /// @brief What a generator did since construction (all packets, faults counted per event).
@@ -122,7 +125,7 @@ class SimIsoStreamGenerator {
   void push(std::uint64_t frame, std::uint32_t packet, const SimPacketFaults& faults,
             core::Rng& rng) noexcept;
   void enqueue(const Pending& p) noexcept;
-  std::size_t emit(const Pending& p, std::span<std::byte> out) noexcept;
+  std::size_t emit(const Pending& p, std::span<std::byte> out, bool zero_size) noexcept;
   void load(std::uint64_t frame) noexcept;
 
   std::uint8_t stream_flag_;

@@ -210,7 +210,6 @@ TEST(KinectAssembler, CorruptHeadersAreCountedAndNeverPlaced) {
   auto p = packetize(f, g, seq, 1);
   p[5][0] = 0x00;                // bad magic
   p[6][3] = 0x82;                // another stream's flag
-  p[7][7] ^= 0x01;               // size field disagrees
   p[8].resize(7);                // short header
   p[9].resize(p[9].size() + 4);  // oversize payload (size field fixed to match)
   p[9][6] = static_cast<std::uint8_t>(p[9].size() >> 8);
@@ -223,15 +222,35 @@ TEST(KinectAssembler, CorruptHeadersAreCountedAndNeverPlaced) {
   const auto& s = h.assembler.stats();
   EXPECT_EQ(s.bad_magic, 1U);
   EXPECT_EQ(s.wrong_stream, 1U);
-  EXPECT_EQ(s.bad_size_field, 1U);
   EXPECT_EQ(s.short_header, 1U);
   EXPECT_EQ(s.oversize, 1U);
   EXPECT_EQ(s.undersize, 1U);
   EXPECT_EQ(s.empty_packets, 1U);
   ASSERT_EQ(h.frames.size(), 1U);
   EXPECT_FALSE(h.frames[0].complete);
-  for (std::size_t k : {5, 6, 7, 8, 9, 10}) EXPECT_EQ(h.frames[0].present[k], 0) << k;
-  EXPECT_EQ(h.frames[0].packets_present, 242U - 6U);
+  for (std::size_t k : {5, 6, 8, 9, 10}) EXPECT_EQ(h.frames[0].present[k], 0) << k;
+  EXPECT_EQ(h.frames[0].packets_present, 242U - 5U);
+}
+
+// Header bytes 6-7 read as a packet size are inferred (KINECT_V1.md 13, row 11) and libfreenect
+// ignores them: packets whose field says anything else are placed as libfreenect places them, and
+// counted.
+TEST(KinectAssembler, ASizeFieldThatDisagreesIsCountedNotDropped) {
+  const auto g = depth_geometry(11);
+  Harness h(g);
+  std::uint8_t seq = 0;
+  const auto f = random_frame(g.frame_bytes, 13);
+  auto p = packetize(f, g, seq, 1);
+  p[7][7] ^= 0x01;  // off by one
+  p[8][6] = 0x00;   // zero
+  p[8][7] = 0x00;
+  p[241][6] = 0xFF;  // the last packet: far too large
+  p[241][7] = 0xFF;
+  h.feed(p);
+  ASSERT_EQ(h.frames.size(), 1U);
+  EXPECT_TRUE(h.frames[0].complete);
+  EXPECT_EQ(h.frames[0].bytes, f);
+  EXPECT_EQ(h.assembler.stats().bad_size_field, 3U);
 }
 
 TEST(KinectAssembler, WrongFlagAtAPositionResyncs) {

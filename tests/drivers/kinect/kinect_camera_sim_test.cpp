@@ -200,6 +200,35 @@ TEST(KinectCameraSim, SurvivesJunkEmptyWrongTagAndStalledReplies) {
   EXPECT_LE(usb.clock().now_ns() - before, 2'600'000'000LL);
 }
 
+// A device that writes header bytes 6-7 differently (here: zero) loses nothing: libfreenect
+// ignores them, and so does the assembler; the camera's health counts every disagreement.
+TEST(KinectCameraSim, ASizeFieldThatDisagreesLosesNoFrameAndIsCounted) {
+  SimUsbTransport usb;
+  SimKinectConfig c = kinect_config();
+  c.faults.packets.size_field_zero = true;
+  usb.add_kinect(c);
+  auto camera = KinectCamera::open(usb);
+  ASSERT_TRUE(camera.has_value());
+  KinectCamera& cam = *camera.value();
+  ASSERT_TRUE(cam.start_depth().has_value());
+  const auto frames = collect(usb, cam, 5, 3000ms);
+  ASSERT_GE(frames.size(), 5U);
+  std::vector<std::uint16_t> expected(DEPTH_PIXELS);
+  for (const DepthFrame& f : frames) {
+    EXPECT_TRUE(f.complete) << "frame " << f.number;
+    usb.kinect(0).depth_raw_image(f.number, expected);
+    EXPECT_EQ(f.raw, expected) << "frame " << f.number;
+  }
+  const CameraHealth h = cam.health();
+  EXPECT_GE(h.depth.bad_size_field, 5U * 242U);
+  const auto counters = health_counters(h);
+  const auto mismatch = std::find_if(counters.begin(), counters.end(), [](const auto& k) {
+    return std::string_view(k.name) == "size_field_mismatch";
+  });
+  ASSERT_NE(mismatch, counters.end());
+  EXPECT_EQ(mismatch->value, h.depth.bad_size_field);
+}
+
 TEST(KinectCameraSim, PacketLossGivesDegradedFramesWithExactlyTheMissingPixelsMarked) {
   SimUsbTransport usb;
   SimKinectConfig c = kinect_config();
