@@ -6,6 +6,8 @@
 #include <string_view>
 
 #include "engine/object_list_payload.hpp"
+#include "graphs/frame/frame_block.hpp"
+#include "kernels/table_verdict.hpp"
 
 namespace orthoflow::ui {
 
@@ -85,14 +87,17 @@ std::string_view refusal_text(Outcome outcome) {
 // The objects' boxes in the last camera image, or null before one was served.
 /// The frame's table verdict (docs/SEGMENTATION.md, "The table verdict"): null when not reported.
 Json table_json(const UiSnapshot& s) {
-  static constexpr const char* REASONS[] = {"accepted",  "held",         "no_plane",
-                                            "not_level", "out_of_range", "too_small"};
-  static constexpr const char* GRAVITY[] = {"none", "sensor", "configured"};
-  if (s.table_reason == 0 || s.table_reason > 6) return nullptr;
-  return {
-      {"found", s.table_reason <= 2},
-      {"reason", REASONS[s.table_reason - 1]},
-      {"gravity", s.gravity >= 1 && s.gravity <= 3 ? Json(GRAVITY[s.gravity - 1]) : Json(nullptr)}};
+  using kernels::TableReason;
+  if (s.table_reason == 0 || s.table_reason > static_cast<unsigned>(TableReason::TOO_SMALL) + 1U)
+    return nullptr;
+  const auto reason = static_cast<TableReason>(s.table_reason - 1U);
+  const bool known_gravity =
+      s.gravity >= 1 && s.gravity <= static_cast<unsigned>(graphs::Gravity::CONFIGURED) + 1U;
+  return {{"found", reason == TableReason::ACCEPTED || reason == TableReason::HELD},
+          {"reason", kernels::table_reason_name(reason)},
+          {"gravity", known_gravity
+                          ? Json(graphs::gravity_name(static_cast<graphs::Gravity>(s.gravity - 1U)))
+                          : Json(nullptr)}};
 }
 
 Json camera_json(const CameraBoxes& c) {

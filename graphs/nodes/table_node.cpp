@@ -109,7 +109,7 @@ class Table final : public engine::Node {
     kept_plane_ = s.plane;
     kept_inliers_ = s.plane_inliers;
     kept_check_ = s.plane_check;
-    kept_hull_ = std::min(u.size(), KEPT_HULL);
+    kept_hull_ = std::min(u.size(), MAX_HULL);
     std::copy_n(u.begin(), kept_hull_, kept_u_.begin());
     std::copy_n(v.begin(), kept_hull_, kept_v_.begin());
   }
@@ -127,7 +127,6 @@ class Table final : public engine::Node {
     s.table_reason = TableReason::HELD;
   }
 
-  static constexpr std::size_t KEPT_HULL = MAX_HULL;
   std::size_t capacity_;
   std::string name_;
   kernels::SegmentationParams params_;
@@ -139,7 +138,7 @@ class Table final : public engine::Node {
   kernels::Plane kept_plane_{};
   std::uint32_t kept_inliers_ = 0;
   kernels::PlaneCheck kept_check_{};
-  std::array<double, KEPT_HULL> kept_u_{}, kept_v_{};
+  std::array<double, MAX_HULL> kept_u_{}, kept_v_{};
 };
 
 }  // namespace
