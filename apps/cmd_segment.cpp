@@ -105,6 +105,8 @@ nlohmann::json to_json(const kernels::SegmentationResult& seg, const nlohmann::j
           {"objects", stats_json(seg.candidates)},
           {"rejected",
            {{"size", c.rejected_size}, {"edge", c.rejected_edge}, {"capacity", c.over_capacity}}},
+          // the work budget: objects' points are those clustered, every stride-th pixel and row
+          {"budget", {{"stride", seg.stride}, {"refined", seg.refined}}},
           {"timings_ms", timings}};
 }
 

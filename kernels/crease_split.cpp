@@ -55,7 +55,16 @@ Result<std::size_t, ClusterError> ObjectStage::cluster_crowded(
                              std::span(nz_).first(n)};
     const RowRange rows{static_cast<std::uint32_t>(first_row >= g ? first_row - g : 0),
                         static_cast<std::uint32_t>(std::min(h, last_row + g + 1))};
-    organized_normals(cloud, p.crease.normals, normals, rows);
+    // Thinned by the budget to every s-th row, with s dividing the gap: the crease test reads
+    // normals only on grid rows (its members' and those g rows away), so only they are computed.
+    const std::uint32_t s = p.cluster.pixel_step;
+    if (s > 1 && g % s == 0) {
+      for (std::uint32_t r = (rows.begin + s - 1) / s * s; r < rows.end; r += s) {
+        organized_normals(cloud, p.crease.normals, normals, {r, r + 1});
+      }
+    } else {
+      organized_normals(cloud, p.crease.normals, normals, rows);
+    }
   } else {
     first_row = last_row = 0;
   }
@@ -82,7 +91,7 @@ Result<std::size_t, ClusterError> ObjectStage::cluster_crowded(
   if (!clusters) return clusters;
   // Crease pixels take the label of the nearest labelled pixel within the window and tolerance;
   // round k only reads pixels labelled before it, so a band fills from both of its sides evenly.
-  const std::size_t rad = p.cluster.pixel_radius;
+  const std::size_t rad = p.cluster.pixel_radius, step = p.cluster.pixel_step;
   const float tol2 = p.cluster.tolerance * p.cluster.tolerance;
   for (std::uint32_t k = 1; k <= p.crease.attach_rounds && k < UNATTACHED; ++k) {
     std::size_t still = 0;  // the pending list, compacted as pixels attach
@@ -91,8 +100,9 @@ Result<std::size_t, ClusterError> ObjectStage::cluster_crowded(
       const std::size_t r = i / w, c = i % w;
       float best = tol2;
       std::int32_t label = -1;
-      for (std::size_t rr = r >= rad ? r - rad : 0; rr <= std::min(h - 1, r + rad); ++rr) {
-        for (std::size_t cc = c >= rad ? c - rad : 0; cc <= std::min(w - 1, c + rad); ++cc) {
+      // Thinned frames label grid pixels only (r, c and rad are multiples of the stride there).
+      for (std::size_t rr = r >= rad ? r - rad : 0; rr <= std::min(h - 1, r + rad); rr += step) {
+        for (std::size_t cc = c >= rad ? c - rad : 0; cc <= std::min(w - 1, c + rad); cc += step) {
           const std::size_t j = rr * w + cc;
           if (labels[j] < 0 || round_[j] >= k) continue;
           const float dx = pts.x[j] - pts.x[i], dy = pts.y[j] - pts.y[i], dz = pts.z[j] - pts.z[i];

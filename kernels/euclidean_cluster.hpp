@@ -25,12 +25,17 @@ struct ClusterParams {
       std::numeric_limits<std::uint32_t>::max();  ///< larger components get label -1
   std::uint32_t pixel_radius =
       2;  ///< organized only: neighbours within this many pixels (Chebyshev)
+  /// Organized only: the mask holds pixels on every pixel_step-th row and column only (the object
+  /// stage's budget thinned it; pixel_radius a multiple of it), so the window visits those alone.
+  /// The partition is the one pixel_step 1 gives on the same mask.
+  std::uint32_t pixel_step = 1;
 };
 
 /// @brief Why clustering refused to run.
 struct ClusterError {
   enum class Code : std::uint8_t {
-    BAD_PARAMS,         ///< tolerance not finite or <= 0, min_size > max_size, pixel_radius 0
+    BAD_PARAMS,         ///< tolerance not finite or <= 0, min_size > max_size, pixel_radius 0,
+                        ///< pixel_step 0 or not dividing pixel_radius
     SCRATCH_TOO_SMALL,  ///< scratch capacity below the point count
     GRID_OVERFLOW,      ///< extent / tolerance needs more than 64 bits of cell key
   };

@@ -77,25 +77,27 @@ struct Linker {
 /// is seen from its later pixel. Row runs: when the left pixel i-1 is included, was clean (every
 /// included pixel of its window ended in its component) and links to i, the part of i's window that
 /// i-1's window covers is in i's component already, so only the new column u + r of the rows above
-/// is visited (the partition is the same, far fewer edges are tested). @return whether i is clean.
+/// is visited (the partition is the same, far fewer edges are tested). On a mask thinned to every
+/// pixel_step-th row and column, "adjacent" and the window are on that grid. @return whether i is
+/// clean.
 bool link_window(PointsView p, std::size_t w, std::size_t u, std::size_t v,
                  const ClusterParams& prm, std::uint32_t* parent, bool left_clean) {
-  const std::size_t r = prm.pixel_radius, i = v * w + u;
+  const std::size_t r = prm.pixel_radius, st = prm.pixel_step, i = v * w + u;
   const std::size_t u_lo = u >= r ? u - r : 0, u_hi = std::min(w - 1, u + r),
                     v_lo = v >= r ? v - r : 0;
   Linker link{p,      parent, prm.tolerance * prm.tolerance, p.x[i],
               p.y[i], p.z[i], static_cast<std::uint32_t>(i)};
   if (left_clean) {
-    link.visit(i - 1);
-    if (link.root != i) {  // i joined i-1's component
-      for (std::size_t vv = v_lo; vv < v && u + r < w; ++vv) { link.visit(vv * w + u + r); }
+    link.visit(i - st);
+    if (link.root != i) {  // i joined its left neighbour's component
+      for (std::size_t vv = v_lo; vv < v && u + r < w; vv += st) { link.visit(vv * w + u + r); }
       parent[i] = link.root;
       return link.clean;
     }
   }
-  for (std::size_t vv = v_lo; vv <= v; ++vv) {
+  for (std::size_t vv = v_lo; vv <= v; vv += st) {
     const std::size_t end = vv == v ? u : u_hi + 1;
-    for (std::size_t uu = u_lo; uu < end; ++uu) { link.visit(vv * w + uu); }
+    for (std::size_t uu = u_lo; uu < end; uu += st) { link.visit(vv * w + uu); }
   }
   parent[i] = link.root;  // path compression: later windows then mostly see the root directly
   return link.clean;
@@ -145,7 +147,8 @@ Result<std::size_t, ClusterError> euclidean_cluster_organized(
     while (i >= row_start + w) {
       ++v, row_start += w;
     }  // rows from the ascending list: no division
-    const bool left_clean = previous_clean && previous + 1 == i && i > row_start;
+    const bool left_clean =
+        previous_clean && previous + params.pixel_step == i && i >= row_start + params.pixel_step;
     previous_clean = link_window(p, w, i - row_start, v, params, scratch.parent.data(), left_clean);
     previous = i;
   }

@@ -21,6 +21,36 @@ double inside_distance(double u, double v, std::span<const double> hu,
   return best;
 }
 
+namespace {
+
+constexpr std::int32_t OVER = -2;  // passed both constraints, found the candidates full
+
+float range2(const ClusterStats& st) noexcept {
+  return st.centroid[0] * st.centroid[0] + st.centroid[1] * st.centroid[1] +
+         st.centroid[2] * st.centroid[2];
+}
+
+/// Swaps each candidate left over for the farthest kept one while it is nearer (ties: the lower
+/// cluster index is nearer), then numbers the kept ones in cluster order again; the rest get -1.
+void keep_nearest(std::span<const ClusterStats> clusters, std::span<std::int32_t> slot_of) {
+  auto nearer = [&](std::size_t a, std::size_t b) {
+    const float ra = range2(clusters[a]), rb = range2(clusters[b]);
+    return ra < rb || (ra == rb && a < b);
+  };
+  for (std::size_t c = 0; c < clusters.size(); ++c) {
+    if (slot_of[c] != OVER) continue;
+    std::size_t far = clusters.size();
+    for (std::size_t k = 0; k < clusters.size(); ++k) {
+      if (slot_of[k] >= 0 && (far == clusters.size() || nearer(far, k))) far = k;
+    }
+    if (far < clusters.size() && nearer(c, far)) std::swap(slot_of[c], slot_of[far]);
+  }
+  std::int32_t next = 0;
+  for (auto& slot : slot_of) slot = slot >= 0 ? next++ : -1;
+}
+
+}  // namespace
+
 CandidateCounts select_candidates(std::span<const ClusterStats> clusters, const Plane& plane,
                                   std::span<const double> hu, std::span<const double> hv,
                                   const CandidateParams& p, std::size_t max_candidates,
@@ -46,10 +76,12 @@ CandidateCounts select_candidates(std::span<const ClusterStats> clusters, const 
     }
     if (counts.kept == max_candidates) {
       ++counts.over_capacity;
+      slot_of[c] = OVER;
       continue;
     }
     slot_of[c] = static_cast<std::int32_t>(counts.kept++);
   }
+  if (counts.over_capacity > 0) keep_nearest(clusters, slot_of.first(clusters.size()));
   return counts;
 }
 

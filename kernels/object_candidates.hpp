@@ -37,7 +37,9 @@ struct CandidateCounts {
                                      std::span<const double> hv) noexcept;
 
 /// @brief Applies C_size and C_edge to @p clusters in order; slot_of[c] = the candidate index of
-/// cluster c (0, 1, ... in cluster order) or -1 when rejected. At most @p max_candidates are kept.
+/// cluster c (0, 1, ... in cluster order) or -1 when rejected. At most @p max_candidates are kept:
+/// when more pass, the nearest to the sensor (centroid range; ties: cluster order), so a crowded
+/// frame drops its farthest objects (kernels::ObjectBudget step 3).
 /// @pre slot_of.size() >= clusters.size(); hu/hv in make_plane_basis(plane). Allocation-free,
 /// deterministic.
 CandidateCounts select_candidates(std::span<const ClusterStats> clusters, const Plane& plane,

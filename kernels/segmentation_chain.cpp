@@ -64,7 +64,9 @@ Result<SegmentationResult, SegmentationError> SegmentationChain::run(CloudView c
                             t,
                             table_result->hull_u,
                             table_result->hull_v,
-                            input_result->dense.size()};
+                            input_result->dense.size(),
+                            objects_result->stride,
+                            objects_result->refined};
 }
 
 }  // namespace orthoflow::kernels

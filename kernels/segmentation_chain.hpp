@@ -45,6 +45,8 @@ struct SegmentationResult {
   SegmentationTimings timings;
   std::span<const double> hull_u, hull_v;  ///< the support polygon (make_plane_basis of the plane)
   std::size_t plane_sample = 0;            ///< the dense plane-input points (the verdict's share)
+  std::uint32_t stride = 1;                ///< the object stage's budget: ObjectClusters::stride
+  bool refined = true;                     ///< and ObjectClusters::refined
 };
 
 /// @brief Pre-sized tabletop segmentation. @note Not thread-safe; one instance per thread.

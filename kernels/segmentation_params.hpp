@@ -60,6 +60,21 @@ struct CreaseParams {
 };
 
 /// @brief Chain settings; defaults are the PCL baseline's (specs/BASELINES.md).
+/// @brief The object stage's work budget, fixed at start (issue 50 item 3). A frame beyond it is
+/// degraded in this order, deterministically, and ObjectClusters says how:
+/// 1. more than max_points prism pixels (organized path): only every s-th pixel of every s-th row
+///    is clustered, s = 2, 3 or 4, the smallest that fits (at most 4); the cluster window and the
+///    cluster sizes in points scale with it, so the same metric neighbourhood links pixels;
+/// 2. more than max_refine_clusters clusters: the crowded refinements (footprint merge, occlusion
+///    join, neck split) are skipped;
+/// 3. more candidates than the caller keeps: the nearest to the sensor are kept
+///    (kernels::select_candidates with nearest_first), the farthest dropped.
+/// 0 turns a limit off.
+struct ObjectBudget {
+  std::size_t max_points = 0;
+  std::size_t max_refine_clusters = 0;
+};
+
 struct SegmentationParams {
   AxisBox roi{{-1.0F, -1.0F, 0.3F}, {1.0F, 1.0F, 2.0F}};
   float leaf = 0.005F;  ///< 0: no voxel grid
@@ -79,6 +94,7 @@ struct SegmentationParams {
   float merge_overlap = 0.0F;
   ClusterMode cluster_mode = ClusterMode::EUCLIDEAN;
   CreaseParams crease{};
+  ObjectBudget budget{};
 };
 
 }  // namespace orthoflow::kernels

@@ -179,12 +179,17 @@ struct ObjectClusters {
   PointsView
       target;  ///< the points labelled: the full-resolution pixels (organized) or the plane input
   std::span<const std::int32_t> labels;  ///< per target point: cluster id or -1
-  std::span<const std::uint32_t>
-      members;  ///< ascending superset of the labelled indices (all when empty)
+  /// Ascending superset of the clustered indices (all when empty). At stride > 1 the prism pixels
+  /// thinned out are not members but are labelled too, from the nearest clustered pixel of their
+  /// stride cell's corners within the cluster tolerance, so labels stay dense for the pixel-level
+  /// evaluation and the labels output while statistics and descriptors use the members.
+  std::span<const std::uint32_t> members;
   std::span<const ClusterStats> clusters;  ///< after the footprint merge
-  std::size_t prism_points = 0;            ///< points inside the prism
+  std::size_t prism_points = 0;            ///< points inside the prism (before any thinning)
   double prism_ms = 0.0,
-         cluster_ms = 0.0;  ///< wall time of the prism and of clusters + merge + statistics
+         cluster_ms = 0.0;   ///< wall time of the prism and of clusters + merge + statistics
+  std::uint32_t stride = 1;  ///< budget step 1: every stride-th pixel and row clustered (1: all)
+  bool refined = true;       ///< false: budget step 2 skipped the crowded refinements
 };
 
 /// @brief Stage 3: prism, clusters, footprint merge, statistics. @note Not thread-safe.
@@ -220,6 +225,7 @@ class ObjectStage {
       CloudView cloud, const SegmentationParams& p) noexcept;
   std::vector<float> heights_;
   std::vector<std::uint8_t> mask_;
+  std::vector<std::uint8_t> prism_mask_;  // the prism before the budget's thinning
   std::vector<std::int32_t> labels_;
   std::vector<ClusterMoments> moments_;
   std::vector<ClusterStats> stats_;

@@ -7,16 +7,21 @@
 // stamp -> frame fully processed) p50 / p99 / p99.9 / max and the frames over 33.3 ms (a 30 Hz
 // deadline); beside it, in the same run, PCL 1.13's classic chain (specs/BASELINES.md) on the same
 // frames, timed per frame. Inputs: the 45 mOSD learn-split frames, the same frames unorganized (the
-// NaN pixels dropped, HEIGHT 1, as ROS bags store them), synthetic sequences with 3, 10 and 30
-// objects. Usage: graph_latency_vs_pcl [--frames N] (synthetic frames per input, default 300; PCL
+// NaN pixels dropped, HEIGHT 1, as ROS bags store them), synthetic sequences with 3, 10, 16 and 30
+// objects, and the hostile inputs of issue 50 (tests/support/hostile_frames.hpp: sensor noise, a
+// wall, no reading, a hand at the lens, a person at a desk, a heap of 60 objects). Per input it also
+// reports the objects and track nodes' p99 and the objects node's budget counters (degraded_*). Usage: graph_latency_vs_pcl [--frames N] (synthetic frames per input, default 300; PCL
 // runs on the first 30 of them) plus Google Benchmark flags.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <unistd.h>
@@ -28,6 +33,7 @@
 #include "graphs/embedded_graphs.hpp"
 #include "graphs/tabletop.hpp"
 #include "simulation/world/synthetic_sequence.hpp"
+#include "tests/support/hostile_frames.hpp"
 #include "tests/support/unorganized_copy.hpp"
 
 namespace {
@@ -38,6 +44,7 @@ namespace ok = orthoflow::kernels;
 namespace fs = std::filesystem;
 
 std::uint64_t g_synthetic_frames = 300;
+std::uint64_t g_hostile_frames = 40;
 constexpr std::size_t PCL_SYNTHETIC_FRAMES = 30;
 constexpr double DEADLINE_MS = 1000.0 / 30.0;
 
@@ -82,6 +89,17 @@ void run_graph(benchmark::State& state, const oe::GraphSpec& spec) {
   state.counters["graph_p999_ms"] = ms(lat.percentile(0.999));
   state.counters["graph_max_ms"] = ms(lat.max());
   state.counters["frames"] = double(lat.count());
+  for (const auto& node : engine.stats().nodes) {
+    if (node.name == "objects" || node.name == "track") {
+      state.counters[node.name + "_p99_ms"] = ms(node.service.percentile(0.99));
+    }
+    if (!node.device || std::string_view(node.counter_group) != "budget") continue;
+    std::array<oe::DeviceCounter, oe::MAX_DEVICE_COUNTERS> counters{};
+    const std::size_t n = node.device(counters);
+    for (std::size_t k = 0; k < n; ++k) {
+      state.counters[std::string("degraded_") + counters[k].name] = double(counters[k].value);
+    }
+  }
   std::size_t over = 0;  // the histogram's buckets do not give an exact count; the max bounds it
   over = lat.max() > static_cast<std::int64_t>(DEADLINE_MS * 1e6) ? 1 : 0;
   state.counters["max_over_33ms"] = double(over);  // 0: no frame missed a 30 Hz deadline
@@ -158,6 +176,28 @@ void BM_Synthetic(benchmark::State& state, std::uint32_t objects) {
   }
 }
 
+/// An input of tests/support/hostile_frames.hpp: its frames written once into a temporary folder
+/// and replayed by pcd_source; PCL on the same frames.
+void BM_Hostile(benchmark::State& state, orthoflow::test::Hostile input) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("orthoflow_hostile_" + std::to_string(::getpid()) + "_" +
+                                   std::string(orthoflow::test::hostile_name(input)));
+  fs::create_directories(dir);
+  std::vector<ok::PointCloud> clouds;
+  for (std::uint64_t k = 0; k < g_hostile_frames; ++k) {
+    ok::PointCloud c = orthoflow::test::hostile_frame(input, 50, k);
+    char name[32];
+    std::snprintf(name, sizeof name, "frame_%04llu.pcd", static_cast<unsigned long long>(k));
+    (void)orthoflow::formats::write_pcd(c, dir / name);
+    if (clouds.size() < PCL_SYNTHETIC_FRAMES) clouds.push_back(std::move(c));
+  }
+  for (auto _ : state) {
+    run_graph(state, spec_with_source("pcd_source", {{"dir", dir.string()}}));
+    run_pcl(state, clouds);
+  }
+  fs::remove_all(dir);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -176,7 +216,14 @@ int main(int argc, char** argv) {
   benchmark::RegisterBenchmark("graph_vs_pcl/mosd_learn_unorganized", BM_LearnSplit, true)
       ->Iterations(1)
       ->Unit(benchmark::kMillisecond);
-  for (const std::uint32_t objects : {3U, 10U, 30U}) {
+  for (const auto input : orthoflow::test::HOSTILE_INPUTS) {
+    benchmark::RegisterBenchmark(
+        ("graph_vs_pcl/" + std::string(orthoflow::test::hostile_name(input))).c_str(), BM_Hostile,
+        input)
+        ->Iterations(1)
+        ->Unit(benchmark::kMillisecond);
+  }
+  for (const std::uint32_t objects : {3U, 10U, 16U, 30U}) {
     benchmark::RegisterBenchmark(("graph_vs_pcl/synthetic_" + std::to_string(objects)).c_str(),
                                  BM_Synthetic, objects)
         ->Iterations(1)

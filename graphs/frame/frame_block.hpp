@@ -151,6 +151,12 @@ struct FrameState {
   std::uint32_t rejected_edge = 0;      ///< failed C_edge
   std::uint32_t rejected_capacity = 0;  ///< passed both but found the MAX_OBJECTS records full
   std::uint32_t object_count = 0;       ///< candidates kept in objects
+  /// What the objects stage's budget (kernels::ObjectBudget) spared on this frame: the prism's
+  /// pixels before thinning, the stride it clustered at (1: every pixel), whether the crowded
+  /// refinements ran; the farthest candidates it dropped are rejected_capacity.
+  std::uint32_t prism_points = 0;
+  std::uint8_t stride = 1;
+  bool refined = true;
   std::array<ObjectRecord, MAX_OBJECTS> objects{};
   FrameError error;  ///< why a stage produced nothing for this frame (empty = fine)
 };

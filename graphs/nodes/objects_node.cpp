@@ -8,6 +8,7 @@
 #include <array>
 #include <vector>
 
+#include "graphs/nodes/budget_counters.hpp"
 #include "graphs/nodes/labels_writer.hpp"
 #include "graphs/nodes/node_support.hpp"
 #include "graphs/nodes/segment_nodes.hpp"
@@ -44,6 +45,9 @@ class Objects final : public engine::Node {
     const FrameBlock block = block_of(in, capacity_);
     FrameState& s = block.state();
     s.object_count = s.clusters = s.rejected_size = s.rejected_edge = s.rejected_capacity = 0;
+    s.prism_points = 0;
+    s.stride = 1;
+    s.refined = true;
     auto frame = block.frame();
     labelled_ = false;
     if (s.table_found && frame) segment(block, *frame);
@@ -51,7 +55,12 @@ class Objects final : public engine::Node {
       labels_->offer(frame->header->frame_id, frame->cloud, s.plane, p_.stages.ransac.tau, s.roi,
                      {}, {});
     }
+    budget_.record(s);
     out.emit(0, in);
+  }
+  const char* counter_group() const noexcept override { return "budget"; }
+  std::size_t device_counters(std::span<engine::DeviceCounter> out) const noexcept override {
+    return budget_.read(out);
   }
 
  private:
@@ -70,6 +79,9 @@ class Objects final : public engine::Node {
       return;
     }
     s.clusters = static_cast<std::uint32_t>(found->clusters.size());
+    s.prism_points = static_cast<std::uint32_t>(found->prism_points);
+    s.stride = static_cast<std::uint8_t>(found->stride);
+    s.refined = found->refined;
     const kernels::CandidateCounts counts = kernels::select_candidates(
         found->clusters, s.plane, table.hull_u, table.hull_v, p_.candidates, MAX_OBJECTS, slot_of_);
     s.rejected_size = static_cast<std::uint32_t>(counts.rejected_size);
@@ -117,6 +129,7 @@ class Objects final : public engine::Node {
   bool labelled_ = false;  // this frame's labels were offered
   std::string name_;
   TabletopSegmentation p_;
+  BudgetCounters budget_;
   kernels::ObjectStage stage_;
   std::vector<std::int32_t> slot_of_;
   std::vector<std::uint32_t> truth_counts_;

@@ -12,6 +12,10 @@ kernels::SegmentationParams TabletopSegmentation::defaults() noexcept {
   kernels::SegmentationParams p;
   p.cluster = kernels::ClusterParams{0.02F, 50, 200000, 2};
   p.merge_overlap = 0.3F;
+  // The work budget (issue 50 item 3), chosen on the 45 mOSD learn frames (docs/SEGMENTATION.md,
+  // "The work budget"): their prisms hold 10,000-40,262 pixels, most are clustered at stride 2 and
+  // score no worse than at full resolution.
+  p.budget = kernels::ObjectBudget{12000, 96};
   return p;
 }
 
@@ -88,12 +92,13 @@ Result<void, std::string> parse_table_params(const engine::ParamMap& params,
 
 Result<void, std::string> parse_objects_params(const engine::ParamMap& params,
                                                TabletopSegmentation& out) {
-  if (auto ok = params.only({"h_min",        "h_max",          "tolerance",    "min_points",
-                             "max_points",   "pixel_radius",   "min_size",     "max_size",
-                             "edge_margin",  "merge_overlap",  "cluster_mode", "crease_angle",
-                             "crease_gap",   "normal_offset",  "max_rise",     "depth_change",
-                             "stand_height", "occlusion_rows", "occluder_gap", "occlusion_top",
-                             "neck_cell",    "neck_core",      "neck_ratio",   "neck_round"});
+  if (auto ok = params.only({"h_min",         "h_max",          "tolerance",    "min_points",
+                             "max_points",    "pixel_radius",   "min_size",     "max_size",
+                             "edge_margin",   "merge_overlap",  "cluster_mode", "crease_angle",
+                             "crease_gap",    "normal_offset",  "max_rise",     "depth_change",
+                             "stand_height",  "occlusion_rows", "occluder_gap", "occlusion_top",
+                             "neck_cell",     "neck_core",      "neck_ratio",   "neck_round",
+                             "budget_points", "budget_clusters"});
       !ok) {
     return err(ok.error());
   }
@@ -131,6 +136,9 @@ Result<void, std::string> parse_objects_params(const engine::ParamMap& params,
   take(params.number("neck_core", k.neck_core, 0.001, 0.3), k.neck_core, e);
   take(params.number("neck_ratio", k.neck_ratio, 0.0, 0.95), k.neck_ratio, e);
   take(params.number("neck_round", k.neck_round, 1.0, 100.0), k.neck_round, e);
+  take(params.integer("budget_points", p.budget.max_points, 0, 1U << 24), p.budget.max_points, e);
+  take(params.integer("budget_clusters", p.budget.max_refine_clusters, 0, 100000),
+       p.budget.max_refine_clusters, e);
   take(params.number("min_size", c.min_size, 0.0, 10.0), c.min_size, e);
   take(params.number("max_size", c.max_size, 0.0, 10.0), c.max_size, e);
   take(params.number("edge_margin", c.edge_margin, -1.0, 1.0), c.edge_margin, e);

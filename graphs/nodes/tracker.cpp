@@ -9,10 +9,10 @@ namespace {
 
 constexpr std::size_t MAX_INPUTS = 256;  // clusters per frame the share matrix has room for
 
-// Share of the points inside [lo - m, hi + m] shifted by `shift`.
-float share_inside(kernels::PointsView p, const std::array<float, 3>& lo,
-                   const std::array<float, 3>& hi, const std::array<float, 3>& shift,
-                   float m) noexcept {
+// Share of the points inside [lo - m, hi + m] shifted by `shift`: every point tested.
+float share_inside_scan(kernels::PointsView p, const std::array<float, 3>& lo,
+                        const std::array<float, 3>& hi, const std::array<float, 3>& shift,
+                        float m) noexcept {
   if (p.empty()) return 0.0F;
   std::size_t inside = 0;
   for (std::size_t i = 0; i < p.size(); ++i) {
@@ -25,22 +25,64 @@ float share_inside(kernels::PointsView p, const std::array<float, 3>& lo,
 
 }  // namespace
 
+float share_inside(kernels::PointsView p, const std::array<float, 3>& lo,
+                   const std::array<float, 3>& hi, const std::array<float, 3>& shift, float m,
+                   const std::array<float, 3>& p_lo, const std::array<float, 3>& p_hi,
+                   bool bounds_known) noexcept {
+  if (p.empty()) return 0.0F;
+  if (bounds_known) {
+    // Rounding is monotonic, so (max x) - shift is the largest of the points' x - shift: a box
+    // outside on one axis holds no point, a box that holds the bounds holds every point. Exact.
+    bool all = true;
+    for (std::size_t a = 0; a < 3; ++a) {
+      const float b0 = p_lo[a] - shift[a], b1 = p_hi[a] - shift[a];
+      if (b1 < lo[a] - m || b0 > hi[a] + m) return 0.0F;
+      all = all && b0 >= lo[a] - m && b1 <= hi[a] + m;
+    }
+    if (all) return 1.0F;
+  }
+  return share_inside_scan(p, lo, hi, shift, m);
+}
+
+float share_inside_reference(kernels::PointsView p, const std::array<float, 3>& lo,
+                             const std::array<float, 3>& hi, const std::array<float, 3>& shift,
+                             float m) noexcept {
+  return share_inside_scan(p, lo, hi, shift, m);
+}
+
 Tracker::Tracker(const TrackerParams& params) : params_(params) {
   tracks_.reserve(params.max_tracks);
   share_.resize(MAX_INPUTS * params.max_tracks);
+  bounds_.resize(MAX_INPUTS);
   pair_.resize(MAX_INPUTS);
   taken_.resize(params.max_tracks);
 }
 
 void Tracker::match(std::int64_t stamp_ns, std::span<const TrackInput> inputs) noexcept {
   const std::size_t nt = tracks_.size();
+  for (std::size_t i = 0; i < inputs.size(); ++i) {  // one pass over the points, not one per track
+    const kernels::PointsView p = inputs[i].points;
+    PointBounds& b = bounds_[i];
+    b.finite = true;
+    b.lo = {p.empty() ? 0.0F : p.x[0], p.empty() ? 0.0F : p.y[0], p.empty() ? 0.0F : p.z[0]};
+    b.hi = b.lo;
+    for (std::size_t k = 0; k < p.size(); ++k) {
+      const float c[3] = {p.x[k], p.y[k], p.z[k]};
+      for (std::size_t a = 0; a < 3; ++a) {
+        b.finite = b.finite && std::isfinite(c[a]);
+        b.lo[a] = std::min(b.lo[a], c[a]);
+        b.hi[a] = std::max(b.hi[a], c[a]);
+      }
+    }
+  }
   for (std::size_t t = 0; t < nt; ++t) {
     const Track& tr = tracks_[t];
     const auto dt = static_cast<float>(static_cast<double>(stamp_ns - tr.last_seen_ns) * 1e-9);
     const std::array<float, 3> shift{tr.velocity[0] * dt, tr.velocity[1] * dt, tr.velocity[2] * dt};
     for (std::size_t i = 0; i < inputs.size(); ++i) {
       share_[i * nt + t] =
-          share_inside(inputs[i].points, tr.box_min, tr.box_max, shift, params_.box_margin);
+          share_inside(inputs[i].points, tr.box_min, tr.box_max, shift, params_.box_margin,
+                       bounds_[i].lo, bounds_[i].hi, bounds_[i].finite);
     }
   }
   std::fill(pair_.begin(), pair_.begin() + static_cast<std::ptrdiff_t>(inputs.size()), -1);

@@ -32,6 +32,19 @@ struct TrackerParams {
   std::size_t max_tracks = 64;
 };
 
+/// @brief Share of the points @p p inside the box [lo - m, hi + m] moved by @p shift. With @p
+/// bounds_known, [p_lo, p_hi] is the points' exact bounding box: a box that misses it on one axis
+/// gives 0 and one that holds it gives 1 without a scan, otherwise every point is tested; the
+/// result equals share_inside_reference() bit for bit. Allocation-free.
+[[nodiscard]] float share_inside(kernels::PointsView p, const std::array<float, 3>& lo,
+                                 const std::array<float, 3>& hi, const std::array<float, 3>& shift,
+                                 float m, const std::array<float, 3>& p_lo,
+                                 const std::array<float, 3>& p_hi, bool bounds_known) noexcept;
+/// @brief The scalar reference twin of share_inside(): every point tested.
+[[nodiscard]] float share_inside_reference(kernels::PointsView p, const std::array<float, 3>& lo,
+                                           const std::array<float, 3>& hi,
+                                           const std::array<float, 3>& shift, float m) noexcept;
+
 /// @brief One cluster of the current frame, as the tracker sees it.
 struct TrackInput {
   kernels::PointsView points;
@@ -65,6 +78,11 @@ class Tracker {
   [[nodiscard]] std::uint32_t started() const noexcept { return next_id_ - 1; }
 
  private:
+  /// The exact bounding box of an input's points (finite: every coordinate of every point was).
+  struct PointBounds {
+    std::array<float, 3> lo{}, hi{};
+    bool finite = false;
+  };
   struct Track {
     std::uint32_t id = 0;
     std::array<float, 3> centroid{}, velocity{}, box_min{}, box_max{};
@@ -84,6 +102,7 @@ class Tracker {
   std::vector<float> share_;         // inputs x tracks, reserved once
   std::vector<std::int32_t> pair_;   // input -> track index or -1
   std::vector<std::uint8_t> taken_;  // track already paired
+  std::vector<PointBounds> bounds_;  // per input: its points' exact bounding box
   std::uint32_t next_id_ = 1;
 };
 

@@ -120,6 +120,10 @@ void SessionLog::write_json(const FrameBlock& block, std::uint64_t frame_id) noe
         out + n, cap - n, R"("support":{"share":%.4f,"area_m2":%.4f,"height_m":%.4f},)",
         static_cast<double>(s.judged.share), static_cast<double>(s.judged.area_m2),
         static_cast<double>(s.judged.height_m)));
+  n += static_cast<std::size_t>(std::snprintf(  // what the objects stage's budget spared
+      out + n, cap - n,
+      R"("budget":{"prism_points":%u,"stride":%u,"refined":%s,"far_dropped":%u},)", s.prism_points,
+      static_cast<unsigned>(s.stride), s.refined ? "true" : "false", s.rejected_capacity));
   n += write_plane(s, out + n, cap - n);
   for (std::uint32_t k = 0; k < s.object_count && n + 2048 < cap; ++k) {
     const ObjectRecord& o = s.objects[k];

@@ -47,7 +47,9 @@ inline Result<std::size_t, ClusterError> check(std::size_t n, const ClusterParam
   if (prm.min_size > prm.max_size) {
     return err(ClusterError{Code::BAD_PARAMS, double(prm.min_size)});
   }
-  if (prm.pixel_radius == 0) { return err(ClusterError{Code::BAD_PARAMS, 0.0}); }
+  if (prm.pixel_radius == 0 || prm.pixel_step == 0 || prm.pixel_radius % prm.pixel_step != 0) {
+    return err(ClusterError{Code::BAD_PARAMS, 0.0});
+  }
   if (n > s.capacity()) { return err(ClusterError{Code::SCRATCH_TOO_SMALL, double(n)}); }
   return n;
 }

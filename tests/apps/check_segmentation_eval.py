@@ -73,9 +73,16 @@ def main():
     objects = sorted(k for k in counts if k >= 2)
     expect(objects == list(range(2, 2 + len(seg["objects"]))),
            f"object labels {objects} for {len(seg['objects'])} objects")
+    # Points are those clustered: every pixel, or at the budget's stride s every s-th pixel of every
+    # s-th row, the pixels between them labelled from their cell's corners (about s^2 as many).
+    stride = seg["budget"]["stride"]
     for k in objects:
-        expect(counts[k] == seg["objects"][k - 2]["points"],
-               f"object {k - 2}: {counts[k]} labelled points, JSON says {seg['objects'][k - 2]['points']}")
+        points = seg["objects"][k - 2]["points"]
+        if stride == 1:
+            expect(counts[k] == points, f"object {k - 2}: {counts[k]} labelled points, JSON says {points}")
+        else:
+            expect(0.75 * points * stride * stride <= counts[k] <= 1.25 * points * stride * stride,
+                   f"object {k - 2} at stride {stride}: {counts[k]} labelled pixels for {points} points")
     expect(counts[1] > 100000, f"table points {counts[1]}")
 
     dataset = os.path.join(work, "frames")

@@ -98,3 +98,24 @@ TEST(ObjectCandidates, MajorityNeedsHalfAndNeverTagZero) {
 }
 
 }  // namespace
+
+// Over capacity, the nearest candidates to the sensor are kept (the farthest dropped: the budget's
+// step 3), numbered in cluster order; equal ranges keep the earlier cluster.
+TEST(ObjectCandidates, OverCapacityKeepsTheNearest) {
+  const ok::Plane plane{{0.0F, 0.0F, -1.0F}, 1.0F};
+  const std::vector<double> hu{-10, 10, 10, -10}, hv{-10, -10, 10, 10};  // no edge in reach
+  std::vector<ok::ClusterStats> clusters{
+      cluster(0.3F, 0.0F, 0.10F, 500),  // range^2 1.09
+      cluster(0.0F, 0.0F, 0.10F, 500),  // 1.00: nearest
+      cluster(0.3F, 0.0F, 0.10F, 500),  // 1.09: ties with 0, loses to it
+      cluster(0.1F, 0.0F, 0.10F, 500),  // 1.01
+      cluster(0.5F, 0.0F, 0.10F, 500),  // 1.25
+  };
+  std::vector<std::int32_t> slot_of(clusters.size());
+  ok::CandidateParams p;
+  p.edge_margin = -100.0F;
+  const auto counts = ok::select_candidates(clusters, plane, hu, hv, p, 3, slot_of);
+  EXPECT_EQ(counts.kept, 3U);
+  EXPECT_EQ(counts.over_capacity, 2U);
+  EXPECT_EQ(slot_of, (std::vector<std::int32_t>{0, 1, -1, 2, -1}));
+}

@@ -142,6 +142,59 @@ TEST(SegCluster, OrganizedSeparatesByDepthAndMask) {
   ASSERT_EQ(*ok::euclidean_cluster_organized({c.view(), w, h}, mask, p, scratch, labels), 3U);
 }
 
+// On a mask thinned to every s-th row and column (the object stage's budget), pixel_step s visits
+// only the grid and must give the partition pixel_step 1 gives on the same mask with the same
+// radius: random range images with depth steps, NaN holes and masked blobs, sizes around the
+// stride and a SIMD width, radius s and 2s.
+TEST(SegCluster, PixelStepOnAThinnedMaskEqualsTheFullWindow) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> unit(0.0F, 1.0F);
+  std::size_t compared = 0;
+  for (const std::uint32_t s : {2U, 3U, 4U}) {
+    for (const std::uint32_t w : {1U, 7U, 8U, 9U, 17U, 64U}) {
+      for (int trial = 0; trial < 12; ++trial) {
+        const std::uint32_t h = 1 + static_cast<std::uint32_t>(unit(rng) * 40.0F);
+        Cloud c;
+        std::vector<std::uint8_t> mask(std::size_t{w} * h, 0);
+        for (std::uint32_t v = 0; v < h; ++v) {
+          for (std::uint32_t u = 0; u < w; ++u) {
+            float z = 1.0F + ((u / 5 + v / 7) % 3 == 0 ? 0.1F : 0.0F) + 0.002F * unit(rng);
+            if (unit(rng) < 0.05F) z = std::numeric_limits<float>::quiet_NaN();
+            c.add((float(u) - float(w) / 2) * 0.0017F * z, (float(v) - float(h) / 2) * 0.0017F * z,
+                  z);
+            mask[std::size_t{v} * w + u] = (u % s == 0 && v % s == 0 && unit(rng) < 0.9F) ? 1 : 0;
+          }
+        }
+        for (const std::uint32_t radius : {s, 2 * s}) {
+          ok::ClusterParams full;
+          full.tolerance = 0.012F;
+          full.min_size = 2;
+          full.pixel_radius = radius;
+          ok::ClusterParams grid = full;
+          grid.pixel_step = s;
+          ok::ClusterScratch a(c.x.size()), b(c.x.size());
+          std::vector<std::int32_t> la(c.x.size()), lb(c.x.size());
+          auto ra = ok::euclidean_cluster_organized({c.view(), w, h}, mask, full, a, la);
+          auto rb = ok::euclidean_cluster_organized({c.view(), w, h}, mask, grid, b, lb);
+          ASSERT_TRUE(ra && rb);
+          ASSERT_EQ(*ra, *rb) << "s " << s << " w " << w << " h " << h;
+          ASSERT_EQ(la, lb) << "s " << s << " w " << w << " h " << h;
+          ++compared;
+        }
+      }
+    }
+  }
+  EXPECT_EQ(compared, 3U * 6U * 12U * 2U);
+  ok::ClusterParams bad;
+  bad.pixel_radius = 3;
+  bad.pixel_step = 2;  // the radius must be a multiple of the step
+  ok::ClusterScratch scratch(4);
+  std::vector<std::int32_t> labels(4);
+  Cloud c;
+  for (int k = 0; k < 4; ++k) c.add(0.0F, 0.0F, 1.0F);
+  EXPECT_FALSE(ok::euclidean_cluster_organized({c.view(), 2, 2}, {}, bad, scratch, labels));
+}
+
 TEST(SegCluster, EveryErrorCode) {
   using Code = ok::ClusterError::Code;
   Cloud c = blobs(10, 1, 0.01F, 1);

@@ -7,8 +7,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -257,4 +260,101 @@ TEST(TablePlane, TheFloorBelowALargeViewOfItIsNotTheTable) {
   EXPECT_NEAR(seg->plane.plane.d, frame.d, 0.01);
   EXPECT_TRUE(seg->plane_check.switched);
   EXPECT_GE(seg->candidates.size(), 6U);
+}
+
+// The object stage's work budget (kernels::ObjectBudget, issue 50 item 3) on a heap of touching
+// objects whose prism exceeds the product's budget: the frame is clustered at stride 2 and still
+// finds nearly what the full-resolution pass finds; a cluster budget below the frame's clusters
+// skips the crowded refinements; the 45 mOSD learn frames stay inside the budget (their largest
+// prism, 40,262 pixels, is below the default 50,000), so their segmentation is unchanged.
+TEST(ObjectBudget, AHeapOverTheBudgetIsThinnedAndStillFindsItsObjects) {
+  orthoflow::simulation::SceneConfig config;
+  config.objects = 60;
+  config.touching = true;
+  const auto scene = orthoflow::simulation::make_scene(config, 3);
+  orthoflow::core::Rng rng(3);
+  ok::PointCloud cloud;
+  orthoflow::simulation::render_scene(scene, {}, rng, cloud);
+  const auto truth = mosd_truth(cloud);
+  const auto seg = tabletop(ok::ClusterMode::CROWDED);
+  ASSERT_EQ(seg.stages.budget.max_points, 12000U);  // the product's default
+  auto full_params = seg.stages;
+  full_params.budget = {};
+  ok::SegmentationChain budgeted(cloud.size(), seg.stages, seg.candidates);
+  ok::SegmentationChain full(cloud.size(), full_params, seg.candidates);
+  const auto b = budgeted.run(cloud.view());
+  const auto f = full.run(cloud.view());
+  ASSERT_TRUE(b && f);
+  EXPECT_EQ(f->stride, 1U);
+  EXPECT_GE(b->stride, 2U);
+  EXPECT_TRUE(b->refined);
+  auto recall = [&](const orthoflow::evaluation::Segmenter& s) {
+    const auto out = s(cloud);
+    EXPECT_TRUE(out.error.empty()) << out.error;
+    const auto c = orthoflow::evaluation::score_objects(truth, out.labels);
+    return static_cast<double>(c.matched) / static_cast<double>(std::max<std::size_t>(1, c.truth));
+  };
+  const double r_budgeted =
+      recall(orthoflow::evaluation::make_chain_segmenter(seg.stages, seg.candidates));
+  const double r_full =
+      recall(orthoflow::evaluation::make_chain_segmenter(full_params, seg.candidates));
+  std::printf("heap of %zu: recall %.3f at stride %u, %.3f at full resolution\n",
+              scene.objects.size(), r_budgeted, b->stride, r_full);
+  EXPECT_GT(scene.objects.size(), 20U);  // as many of the 60 as fit
+  EXPECT_GE(r_budgeted, r_full - 0.10);  // thinning costs at most a tenth of the objects
+  EXPECT_GT(r_budgeted, 0.5);
+
+  auto few = seg.stages;
+  few.budget.max_refine_clusters = 1;
+  ok::SegmentationChain unrefined(cloud.size(), few, seg.candidates);
+  const auto u = unrefined.run(cloud.view());
+  ASSERT_TRUE(u);
+  EXPECT_FALSE(u->refined);
+}
+
+// The budget was chosen on the 45 mOSD learn frames: at the product's budget most of them are
+// clustered at stride 2, and they score no worse than at full resolution (pixel IoU >= 0.5).
+TEST(ObjectBudget, TheLearnFramesScoreNoWorseThanAtFullResolution) {
+  const auto seg = tabletop(ok::ClusterMode::CROWDED);
+  auto full_params = seg.stages;
+  full_params.budget = {};
+  std::vector<std::string> files;
+  for (const auto& e : std::filesystem::directory_iterator(std::string(ORTHOFLOW_SHARED_DIR) +
+                                                           "/data/mosd_learn")) {
+    if (e.path().extension() == ".pcd") files.push_back(e.path().string());
+  }
+  ASSERT_EQ(files.size(), 45U);
+  std::sort(files.begin(), files.end());
+  const auto budgeted = orthoflow::evaluation::make_chain_segmenter(seg.stages, seg.candidates);
+  const auto full = orthoflow::evaluation::make_chain_segmenter(full_params, seg.candidates);
+  std::size_t strided = 0, truth = 0;
+  std::array<std::size_t, 2> predicted{}, matched{};
+  std::unique_ptr<ok::SegmentationChain> chain;
+  for (const auto& f : files) {
+    auto c = orthoflow::formats::read_pcd(f);
+    ASSERT_TRUE(c) << f;
+    if (!chain)
+      chain = std::make_unique<ok::SegmentationChain>(c->size(), seg.stages, seg.candidates);
+    const auto r = chain->run(c->view());
+    ASSERT_TRUE(r) << f;
+    strided += r->stride > 1 ? 1 : 0;
+    std::vector<std::uint32_t> labels(c->label().begin(), c->label().end());
+    for (std::size_t k = 0; k < 2; ++k) {
+      const auto out = (k == 0 ? budgeted : full)(*c);
+      ASSERT_TRUE(out.error.empty()) << out.error;
+      const auto score = orthoflow::evaluation::score_objects(labels, out.labels);
+      predicted[k] += score.predicted;
+      matched[k] += score.matched;
+      if (k == 0) truth += score.truth;
+    }
+  }
+  const double p_b = double(matched[0]) / double(predicted[0]),
+               r_b = double(matched[0]) / double(truth);
+  const double p_f = double(matched[1]) / double(predicted[1]),
+               r_f = double(matched[1]) / double(truth);
+  std::printf("learn split: %zu of 45 strided; budgeted P %.3f R %.3f, full P %.3f R %.3f\n",
+              strided, p_b, r_b, p_f, r_f);
+  EXPECT_GE(strided, 30U);
+  EXPECT_GE(p_b, p_f - 0.01);
+  EXPECT_GE(r_b, r_f - 0.01);
 }

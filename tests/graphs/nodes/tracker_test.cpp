@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <vector>
 
 namespace orthoflow::graphs {
@@ -103,3 +105,48 @@ TEST(Tracker, TooManyObjectsAreLeftUntracked) {
 
 }  // namespace
 }  // namespace orthoflow::graphs
+
+// share_inside() skips the scan when the points' bounding box settles the answer; it must equal
+// the reference scan bit for bit: boxes apart, holding, straddling, touching at the margin, a
+// shifted box, empty input, one point, and sizes around a SIMD width.
+TEST(Tracker, ShareInsideEqualsTheReferenceScan) {
+  std::uint64_t state = 12345;
+  auto uniform = [&](float lo, float hi) {
+    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+    return lo + (hi - lo) * static_cast<float>(state >> 40) / static_cast<float>(1ULL << 24);
+  };
+  std::size_t cases = 0, skipped_scan = 0;
+  for (const std::size_t n : {0UL, 1UL, 7UL, 8UL, 9UL, 15UL, 16UL, 17UL, 100UL, 1000UL}) {
+    for (int trial = 0; trial < 200; ++trial) {
+      std::vector<float> x(n), y(n), z(n);
+      const float cx = uniform(-0.3F, 0.3F), cy = uniform(-0.3F, 0.3F), cz = uniform(0.8F, 1.2F);
+      const float r = uniform(0.01F, 0.1F);
+      for (std::size_t k = 0; k < n; ++k) {
+        x[k] = cx + uniform(-r, r), y[k] = cy + uniform(-r, r), z[k] = cz + uniform(-r, r);
+      }
+      std::array<float, 3> lo{}, hi{}, p_lo{cx, cy, cz}, p_hi{cx, cy, cz};
+      if (n > 0) {
+        p_lo = {x[0], y[0], z[0]}, p_hi = p_lo;
+        for (std::size_t k = 0; k < n; ++k) {
+          p_lo = {std::min(p_lo[0], x[k]), std::min(p_lo[1], y[k]), std::min(p_lo[2], z[k])};
+          p_hi = {std::max(p_hi[0], x[k]), std::max(p_hi[1], y[k]), std::max(p_hi[2], z[k])};
+        }
+      }
+      for (std::size_t a = 0; a < 3; ++a) {  // boxes from far apart to holding everything
+        const float c = a == 0 ? cx : a == 1 ? cy : cz, s = uniform(0.0F, 0.15F);
+        lo[a] = c + uniform(-0.2F, 0.1F), hi[a] = lo[a] + s;
+      }
+      if (trial % 7 == 0 && n > 0) lo = p_lo, hi = p_hi;  // exactly the bounds: all inside
+      const std::array<float, 3> shift{uniform(-0.05F, 0.05F), 0.0F, uniform(-0.05F, 0.05F)};
+      const float m = trial % 5 == 0 ? 0.0F : 0.02F;
+      const orthoflow::kernels::PointsView p{x, y, z};
+      const float fast = orthoflow::graphs::share_inside(p, lo, hi, shift, m, p_lo, p_hi, true);
+      const float ref = orthoflow::graphs::share_inside_reference(p, lo, hi, shift, m);
+      ASSERT_EQ(fast, ref) << "n " << n << " trial " << trial;
+      ++cases;
+      skipped_scan += (ref == 0.0F || ref == 1.0F) ? 1 : 0;
+    }
+  }
+  EXPECT_GT(skipped_scan, cases / 4);  // the cases where the bounds decide were exercised
+  EXPECT_LT(skipped_scan, cases);      // and so were the straddling ones
+}
