@@ -9,9 +9,10 @@
 // frames, timed per frame. Inputs: the 45 mOSD learn-split frames, the same frames unorganized (the
 // NaN pixels dropped, HEIGHT 1, as ROS bags store them), synthetic sequences with 3, 10, 16 and 30
 // objects, and the hostile inputs of issue 50 (tests/support/hostile_frames.hpp: sensor noise, a
-// wall, no reading, a hand at the lens, a person at a desk, a heap of 60 objects). Per input it also
-// reports the objects and track nodes' p99 and the objects node's budget counters (degraded_*). Usage: graph_latency_vs_pcl [--frames N] (synthetic frames per input, default 300; PCL
-// runs on the first 30 of them) plus Google Benchmark flags.
+// wall, no reading, a hand at the lens, a person at a desk, a heap of 60 objects). Per input it
+// also reports the objects and track nodes' p99 and the objects node's budget counters
+// (degraded_*). Usage: graph_latency_vs_pcl [--frames N] (synthetic frames per input, default 300;
+// PCL runs on the first 30 of them) plus Google Benchmark flags.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
