@@ -5,6 +5,7 @@
 // that of locally convex connected patches (Stein et al., CVPR 2014), applied per pixel on the
 // organized grid instead of on supervoxels.
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "kernels/tabletop_stages.hpp"
@@ -14,6 +15,10 @@ namespace orthoflow::kernels {
 namespace {
 
 constexpr std::uint8_t UNATTACHED = 255;
+/// Per-pixel normals cost about this many times a pixel of the SIMD row kernel (measured on the
+/// scattered wall of tests/support/hostile_frames.hpp; a rough figure: only the choice depends on
+/// it).
+constexpr std::size_t SCATTERED_RATIO = 8;
 
 struct CreaseTest {
   PointsView p;
@@ -41,18 +46,25 @@ Result<std::size_t, ClusterError> ObjectStage::cluster_crowded(
   }
   // Only the rows that hold prism pixels, and those the crease test reads around them, need
   // normals: objects cover a band of the image, not the frame.
-  std::size_t first_row = h, last_row = 0;
+  std::size_t first_row = h, last_row = 0, prism = 0;
   for (std::size_t r = 0; r < h; ++r) {
     const auto row = std::span<const std::uint8_t>(mask_).subspan(r * w, w);
     if (std::find(row.begin(), row.end(), std::uint8_t{1}) == row.end()) continue;
     first_row = std::min(first_row, r);
     last_row = r;
+    prism += static_cast<std::size_t>(std::count(row.begin(), row.end(), std::uint8_t{1}));
   }
   std::fill(off_crease_.begin(), off_crease_.begin() + static_cast<std::ptrdiff_t>(n), 0);
   const std::size_t g = p.crease.gap;
-  if (first_row <= last_row) {
-    const PointsSpan normals{std::span(nx_).first(n), std::span(ny_).first(n),
-                             std::span(nz_).first(n)};
+  const PointsSpan normals{std::span(nx_).first(n), std::span(ny_).first(n),
+                           std::span(nz_).first(n)};
+  // A few pixels scattered over many rows (plane noise above a wall, a hand's rim): the five
+  // normals each one's crease test reads, pixel by pixel, cost less than the band of rows.
+  const bool scattered =
+      first_row <= last_row && SCATTERED_RATIO * 5 * prism < (last_row - first_row + 1) * w;
+  if (first_row > last_row) {
+    first_row = last_row = 0;  // no prism pixel: the loop below sees none
+  } else if (!scattered) {
     const RowRange rows{static_cast<std::uint32_t>(first_row >= g ? first_row - g : 0),
                         static_cast<std::uint32_t>(std::min(h, last_row + g + 1))};
     // Thinned by the budget to every s-th row, with s dividing the gap: the crease test reads
@@ -65,8 +77,6 @@ Result<std::size_t, ClusterError> ObjectStage::cluster_crowded(
     } else {
       organized_normals(cloud, p.crease.normals, normals, rows);
     }
-  } else {
-    first_row = last_row = 0;
   }
   const CreaseTest test{pts, nx_.data(), ny_.data(), nz_.data(),
                         std::cos(p.crease.min_angle_deg * 3.14159265F / 180.0F)};
@@ -74,6 +84,17 @@ Result<std::size_t, ClusterError> ObjectStage::cluster_crowded(
   for (std::size_t r = first_row, i = first_row * w; r <= last_row && r < h; ++r) {
     for (std::size_t c = 0; c < w; ++c, ++i) {
       if (mask_[i] == 0) continue;
+      if (scattered) {
+        std::array<std::uint32_t, 5> at{};
+        std::size_t k = 0;
+        at[k++] = static_cast<std::uint32_t>(i);
+        if (c >= g && c + g < w)
+          at[k++] = static_cast<std::uint32_t>(i - g), at[k++] = static_cast<std::uint32_t>(i + g);
+        if (r >= g && r + g < h)
+          at[k++] = static_cast<std::uint32_t>(i - g * w),
+          at[k++] = static_cast<std::uint32_t>(i + g * w);
+        organized_normals_at(cloud, p.crease.normals, normals, std::span(at).first(k));
+      }
       members_[m++] = static_cast<std::uint32_t>(i);
       // A prism pixel without a normal sits on a depth edge (or the image border): a boundary too.
       const bool crease = !std::isfinite(nx_[i]) ||

@@ -43,6 +43,22 @@ std::size_t organized_normals_scalar(CloudView cloud, const NormalParams& params
   });
 }
 
+std::size_t organized_normals_at(CloudView cloud, const NormalParams& params, PointsSpan out,
+                                 std::span<const std::uint32_t> pixels) noexcept {
+  OF_ASSERT(params.offset >= 1, "organized_normals_at: offset 0");
+  const std::size_t w = cloud.width, h = cloud.height, s = params.offset;
+  std::size_t written = 0;
+  for (const std::uint32_t i : pixels) {
+    const std::size_t r = i / w, c = i % w;
+    if (r < s || r + s >= h || w <= 2 * s || c < s || c + s >= w) {
+      detail::set_nan(out, i);  // all_rows' border: no normal
+      continue;
+    }
+    written += detail::normals_range(cloud, params, r, c, c + 1, out);
+  }
+  return written;
+}
+
 std::size_t organized_normals(CloudView cloud, const NormalParams& params, PointsSpan out,
                               RowRange rows) noexcept {
   static auto dispatched = xsimd::dispatch<SimdArchs>(detail::OrganizedNormalsRowKernel{});

@@ -6,6 +6,7 @@
 /// toward the sensor (n . P < 0). NaN when a neighbour is missing, lies outside the image, or
 /// steps in depth by more than depth_change x z of the centre (a depth edge, not a surface).
 #include <cstdint>
+#include <span>
 
 #include "kernels/point_cloud.hpp"
 
@@ -30,6 +31,13 @@ struct RowRange {
 /// contraction), so x86 and ARM agree.
 std::size_t organized_normals(CloudView cloud, const NormalParams& params, PointsSpan out,
                               RowRange rows = {}) noexcept;
+/// @brief Writes the normal of each of @p pixels (flat indices, any order, repeats allowed) of @p
+/// cloud to @p out, the value organized_normals() gives there (bit for bit); other pixels of @p
+/// out are left as they are. For a few scattered pixels, where a band of rows would cost more.
+/// @pre as organized_normals(); every index < width * height. @return the pixels with a normal
+/// (repeats counted). @note Stateless, thread-safe, allocation-free.
+std::size_t organized_normals_at(CloudView cloud, const NormalParams& params, PointsSpan out,
+                                 std::span<const std::uint32_t> pixels) noexcept;
 /// @brief Scalar reference twin of organized_normals().
 std::size_t organized_normals_scalar(CloudView cloud, const NormalParams& params, PointsSpan out,
                                      RowRange rows = {}) noexcept;

@@ -191,4 +191,40 @@ TEST(OrganizedNormals, RowRangeLeavesOtherRowsAlone) {
   EXPECT_EQ(ok::organized_normals(g.view(), {}, none.span(), ok::RowRange{30, 40}), 0U);
 }
 
+// organized_normals_at() on scattered pixels (the borders, the corners, repeats, every kind of
+// grid, widths around the lane counts) equals the whole-image kernel bit for bit there and leaves
+// every other pixel alone; no pixels write nothing.
+TEST(OrganizedNormals, AtListedPixelsEqualsTheWholeImage) {
+  for (const Kind kind :
+       {Kind::SURFACE, Kind::NAN_HOLES, Kind::STEPS, Kind::HUGE, Kind::ZEROS, Kind::INF}) {
+    for (const std::uint32_t w : {1U, 6U, 7U, 8U, 9U, 17U, 33U}) {
+      const std::uint32_t h = 11;
+      const Grid g = make_grid(w, h, kind, w * 31U);
+      Normals all(g.x.size()), at(g.x.size(), 5.0F);
+      ok::organized_normals(g.view(), {}, all.span());
+      std::vector<std::uint32_t> pixels;
+      std::vector<bool> listed(g.x.size(), false);
+      std::mt19937 rng(w);
+      for (std::size_t k = 0; k < g.x.size(); k += 1 + rng() % 4) {
+        pixels.push_back(static_cast<std::uint32_t>(k));
+        listed[k] = true;
+      }
+      pixels.push_back(0);  // a repeat, and the last pixel (a corner)
+      pixels.push_back(static_cast<std::uint32_t>(g.x.size() - 1));
+      listed.back() = true;
+      const std::size_t written = ok::organized_normals_at(g.view(), {}, at.span(), pixels);
+      EXPECT_LE(written, pixels.size());
+      for (std::size_t i = 0; i < g.x.size(); ++i) {
+        if (listed[i]) {
+          expect_same_bits(all, at, i, i + 1, "listed");
+        } else {
+          ASSERT_EQ(at.x[i], 5.0F) << "pixel " << i << " was written";
+        }
+      }
+      Normals none(g.x.size(), 5.0F);
+      EXPECT_EQ(ok::organized_normals_at(g.view(), {}, none.span(), {}), 0U);
+    }
+  }
+}
+
 }  // namespace
