@@ -6,6 +6,7 @@
 // (the kernel command line) and DIR/layout (partition sizes, extra packages).
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -13,6 +14,8 @@
 #include <string>
 
 #include "apps/commands.hpp"
+#include "apps/graph_run.hpp"
+#include "core/regular_file.hpp"
 #include "deploy/image_files.hpp"
 #include "deploy/robot_config.hpp"
 #include "ui/server_config.hpp"
@@ -33,33 +36,61 @@ struct ImageArgs {
   throw CLI::RuntimeError(code);
 }
 
-deploy::RobotConfig load_or_throw(const std::string& path) {
+/// A robot.yaml and the files it names, each read once: what was checked is what the image gets.
+struct LoadedConfig {
+  deploy::RobotConfig config;
+  std::string yaml, token, keys, graph;
+};
+
+/// A file robot.yaml names under @p key: resolved (symbolic links too) inside the config's own
+/// folder, a regular file of at most @p limit bytes, read once.
+std::string named_file(const std::string& config, const std::string& key, const std::string& name,
+                       std::size_t limit) {
+  std::error_code ec;
+  const fs::path here = fs::canonical(fs::absolute(fs::path(config)).parent_path(), ec);
+  if (ec)
+    fail(config + ": the config's folder cannot be resolved: " + ec.message(), EXIT_BAD_INPUT);
+  const fs::path file = fs::canonical(here / name, ec);
+  if (ec)
+    fail(config + ": " + key + ": " + (here / name).string() + " is not a file (" + ec.message() +
+             ")",
+         EXIT_BAD_INPUT);
+  if (std::mismatch(here.begin(), here.end(), file.begin(), file.end()).first != here.end())
+    fail(config + ": " + key + ": '" + name + "' leads outside the config's folder " +
+             here.string() + " (to " + file.string() + ")",
+         EXIT_BAD_INPUT);
+  auto text = core::read_regular_text(file, limit);
+  if (!text) fail(config + ": " + key + ": " + text.error().message, EXIT_BAD_INPUT);
+  return *text;
+}
+
+LoadedConfig load_or_throw(const std::string& path) {
   auto config = deploy::load_robot_config(path);
   if (!config) fail(config.error(), EXIT_BAD_INPUT);
-  // The files it names must be there now, at build time, not on the robot at boot.
+  LoadedConfig loaded{*config, {}, {}, {}, {}};
+  auto yaml = core::read_regular_text(path, std::size_t{1} << 20);
+  if (!yaml) fail(yaml.error().message, EXIT_BAD_INPUT);
+  loaded.yaml = std::move(*yaml);
+  // The files it names must be there now, at build time, and be what they claim to be.
   if (config->ui.enabled && !config->ui.token_file.empty()) {
-    const fs::path token = fs::path(path).parent_path() / config->ui.token_file;
-    if (auto t = ui::read_token_file(token.string()); !t)
-      fail(path + ": ui.token_file: " + t.error(), EXIT_BAD_INPUT);
+    loaded.token = named_file(path, "ui.token_file", config->ui.token_file, 4096);
+    if (auto t = ui::token_from_text(loaded.token, path + ": ui.token_file"); !t)
+      fail(t.error(), EXIT_BAD_INPUT);
   }
   if (!config->admin.ssh_authorized_keys.empty()) {
-    const fs::path keys = fs::path(path).parent_path() / config->admin.ssh_authorized_keys;
-    std::ifstream in(keys, std::ios::binary);
-    if (!in)
-      fail(path + ": admin.ssh_authorized_keys: " + keys.string() + " cannot be read",
-           EXIT_BAD_INPUT);
-    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    if (auto ok = deploy::check_authorized_keys(text); !ok)
-      fail(path + ": admin.ssh_authorized_keys: " + keys.string() + ": " + ok.error(),
-           EXIT_BAD_INPUT);
+    loaded.keys =
+        named_file(path, "admin.ssh_authorized_keys", config->admin.ssh_authorized_keys, 1 << 16);
+    if (auto ok = deploy::check_authorized_keys(loaded.keys); !ok)
+      fail(path + ": admin.ssh_authorized_keys: " + ok.error(), EXIT_BAD_INPUT);
   }
   if (config->graph != "tabletop") {
-    const fs::path graph = fs::path(path).parent_path() / config->graph;
-    std::error_code ec;
-    if (!fs::is_regular_file(graph, ec))
-      fail(path + ": graph: " + graph.string() + " is not a file", EXIT_BAD_INPUT);
+    loaded.graph = named_file(path, "graph", config->graph, std::size_t{1} << 20);
+    auto spec = engine::parse_graph(loaded.graph, config->graph);
+    if (!spec) fail(path + ": graph: " + engine::to_string(spec.error()), EXIT_BAD_INPUT);
+    auto built = engine::build_graph(*spec, make_graph_registry(), engine::BuildMode::CHECK);
+    if (!built) fail(path + ": graph: " + engine::to_string(built.error()), EXIT_BAD_INPUT);
   }
-  return *config;
+  return loaded;
 }
 
 void write_file(const fs::path& path, const std::string& text, unsigned mode) {
@@ -72,28 +103,20 @@ void write_file(const fs::path& path, const std::string& text, unsigned mode) {
     fail("cannot write " + path.string(), EXIT_FAILURE_GENERIC);
 }
 
-void copy_file(const fs::path& from, const fs::path& to, unsigned mode) {
-  std::ifstream in(from, std::ios::binary);
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (!in && !in.eof()) fail("cannot read " + from.string(), EXIT_BAD_INPUT);
-  write_file(to, text, mode);
-}
-
 void render(const ImageArgs& a) {
   auto arch = deploy::parse_arch(a.arch);
   if (!arch) fail(arch.error(), EXIT_USAGE);
-  const deploy::RobotConfig config = load_or_throw(a.config);
+  const LoadedConfig loaded = load_or_throw(a.config);
+  const deploy::RobotConfig& config = loaded.config;
   const fs::path out(a.out);
   const fs::path root = out / "rootfs";
   for (const auto& f : deploy::root_files(config)) write_file(root / f.path, f.text, f.mode);
-  const fs::path here = fs::path(a.config).parent_path();
-  copy_file(a.config, root / "etc/orthoflow/robot.yaml", 0644);
+  write_file(root / "etc/orthoflow/robot.yaml", loaded.yaml, 0644);
   if (config.ui.enabled && !config.ui.token_file.empty())
-    copy_file(here / config.ui.token_file, root / "etc/orthoflow/ui-token", 0640);
-  if (config.graph != "tabletop")
-    copy_file(here / config.graph, root / "etc/orthoflow/graph.yaml", 0644);
+    write_file(root / "etc/orthoflow/ui-token", loaded.token, 0640);
+  if (config.graph != "tabletop") write_file(root / "etc/orthoflow/graph.yaml", loaded.graph, 0644);
   if (!config.admin.ssh_authorized_keys.empty()) {
-    copy_file(here / config.admin.ssh_authorized_keys, root / "root/.ssh/authorized_keys", 0600);
+    write_file(root / "root/.ssh/authorized_keys", loaded.keys, 0600);
     if (::chmod((root / "root/.ssh").c_str(), 0700) != 0 ||
         ::chmod((root / "root").c_str(), 0700) != 0)
       fail("cannot set the mode of " + (root / "root/.ssh").string(), EXIT_FAILURE_GENERIC);
@@ -117,7 +140,7 @@ void add_image_command(CLI::App& app) {
       image->add_subcommand("check", "Validate a robot configuration (YAML); errors name the key");
   check->add_option("FILE", args->config, "robot.yaml")->required();
   check->callback([args] {
-    const auto config = load_or_throw(args->config);
+    const auto config = load_or_throw(args->config).config;
     std::cout << args->config << ": ok (host " << config.hostname << ", source " << config.source
               << ", ui " << (config.ui.enabled ? config.ui.listen : std::string("off")) << ")\n";
   });

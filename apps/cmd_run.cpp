@@ -181,7 +181,8 @@ void add_run_command(CLI::App& app) {
   cmd->add_option(
       "--source", o->source,
       "synthetic:SEED, pcd:DIR, kinect[:SERIAL] (the camera over USB), "
-      "kinect-sim[:SEED] (the simulated camera), replay:DIR, or world:SEED (a simulated "
+      "kinect-sim[:SEED] (the simulated camera), replay:DIR (a fakenect recording), tum:DIR (a TUM "
+      "RGB-D benchmark folder), or world:SEED (a simulated "
       "table seen by the simulated camera, reacting to the arm states on "
       "--arm-state-topic; needs RouDi) (default: the graph's source)");
   cmd->add_option("--frames", o->frames, "stop after N frames (synthetic: session length)");
@@ -237,7 +238,7 @@ void add_run_command(CLI::App& app) {
   cmd->add_option(
          "--on-bad-frame", o->on_bad_frame,
          "a frame that fails (unreadable file, no table, ...): skip (count and report) or fail "
-         "(also exit 2 at the end)")
+         "(also exit 2 at the end); a run in which every frame failed exits 2 either way")
       ->check(CLI::IsMember({"skip", "fail"}));
   cmd->add_flag(
       "--publish-objects", o->publish_objects,

@@ -88,7 +88,7 @@ void report_labels(graphs::LabelsWriter& labels, const RunOptions& o) {
 }
 
 // After the run: every output the user asked for was written whole, or the exit is non-zero; frames
-// that failed are reported (and fail the run with --on-bad-frame fail).
+// that failed are reported (and fail the run with --on-bad-frame fail, or when every frame failed).
 void finish_outputs(const RunOptions& o, graphs::SessionLog& log, const engine::GraphStats& stats,
                     std::unique_ptr<graphs::LineWriter> telemetry) {
   int exit_code = EXIT_OK;
@@ -97,6 +97,12 @@ void finish_outputs(const RunOptions& o, graphs::SessionLog& log, const engine::
     std::cerr << "run: " << summary.frames_with_error << " frame(s) failed; the first, frame "
               << summary.first_error_frame << ": " << summary.first_error.to_string() << "\n";
     if (o.on_bad_frame == "fail") exit_code = EXIT_BAD_INPUT;
+  }
+  // Skipping bad frames is for a run that used some: one that could use none has no result.
+  if (summary.frames > 0 && summary.frames_with_error == summary.frames) {
+    std::cerr << "run: no frame could be used (" << summary.frames << " of " << summary.frames
+              << " failed)\n";
+    exit_code = EXIT_BAD_INPUT;
   }
   if (log.json() != nullptr && (log.json()->dropped() > 0 || log.json()->failed())) {
     std::cerr << "run: --json-out " << o.json_out << ": " << log.json()->dropped()

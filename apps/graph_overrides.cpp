@@ -50,6 +50,11 @@ Result<void, std::string> apply_source(engine::GraphSpec& spec, const std::strin
     src->params = {};
     src->params.assign("dir", source.substr(7));
     spec.period_ns = 0;  // the recording's own pace (replay_source pace=recorded) unless --rate
+  } else if (source.rfind("tum:", 0) == 0) {
+    src->kind = "tum_source";
+    src->params = {};
+    src->params.assign("dir", source.substr(4));
+    spec.period_ns = 0;  // the recording's own pace (tum_source pace=recorded) unless --rate
   } else if (source.rfind("world:", 0) == 0) {
     // The closed-loop world the process supplies (apps/cmd_run.cpp:
     // graphs/sessions/arm_world_feed.hpp).
@@ -58,7 +63,7 @@ Result<void, std::string> apply_source(engine::GraphSpec& spec, const std::strin
   } else if (!source.empty()) {
     return err(
         "--source must be synthetic:SEED, pcd:DIR, kinect[:SERIAL], kinect-sim[:SEED], "
-        "replay:DIR or world:SEED, not '" +
+        "replay:DIR, tum:DIR or world:SEED, not '" +
         source + "'");
   }
   if (frames > 0 && src->kind == "synthetic_source")

@@ -11,7 +11,8 @@
 namespace orthoflow::apps {
 
 /// @brief --source synthetic:SEED | pcd:DIR | kinect[:SERIAL] | kinect-sim[:SEED] | replay:DIR
-/// (a fakenect recording, at its recorded pace) and --frames
+/// (a fakenect recording, at its recorded pace) | tum:DIR (a TUM RGB-D benchmark folder, at its
+/// recorded pace) and --frames
 /// (synthetic sources; 0: the graph's) on
 /// the graph's synthetic_source, pcd_source or kinect_source node. Errors say what is wrong.
 [[nodiscard]] Result<void, std::string> apply_source(engine::GraphSpec& spec,

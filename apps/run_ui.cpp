@@ -68,9 +68,17 @@ std::unique_ptr<ui::UiServer> start_server(const std::string& listen, const std:
   if (!server_result) fail(server_result.error(), EXIT_FAILURE_GENERIC, who);
   auto server = std::move(*server_result);
   std::cout << "ui: " << server->url() << "\n";
+  // Where the token is, never the token: this output goes to the journal under the image's unit.
   if (!server->token().empty()) {
-    std::cout << "ui: bearer token " << server->token()
-              << " (Authorization: Bearer <token>, or ?token=<token> in the page's URL)\n";
+    std::string where = token_file;
+    if (where.empty()) {  // generated: beyond loopback without --ui-token-file
+      auto written = ui::write_private_token(server->token());
+      if (!written) fail(written.error(), EXIT_FAILURE_GENERIC, who);
+      where = *written + " (generated; readable by this user only)";
+    }
+    std::cout
+        << "ui: bearer token: the first line of " << where
+        << " (send Authorization: Bearer <token>, or open the page once with ?token=<token>)\n";
   }
   std::cout.flush();
   return server;

@@ -8,6 +8,8 @@
 #include <Eigen/Geometry>
 
 #include "core/label_text.hpp"
+#include "graphs/frame/frame_block.hpp"
+#include "kernels/table_verdict.hpp"
 
 namespace orthoflow::bridge {
 namespace {
@@ -77,6 +79,18 @@ std::size_t to_ros(const engine::ObjectListPayload& list, const StampClock& cloc
   out.header.frame_id = scratch.camera_frame.data();
   out.frame_number = list.frame_id;
   out.age_ns = list.age_ns;
+  // The table verdict (issue 50): the names are string literals, so their data() ends in a NUL.
+  static constexpr char NOT_REPORTED[] = "";
+  const bool reason_known = list.table_reason >= 1 && list.table_reason <= 6;
+  const auto reason = static_cast<kernels::TableReason>(list.table_reason - 1);
+  out.table = reason_known &&
+              (reason == kernels::TableReason::ACCEPTED || reason == kernels::TableReason::HELD);
+  out.table_reason =
+      const_cast<char*>(reason_known ? kernels::table_reason_name(reason).data() : NOT_REPORTED);
+  const bool gravity_known = list.gravity >= 1 && list.gravity <= 3;
+  out.gravity = const_cast<char*>(
+      gravity_known ? graphs::gravity_name(static_cast<graphs::Gravity>(list.gravity - 1)).data()
+                    : NOT_REPORTED);
   const std::size_t n = std::min<std::size_t>(list.count, engine::OBJECT_LIST_CAPACITY);
   for (std::size_t i = 0; i < n; ++i) {
     const engine::ObjectEntry& e = list.objects[i];

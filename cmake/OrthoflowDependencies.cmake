@@ -15,7 +15,7 @@ set_target_properties(leveldb::leveldb PROPERTIES INTERFACE_LINK_LIBRARIES Threa
 find_package(PkgConfig REQUIRED)
 pkg_check_modules(LZF REQUIRED IMPORTED_TARGET liblzf)
 pkg_check_modules(CAIRO REQUIRED IMPORTED_TARGET cairo)
-pkg_check_modules(PNG REQUIRED IMPORTED_TARGET libpng)  # the web view's camera image (ui/png_encode.cpp)
+pkg_check_modules(PNG REQUIRED IMPORTED_TARGET libpng)  # the web view's camera image (ui/png_encode.cpp), TUM depth PNGs (formats/png_depth.cpp)
 
 if(BUILD_TESTS)
   find_package(GTest REQUIRED)

@@ -11,6 +11,8 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "core/regular_file.hpp"
+
 namespace orthoflow::deploy {
 namespace {
 
@@ -170,22 +172,10 @@ Result<RobotConfig, std::string> parse_robot_config(const std::string& text,
 }
 
 Result<RobotConfig, std::string> load_robot_config(const std::string& path) {
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (f == nullptr) return err(path + ": cannot be read");
-  std::string text;
-  char buf[4096];
-  std::size_t n = 0;
-  while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) {
-    text.append(buf, n);
-    if (text.size() > (1u << 20)) {
-      std::fclose(f);
-      return err(path + ": larger than 1 MiB");
-    }
-  }
-  const bool failed = std::ferror(f) != 0;
-  std::fclose(f);
-  if (failed) return err(path + ": cannot be read");
-  return parse_robot_config(text, path);
+  // A regular file of at most 1 MiB, opened without blocking (core/regular_file.hpp).
+  auto text = core::read_regular_text(path, std::size_t{1} << 20);
+  if (!text) return err(path + ": cannot be read: " + text.error().message.substr(path.size() + 2));
+  return parse_robot_config(*text, path);
 }
 
 std::uint16_t ui_port(const RobotConfig& c) noexcept {

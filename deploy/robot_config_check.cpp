@@ -2,6 +2,7 @@
 // the character sets that keep each text inside its line and its quoting in the image's files
 // (host names, addresses, paths, kernel parameters, package names, authorized keys). Reading the
 // YAML is in robot_config.cpp.
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <string>
@@ -84,8 +85,23 @@ Result<void, std::string> check_listen(const std::string& listen) {
   return {};
 }
 
-// A path on the build machine: printable, no quote, no new line (it is named in messages only).
-bool host_path(const std::string& p) { return made_of(p, 1, 4096, "/._-+@ ~"); }
+// A file beside the config on the build machine: a relative path inside the config's folder (no
+// leading '/' or '~', no '..' component), printable, no quote, no new line. `orthoflow image`
+// also resolves symbolic links and refuses a file they lead outside the folder.
+bool inside_path(const std::string& p) {
+  if (!made_of(p, 1, 4096, "/._-+@ ~") || p.front() == '/' || p.front() == '~') return false;
+  for (std::size_t at = 0; at <= p.size();) {
+    const std::size_t end = std::min(p.find('/', at), p.size());
+    if (std::string_view(p).substr(at, end - at) == "..") return false;
+    at = end + 1;
+  }
+  return true;
+}
+
+constexpr const char* INSIDE =
+    "a relative path inside the config's folder (no leading '/' or '~', no '..'; letters, digits, "
+    "/ "
+    ". _ - + @ ~ and spaces)";
 
 }  // namespace
 
@@ -94,9 +110,9 @@ Result<void, std::string> check_robot_config(const RobotConfig& c) {
     return err("hostname: 1..63 lower-case letters, digits and '-' (not at either end), not '" +
                c.hostname + "'");
   if (auto ok = check_source(c.source); !ok) return ok;
-  if (c.graph != "tabletop" && !host_path(c.graph))
-    return err(
-        "graph: 'tabletop' or a graph file's path (letters, digits, / . _ - + @ ~ and spaces)");
+  if (c.graph != "tabletop" && !inside_path(c.graph))
+    return err("graph: 'tabletop' or a graph file's path: " + std::string(INSIDE) + ", not '" +
+               c.graph + "'");
   if (c.learner != "instance" && c.learner != "bayes")
     return err("learner: instance or bayes, not '" + c.learner + "'");
   if (!std::isfinite(c.rate_hz) || (c.rate_hz != 0.0 && (c.rate_hz < 0.01 || c.rate_hz > 1000.0)))
@@ -104,11 +120,12 @@ Result<void, std::string> check_robot_config(const RobotConfig& c) {
   if (c.threads > 1024) return err("threads: 0..1024");
   if (c.ui.enabled) {
     if (auto ok = check_listen(c.ui.listen); !ok) return ok;
-    if (!c.ui.token_file.empty() && !host_path(c.ui.token_file))
-      return err("ui.token_file: a path (letters, digits, / . _ - + @ ~ and spaces)");
+    if (!c.ui.token_file.empty() && !inside_path(c.ui.token_file))
+      return err("ui.token_file: " + std::string(INSIDE) + ", not '" + c.ui.token_file + "'");
   }
-  if (!c.admin.ssh_authorized_keys.empty() && !host_path(c.admin.ssh_authorized_keys))
-    return err("admin.ssh_authorized_keys: a path (letters, digits, / . _ - + @ ~ and spaces)");
+  if (!c.admin.ssh_authorized_keys.empty() && !inside_path(c.admin.ssh_authorized_keys))
+    return err("admin.ssh_authorized_keys: " + std::string(INSIDE) + ", not '" +
+               c.admin.ssh_authorized_keys + "'");
   const NetworkSettings& n = c.network;
   if (n.interfaces.empty() || n.interfaces.size() > 16)
     return err("network.interfaces: 1..16 interface names or globs");

@@ -5,10 +5,9 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
-#include <fstream>
 #include <set>
-#include <sstream>
 
+#include "core/regular_file.hpp"
 #include "engine/graph.hpp"
 
 namespace orthoflow::engine {
@@ -218,11 +217,13 @@ Result<GraphSpec, GraphError> parse_graph(const std::string& text, const std::st
 }
 
 Result<GraphSpec, GraphError> load_graph_file(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) return err(GraphError{Code::FILE_UNREADABLE, path, 0, "cannot open the graph file"});
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parse_graph(text.str(), path);
+  // A regular file of at most 16 MiB, opened without blocking (a FIFO is refused, never waited on).
+  auto text = core::read_regular_text(path, std::size_t{16} << 20);
+  if (!text)
+    return err(
+        GraphError{Code::FILE_UNREADABLE, path, 0,
+                   "cannot read the graph file: " + text.error().message.substr(path.size() + 2)});
+  return parse_graph(*text, path);
 }
 
 }  // namespace orthoflow::engine

@@ -7,6 +7,9 @@
 #include <memory>
 #include <string>
 
+#include "core/input_limit.hpp"
+#include "core/regular_file.hpp"
+
 namespace orthoflow::formats {
 namespace {
 
@@ -23,27 +26,23 @@ IoError io_error(IoError::Code code, const std::filesystem::path& path, const ch
 
 Result<std::vector<char>, IoError> read_file_bytes(const std::filesystem::path& path,
                                                    std::size_t max_bytes) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) {
-    return err(IoError{IoError::Code::OPEN_FAILED, path.string() + ": is a directory"});
-  }
-  File file(std::fopen(path.c_str(), "rb"));
-  if (!file) { return err(io_error(IoError::Code::OPEN_FAILED, path, "cannot open")); }
   std::vector<char> bytes;
-  char chunk[1 << 16];
-  std::size_t got = 0;
-  while ((got = std::fread(chunk, 1, sizeof(chunk), file.get())) > 0) {
-    if (bytes.size() + got > max_bytes) {
-      return err(IoError{IoError::Code::TOO_LARGE,
-                         path.string() + ": larger than the input limit of " +
-                             std::to_string(max_bytes) + " bytes (ORTHOFLOW_MAX_INPUT_BYTES)"});
-    }
-    bytes.insert(bytes.end(), chunk, chunk + got);
-  }
-  if (std::ferror(file.get()) != 0) {
-    return err(io_error(IoError::Code::OPEN_FAILED, path, "read failed"));
+  auto read = core::read_regular_file(path, max_bytes, bytes);
+  if (!read) {
+    using C = core::FileReadFailure::Code;
+    const auto code =
+        read.error().code == C::TOO_LARGE ? IoError::Code::TOO_LARGE : IoError::Code::OPEN_FAILED;
+    // The general input limit can be raised; a reader's own (a depth image, an index) cannot.
+    const bool general = code == IoError::Code::TOO_LARGE && max_bytes == core::max_input_bytes();
+    return err(IoError{
+        code, read.error().message + (general ? " (ORTHOFLOW_MAX_INPUT_BYTES)" : std::string())});
   }
   return bytes;
+}
+
+std::string read_failure_reason(const IoError& error, const std::filesystem::path& path) {
+  const std::string prefix = path.string() + ": ";
+  return error.message.rfind(prefix, 0) == 0 ? error.message.substr(prefix.size()) : error.message;
 }
 
 Result<void, IoError> write_file_atomically(const std::filesystem::path& path,

@@ -2,6 +2,7 @@
 /// @file
 /// @brief Whole-file reading and atomic whole-file writing with IoError reporting.
 #include <filesystem>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -11,12 +12,16 @@
 
 namespace orthoflow::formats {
 
-/// @brief Reads the whole file, at most @p max_bytes of it: a longer file (or an endless one such
-/// as /dev/zero) is TOO_LARGE, never an allocation without bound. Errors name the path and the
-/// reason.
+/// @brief Reads the whole regular file, at most @p max_bytes of it (core/regular_file.hpp): a
+/// longer file is TOO_LARGE, never an allocation without bound; a FIFO, socket or device (such as
+/// /dev/zero) is OPEN_FAILED at once, never waited on. Errors name the path and the reason.
 [[nodiscard]] Result<std::vector<char>, IoError> read_file_bytes(
     const std::filesystem::path& path, std::size_t max_bytes = core::max_input_bytes());
 
+/// @brief The reason in a read_file_bytes error on @p path: its message without the leading
+/// "<path>: " (for callers that name the file their own way).
+[[nodiscard]] std::string read_failure_reason(const IoError& error,
+                                              const std::filesystem::path& path);
 /// @brief Writes @p bytes to a temporary file beside @p path, then renames it over @p path,
 /// so that readers never see a half-written file.
 [[nodiscard]] Result<void, IoError> write_file_atomically(const std::filesystem::path& path,

@@ -10,6 +10,7 @@
 #include "graphs/nodes/session_log_node.hpp"
 #include "graphs/nodes/source_nodes.hpp"
 #include "graphs/nodes/track_describe_nodes.hpp"
+#include "graphs/nodes/tum_source.hpp"
 
 namespace orthoflow::graphs {
 
@@ -22,6 +23,7 @@ engine::NodeRegistry make_tabletop_registry(LearningService& learning, SessionLo
   add_source_nodes(registry);
   add_kinect_source(registry);
   add_replay_source(registry);
+  add_tum_source(registry);
   add_body_filter_node(registry, arm_state);
   add_segment_nodes(registry, labels);
   add_track_describe_nodes(registry);

@@ -1,10 +1,15 @@
 #include "ui/server_config.hpp"
 
 #include <arpa/inet.h>
+#include <unistd.h>
 
 #include <charconv>
+#include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <random>
+
+#include "core/regular_file.hpp"
 
 namespace orthoflow::ui {
 
@@ -47,18 +52,37 @@ std::string generate_token() {
   return token;
 }
 
+Result<std::string, std::string> write_private_token(const std::string& token) {
+  std::string path =
+      (std::filesystem::temp_directory_path() / "orthoflow-ui-token-XXXXXX").string();
+  const int fd = ::mkstemp(path.data());  // 0600, O_EXCL
+  if (fd < 0) return err("cannot create a private file for the generated token in " + path);
+  const std::string line = token + "\n";
+  const bool written = ::write(fd, line.data(), line.size()) == static_cast<ssize_t>(line.size());
+  ::close(fd);
+  if (!written) {
+    ::unlink(path.c_str());
+    return err("cannot write the generated token to " + path);
+  }
+  return path;
+}
+
 Result<std::string, std::string> read_token_file(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) return err("--ui-token-file " + path + ": cannot be read");
-  std::string line;
-  std::getline(in, line);
+  // A regular file of at most 4 KiB, opened without blocking: a FIFO or /dev/zero is refused at
+  // once.
+  auto text = core::read_regular_text(path, 4096);
+  if (!text) return err("--ui-token-file " + text.error().message);
+  return token_from_text(*text, "--ui-token-file " + path);
+}
+
+Result<std::string, std::string> token_from_text(const std::string& text, const std::string& what) {
+  std::string line = text.substr(0, text.find('\n'));
   const auto first = line.find_first_not_of(" \t\r");
   const auto last = line.find_last_not_of(" \t\r");
   line = first == std::string::npos ? std::string{} : line.substr(first, last - first + 1);
-  if (line.size() < 16) return err("--ui-token-file " + path + ": the token is shorter than 16");
+  if (line.size() < 16) return err(what + ": the token is shorter than 16");
   for (const char c : line) {
-    if (c <= ' ' || c > '~')
-      return err("--ui-token-file " + path + ": the token holds a space or a non-ASCII byte");
+    if (c <= ' ' || c > '~') return err(what + ": the token holds a space or a non-ASCII byte");
   }
   return line;
 }

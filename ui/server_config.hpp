@@ -34,8 +34,18 @@ struct UiServerConfig {
 /// @brief A fresh token: TOKEN_BYTES from std::random_device, in hex.
 [[nodiscard]] std::string generate_token();
 
+/// @brief Writes a generated @p token to a new file only this user can read (mode 0600, created
+/// exclusively in the temporary directory) and returns its path, so that the token itself is never
+/// printed.
+[[nodiscard]] Result<std::string, std::string> write_private_token(const std::string& token);
+
 /// @brief The token in @p path (first line, surrounding white space removed; at least 16
 /// characters of printable ASCII). Errors name the file and the problem.
+/// The file must be a regular file of at most 4 KiB (core/regular_file.hpp: a FIFO or a device is
+/// refused at once, never waited on).
 [[nodiscard]] Result<std::string, std::string> read_token_file(const std::string& path);
+/// @brief The token in a token file's @p text (read_token_file's rule); errors start with @p what.
+[[nodiscard]] Result<std::string, std::string> token_from_text(const std::string& text,
+                                                               const std::string& what);
 
 }  // namespace orthoflow::ui

@@ -95,17 +95,20 @@ Result<std::unique_ptr<UiServer>, std::string> UiServer::start(UiServerConfig co
   // A WebSocket holds its worker thread while it lives: streams get threads of their own.
   const std::string threads =
       std::to_string(s->config_.threads + s->config_.max_stream_clients + 1);
-  const char* options[] = {"listening_ports",
-                           ports.c_str(),
-                           "num_threads",
-                           threads.c_str(),
-                           "request_timeout_ms",
-                           "10000",
-                           "enable_websocket_ping_pong",
-                           "yes",
-                           "websocket_timeout_ms",
-                           "30000",
-                           nullptr};
+  // civetweb answers a CORS preflight itself ("*") unless the access_control_* options are empty:
+  // the API is same-origin only (docs/UI.md), so no preflight is ever granted.
+  // clang-format off
+  const char* options[] = {
+      "listening_ports", ports.c_str(),
+      "num_threads", threads.c_str(),
+      "request_timeout_ms", "10000",
+      "enable_websocket_ping_pong", "yes",
+      "websocket_timeout_ms", "30000",
+      "access_control_allow_origin", "",
+      "access_control_allow_methods", "",
+      "access_control_allow_headers", "",
+      nullptr};
+  // clang-format on
   mg_callbacks callbacks{};
   callbacks.log_message = [](const mg_connection*, const char*) { return 1; };  // answered here
   callbacks.init_thread = [](const mg_context*, int) -> void* {  // master, workers, timer
@@ -130,9 +133,8 @@ UiServer::~UiServer() {
 }
 
 std::string UiServer::url() const {
-  std::string u = "http://" + config_.address + ":" + std::to_string(port_) + "/";
-  if (!policy_.token.empty()) u += "?token=" + policy_.token;
-  return u;
+  // Never with the token: the URL is printed, and a service's output goes to the journal.
+  return "http://" + config_.address + ":" + std::to_string(port_) + "/";
 }
 
 int UiServer::handle_http(mg_connection* conn) {

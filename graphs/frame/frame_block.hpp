@@ -145,6 +145,7 @@ struct FrameState {
   Gravity gravity = Gravity::NONE;  ///< where this frame's "up" came from
   std::array<float, 3> up{};        ///< unit "up" in the sensor frame (gravity != NONE)
   std::uint32_t up_age_ms = 0;      ///< age of the sensor reading behind it (Gravity::SENSOR)
+  std::uint32_t up_stale_ms = 0;    ///< age of a sensor reading refused as too old (0: none)
   std::uint32_t hull_count = 0;
   std::uint32_t clusters = 0;           ///< clusters before the candidate constraints
   std::uint32_t rejected_size = 0;      ///< failed C_size

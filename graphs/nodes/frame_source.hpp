@@ -10,6 +10,7 @@
 #include "engine/frame_payload.hpp"
 #include "engine/node.hpp"
 #include "graphs/frame/frame_block.hpp"
+#include "graphs/nodes/decode_ahead.hpp"
 #include "graphs/nodes/node_support.hpp"
 #include "kernels/point_cloud.hpp"
 #include "simulation/world/object_catalog.hpp"
@@ -57,6 +58,18 @@ class FrameSource : public engine::Node {
     const auto n = simulation::table_frame(table).normal;
     cloud.info.up = {static_cast<float>(n[0]), static_cast<float>(n[1]), static_cast<float>(n[2])};
     cloud.info.up_age_ms = 0;
+  }
+  /// A file that could not be used (@p slot's error, or no slot within the decoder's timeout,
+  /// @p timeout_text): an empty frame carrying the error, so the run counts and names it.
+  void emit_decode_failure(engine::Message& out, const DecodeAhead::Slot* slot,
+                           std::string_view timeout_text) noexcept {
+    const FrameBlock block = block_of(out, capacity_);
+    (void)engine::write_frame(block.raw(), kernels::PointCloud{});
+    new (&block.state()) FrameState{};
+    FrameError& e = block.state().error;
+    e.set(FrameError::Code::FILE_UNREADABLE, name_,
+          slot == nullptr ? 0 : static_cast<std::uint8_t>(slot->error.code));
+    e.detail.assign_elided(slot == nullptr ? timeout_text : std::string_view(slot->error.message));
   }
   /// Writes @p cloud into the message's block and clears the per-frame state.
   bool emit_cloud(engine::Message& out, const kernels::PointCloud& cloud) noexcept {

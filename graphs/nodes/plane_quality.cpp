@@ -51,7 +51,7 @@ void PlaneQualityCounters::record_verdict(kernels::TableReason verdict, kernels:
 std::size_t PlaneQualityCounters::read(std::span<engine::DeviceCounter> out) const noexcept {
   const std::uint64_t min_share = min_share_ppm_.load(std::memory_order_relaxed);
   constexpr auto relaxed = std::memory_order_relaxed;
-  const std::array<engine::DeviceCounter, 13> all{{
+  const std::array<engine::DeviceCounter, 14> all{{
       {"frames", frames_.load(std::memory_order_relaxed)},
       {"switched", switched_.load(std::memory_order_relaxed)},
       {"doubtful", doubtful_.load(std::memory_order_relaxed)},
@@ -65,6 +65,7 @@ std::size_t PlaneQualityCounters::read(std::span<engine::DeviceCounter> out) con
       {"refused_out_of_range", out_of_range_.load(relaxed)},
       {"refused_too_small", too_small_.load(relaxed)},
       {"no_gravity", no_gravity_.load(relaxed)},
+      {"up_stale", up_stale_.load(relaxed)},
   }};
   const std::size_t k = std::min(out.size(), all.size());
   std::copy_n(all.begin(), k, out.begin());

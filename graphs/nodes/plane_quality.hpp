@@ -32,6 +32,8 @@ class PlaneQualityCounters {
   /// the last table), @p own what its own plane got, @p gravity whether it knew where up is.
   void record_verdict(kernels::TableReason verdict, kernels::TableReason own,
                       bool gravity) noexcept;
+  /// @brief Counts a sensor's "up" refused as too old.
+  void record_stale_up() noexcept { up_stale_.fetch_add(1, std::memory_order_relaxed); }
   /// @brief Writes the counters (names with static storage) into @p out; @return how many.
   /// Shares are in parts per million, residuals in micrometres; the worst values are 0 before the
   /// first plane.
@@ -42,7 +44,7 @@ class PlaneQualityCounters {
   std::atomic<std::uint64_t> last_share_ppm_{0}, last_rms_um_{0};
   std::atomic<std::uint64_t> min_share_ppm_{UINT64_MAX}, max_rms_um_{0};
   std::atomic<std::uint64_t> tables_{0}, held_{0}, not_level_{0}, out_of_range_{0}, too_small_{0};
-  std::atomic<std::uint64_t> no_gravity_{0};
+  std::atomic<std::uint64_t> no_gravity_{0}, up_stale_{0};
 };
 
 }  // namespace orthoflow::graphs

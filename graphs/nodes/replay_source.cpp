@@ -15,6 +15,7 @@
 #include "graphs/nodes/fakenect_calibration.hpp"
 #include "graphs/nodes/frame_source.hpp"
 #include "graphs/nodes/node_support.hpp"
+#include "graphs/nodes/recorded_pace.hpp"
 #include "kernels/depth_projection.hpp"
 
 namespace orthoflow::graphs {
@@ -34,7 +35,7 @@ struct RecordedUp {
 
 /// What a recording lacks, counted once at start-up.
 struct RecordingStats {
-  std::uint64_t frames_missing = 0, without_gravity = 0, accel_skipped = 0;
+  std::uint64_t frames_missing = 0, without_gravity = 0, accel_skipped = 0, out_of_order = 0;
 };
 
 /// Frames missing between consecutive depth records: device-time gaps of more than one and a
@@ -90,7 +91,6 @@ Result<std::vector<RecordedUp>, std::string> recorded_ups(
 class ReplaySource final : public FrameSource {
  public:
   static constexpr std::chrono::milliseconds DECODE_TIMEOUT{5000};
-  static constexpr std::int64_t MAX_GAP_NS = 1'000'000'000;  // a pause in the recording: cut to 1 s
 
   ReplaySource(std::size_t capacity, const engine::NodeContext& context,
                std::vector<formats::FakenectEntry> entries, std::vector<RecordedUp> ups,
@@ -114,13 +114,15 @@ class ReplaySource final : public FrameSource {
 
   /// The recording's account: depth records, frames missing between them (gaps in the device's
   /// 60 MHz timestamps of more than one 30 Hz frame period), depth records with no accelerometer
-  /// reading before them, and accelerometer records skipped (unreadable or implausible).
+  /// reading before them, accelerometer records skipped (unreadable or implausible), and depth
+  /// records skipped because INDEX.txt lists them after a later one (out of time order).
   const char* counter_group() const noexcept override { return "recording"; }
   std::size_t device_counters(std::span<engine::DeviceCounter> out) const noexcept override {
-    const std::array<engine::DeviceCounter, 4> all{{{"depth_records", entries_.size()},
+    const std::array<engine::DeviceCounter, 5> all{{{"depth_records", entries_.size()},
                                                     {"frames_missing", stats_.frames_missing},
                                                     {"without_gravity", stats_.without_gravity},
-                                                    {"accel_skipped", stats_.accel_skipped}}};
+                                                    {"accel_skipped", stats_.accel_skipped},
+                                                    {"out_of_order", stats_.out_of_order}}};
     const std::size_t k = std::min(out.size(), all.size());
     std::copy_n(all.begin(), k, out.begin());
     return k;
@@ -129,18 +131,10 @@ class ReplaySource final : public FrameSource {
   engine::SourceStatus produce(Message& out) noexcept override {
     DecodeAhead::Slot* slot = decoder_->next(DECODE_TIMEOUT);
     if (slot != nullptr && slot->end) return engine::SourceStatus::END;
-    if (slot != nullptr && slot->ok && paced_) pace(slot->schedule_ns);
+    if (slot != nullptr && slot->ok && paced_) pace_.wait(slot->schedule_ns);
     if (!take_block(out)) return engine::SourceStatus::FRAME;
     if (slot == nullptr || !slot->ok) {
-      const FrameBlock block = block_of(out, capacity_);
-      (void)engine::write_frame(block.raw(), kernels::PointCloud{});
-      new (&block.state()) FrameState{};
-      FrameError& e = block.state().error;
-      e.set(FrameError::Code::FILE_UNREADABLE, name_,
-            slot == nullptr ? 0 : static_cast<std::uint8_t>(slot->error.code));
-      e.detail.assign_elided(slot == nullptr
-                                 ? std::string_view("replay_source: no record decoded within 5 s")
-                                 : std::string_view(slot->error.message));
+      emit_decode_failure(out, slot, "replay_source: no record decoded within 5 s");
       return engine::SourceStatus::FRAME;
     }
     kernels::PointCloud& cloud = slot->cloud;
@@ -157,9 +151,11 @@ class ReplaySource final : public FrameSource {
     const formats::FakenectEntry& e = entries_[index];
     // Errors name the record as INDEX.txt lists it (a frame error's detail is short).
     auto bytes = formats::read_file_bytes(dir_ / e.file, std::size_t{1} << 20);
-    auto read = bytes ? formats::parse_fakenect_depth(*bytes, e.file, raw_)
-                      : Result<void, formats::IoError>(
-                            err(formats::IoError{bytes.error().code, e.file + ": cannot read"}));
+    auto read =
+        bytes ? formats::parse_fakenect_depth(*bytes, e.file, raw_)
+              : Result<void, formats::IoError>(err(formats::IoError{
+                    bytes.error().code,
+                    e.file + ": " + formats::read_failure_reason(bytes.error(), dir_ / e.file)}));
     if (!read) {
       slot.ok = false;
       slot.error = read.error();
@@ -182,19 +178,6 @@ class ReplaySource final : public FrameSource {
     slot.ok = true;
   }
 
-  /// Sleeps until the record's recorded time (relative to the first record emitted).
-  void pace(std::int64_t schedule_ns) noexcept {
-    const auto now = Clock::now();
-    if (!started_ || schedule_ns < last_schedule_ns_) {  // first record, or the loop started over
-      started_ = true;
-      origin_ = now - std::chrono::nanoseconds(schedule_ns);
-    } else if (schedule_ns - last_schedule_ns_ > MAX_GAP_NS) {
-      origin_ -= std::chrono::nanoseconds(schedule_ns - last_schedule_ns_ - MAX_GAP_NS);
-    }
-    last_schedule_ns_ = schedule_ns;
-    std::this_thread::sleep_until(origin_ + std::chrono::nanoseconds(schedule_ns));
-  }
-
   std::vector<formats::FakenectEntry> entries_;
   std::vector<RecordedUp> ups_;  // one per entry
   RecordingStats stats_;
@@ -206,9 +189,7 @@ class ReplaySource final : public FrameSource {
   double first_seconds_ = 0.0;
   std::uint64_t ticks_ = 0;
   std::uint32_t last_ticks_ = 0;
-  bool started_ = false;
-  std::int64_t last_schedule_ns_ = 0;
-  Clock::time_point origin_{};
+  RecordedPace pace_;
   std::uint64_t frames_ = 0;
   std::unique_ptr<DecodeAhead> decoder_;  // last: its thread uses everything above
 };
@@ -237,14 +218,30 @@ NodeResult make_replay(const ParamMap& params, const engine::NodeContext& contex
                  "replay_source: %zu of %zu accelerometer records skipped (unreadable, or not a "
                  "plausible gravity reading)\n",
                  unusable, accel_records);
+  // Depth records in time order: one whose host time is not later than the record before it is
+  // skipped and counted, never reordered (the device clock wraps every 72 s; the host's does not).
   std::vector<formats::FakenectEntry> depth;
-  for (auto& entry : *index) {
-    if (entry.kind == 'd') depth.push_back(std::move(entry));
-  }
+  std::vector<RecordedUp> depth_ups;
   RecordingStats stats;
+  std::size_t d = 0;
+  for (auto& entry : *index) {
+    if (entry.kind != 'd') continue;
+    const RecordedUp up = (*ups)[d++];
+    if (!depth.empty() && !(entry.host_seconds > depth.back().host_seconds)) {
+      ++stats.out_of_order;
+      continue;
+    }
+    depth.push_back(std::move(entry));
+    depth_ups.push_back(up);
+  }
+  if (stats.out_of_order > 0)
+    std::fprintf(stderr,
+                 "replay_source: %llu depth records skipped: INDEX.txt lists them after a later "
+                 "one\n",
+                 static_cast<unsigned long long>(stats.out_of_order));
   stats.frames_missing = frames_missing(depth);
   stats.accel_skipped = unusable;
-  for (const RecordedUp& u : *ups)
+  for (const RecordedUp& u : depth_ups)
     stats.without_gravity += u.up == std::array<float, 3>{} ? 1U : 0U;
   if (depth.empty()) return err("replay_source: '" + dir + "/INDEX.txt' lists no depth record");
   // device.json is optional in fakenect (older recordings lack it): the typical device then.
@@ -254,9 +251,9 @@ NodeResult make_replay(const ParamMap& params, const engine::NodeContext& contex
     if (!device) return err("replay_source: " + device.error().to_string());
     calibration = *device;
   }
-  return std::unique_ptr<engine::Node>(new ReplaySource(*capacity, context, std::move(depth),
-                                                        std::move(*ups), stats, dir, calibration,
-                                                        pace == "recorded", loop == 1));
+  return std::unique_ptr<engine::Node>(
+      new ReplaySource(*capacity, context, std::move(depth), std::move(depth_ups), stats, dir,
+                       calibration, pace == "recorded", loop == 1));
 }
 
 }  // namespace

@@ -59,9 +59,9 @@ Result<std::array<float, 3>, std::string> parse_up(const std::string& text) {
 
 Result<void, std::string> parse_table_params(const engine::ParamMap& params,
                                              TabletopSegmentation& out) {
-  if (auto ok =
-          params.only({"tau", "iterations", "confidence", "seed", "max_tilt_deg", "min_height",
-                       "max_height", "min_share", "min_area", "hold_frames", "up"});
+  if (auto ok = params.only({"tau", "iterations", "confidence", "seed", "max_tilt_deg",
+                             "min_height", "max_height", "min_share", "min_area", "hold_frames",
+                             "up", "max_up_age_ms"});
       !ok)
     return err(ok.error());
   kernels::RansacParams& r = out.stages.ransac;
@@ -77,6 +77,8 @@ Result<void, std::string> parse_table_params(const engine::ParamMap& params,
   take(params.number("min_share", v.min_share, 0.0, 1.0), v.min_share, e);
   take(params.number("min_area", v.min_area_m2, 0.0, 100.0), v.min_area_m2, e);
   take(params.integer("hold_frames", out.table.hold_frames, 0, 30), out.table.hold_frames, e);
+  take(params.integer("max_up_age_ms", out.table.max_up_age_ms, 0, 60000), out.table.max_up_age_ms,
+       e);
   std::string up = "none";
   take(params.text("up", "none"), up, e);
   if (!e.empty()) return err(e);

@@ -25,6 +25,10 @@ struct TableSettings {
   /// Frames the last accepted table is kept through when a frame's plane fails the verdict (a
   /// hand or an arm in front of the table for a moment). 0: no hysteresis.
   std::uint32_t hold_frames = 2;
+  /// A sensor's "up" older than this is not trusted (a camera whose accelerometer reads stopped,
+  /// or one that was moved since): the frame falls back to the configured up, else none, and says
+  /// so (`up_stale_ms`). The Kinect driver reads its accelerometer every 100 ms.
+  std::uint32_t max_up_age_ms = 1000;
 };
 
 /// @brief The segmentation of the tabletop graph: the stage parameters, the candidate
@@ -43,7 +47,8 @@ struct TabletopSegmentation {
 [[nodiscard]] Result<void, std::string> parse_preprocess_params(const engine::ParamMap& params,
                                                                 kernels::SegmentationParams& out);
 /// @brief table: tau (m), iterations, confidence, seed; the verdict's max_tilt_deg, min_height,
-/// max_height (m), min_share, min_area (m^2), hold_frames and up ("x,y,z", normalised).
+/// max_height (m), min_share, min_area (m^2), hold_frames, up ("x,y,z", normalised) and
+/// max_up_age_ms.
 [[nodiscard]] Result<void, std::string> parse_table_params(const engine::ParamMap& params,
                                                            TabletopSegmentation& out);
 /// @brief objects: h_min, h_max, tolerance, min_points, max_points, pixel_radius, merge_overlap and

@@ -85,18 +85,8 @@ class PcdSource final : public FrameSource {
     const std::uint64_t index = frame_++;
     if (!take_block(out)) return engine::SourceStatus::FRAME;  // the file is skipped with the frame
     if (slot == nullptr || !slot->ok) {  // a bad file is an empty frame with its error
-      const FrameBlock block = block_of(out, capacity_);
-      (void)engine::write_frame(block.raw(), kernels::PointCloud{});
-      new (&block.state()) FrameState{};
-      FrameError& e = block.state().error;
-      if (slot == nullptr) {
-        e.set(FrameError::Code::FILE_UNREADABLE, name_, 0);
-        e.detail.assign_elided("pcd_source: the decoder did not deliver the next file within 5 s");
-      } else {
-        e.set(FrameError::Code::FILE_UNREADABLE, name_,
-              static_cast<std::uint8_t>(slot->error.code));
-        e.detail.assign_elided(slot->error.message);
-      }
+      emit_decode_failure(out, slot,
+                          "pcd_source: the decoder did not deliver the next file within 5 s");
       return engine::SourceStatus::FRAME;
     }
     kernels::PointCloud& cloud = slot->cloud;  // ours until release()

@@ -54,13 +54,23 @@ class Table final : public engine::Node {
   }
 
  private:
-  /// The frame's own "up" (its sensor's), else the configured one, else none.
-  void take_up(const FrameBlock& block, FrameState& s) const noexcept {
+  /// The frame's own "up" (its sensor's) if it is fresh, else the configured one, else none. A
+  /// sensor reading older than max_up_age_ms is refused and its age reported (up_stale_ms).
+  void take_up(const FrameBlock& block, FrameState& s) noexcept {
     auto frame = block.frame();
-    if (frame && engine::frame_up(*frame->header, s.up)) {
-      s.gravity = Gravity::SENSOR;
-      s.up_age_ms = frame->header->up_age_ms;
-    } else if (table_.up) {
+    s.up_stale_ms = 0;
+    std::array<float, 3> sensed{};
+    if (frame && engine::frame_up(*frame->header, sensed)) {
+      if (frame->header->up_age_ms <= table_.max_up_age_ms) {
+        s.gravity = Gravity::SENSOR;
+        s.up = sensed;
+        s.up_age_ms = frame->header->up_age_ms;
+        return;
+      }
+      s.up_stale_ms = std::max<std::uint32_t>(frame->header->up_age_ms, 1);
+      quality_.record_stale_up();
+    }
+    if (table_.up) {
       s.gravity = Gravity::CONFIGURED;
       s.up = *table_.up;
     } else {

@@ -115,6 +115,9 @@ void SessionLog::write_json(const FrameBlock& block, std::uint64_t frame_id) noe
       static_cast<unsigned long long>(frame_id), static_cast<long long>(stamp),
       s.table_found ? "true" : "false", static_cast<int>(verdict.size()), verdict.data(),
       static_cast<int>(gravity.size()), gravity.data(), tilt));
+  if (s.up_stale_ms > 0)  // the sensor's up was refused as too old: why gravity is not "sensor"
+    n += static_cast<std::size_t>(
+        std::snprintf(out + n, cap - n, R"("up_stale_ms":%u,)", s.up_stale_ms));
   if (s.judged.height_m > 0.0F)  // what the verdict measured on this frame's own plane
     n += static_cast<std::size_t>(std::snprintf(
         out + n, cap - n, R"("support":{"share":%.4f,"area_m2":%.4f,"height_m":%.4f},)",

@@ -1,6 +1,7 @@
 """`orthoflow kinect record DIR` and `orthoflow run --source replay:DIR` (issue 18): a recording of
 the simulated camera in fakenect's format, replayed through the same conversion as the live camera;
-an existing recording is never overwritten; a damaged record is a frame error naming the file."""
+an existing recording is never overwritten; a damaged record is a frame error naming the file; a
+FIFO in its place is refused at once; a recording none of whose records reads fails the run."""
 import json
 import os
 import re
@@ -74,6 +75,23 @@ with open(os.path.join(bad, depth[3]), "r+b") as f:
 p = run(cli, "run", "--source", "replay:" + bad, "--rate", "max", "--threads", "1", code=None)
 expect("15 processed" in p.stdout and "1 with an error" in p.stdout, f"bad replay: {p.stdout}")
 expect(depth[3] in p.stderr, f"bad replay names the file: {p.stderr}")
+# A FIFO where a record should be: refused at once as not a regular file (never waited on), the
+# other frames run (issue 52, item 8).
+fifo = os.path.join(work, "fifo")
+shutil.copytree(rec, fifo)
+os.remove(os.path.join(fifo, depth[5]))
+os.mkfifo(os.path.join(fifo, depth[5]))
+p = run(cli, "run", "--source", "replay:" + fifo, "--rate", "max", "--threads", "1", timeout=60)
+expect("15 processed" in p.stdout and "1 with an error" in p.stdout, f"fifo replay: {p.stdout}")
+expect("is not a regular file" in p.stderr, f"fifo replay says why: {p.stderr}")
+# A recording none of whose records reads: the run has no result and fails (issue 52, item 9).
+dead = os.path.join(work, "dead")
+shutil.copytree(rec, dead)
+for name in depth:
+    with open(os.path.join(dead, name), "r+b") as f:
+        f.truncate(1000)
+p = run(cli, "run", "--source", "replay:" + dead, "--rate", "max", "--threads", "1", code=2)
+expect("no frame could be used (15 of 15 failed)" in p.stderr, f"dead replay: {p.stderr}")
 # A directory without a recording.
 p = run(cli, "run", "--source", "replay:" + work, code=None)
 expect(p.returncode != 0 and "INDEX.txt" in p.stderr, f"no index: {p.stderr}")

@@ -4,7 +4,9 @@ level plane at all), a plane 15 degrees from level is refused as not level; the
 same wall is a floor-like support when the accelerometer says the camera looks straight down; with
 no accelerometer records the level test is skipped and the JSON says `gravity: none`; unusable
 accelerometer readings (all zero) are skipped and counted; a small patch is too small; and the last
-accepted table is held through two frames and no more."""
+accepted table is held through two frames and no more; an accelerometer reading older than a second
+is not trusted (gravity none, its age in `up_stale_ms`, counted as `up_stale`); a depth record listed
+after a later one is skipped and counted."""
 import json
 import math
 import os
@@ -38,17 +40,18 @@ def accel_record(x, y, z):
     return struct.pack("<hhhbxi", x, y, z, 0, 0)  # freenect_raw_tilt_state, 12 bytes
 
 
-def recording(name, frames, accel, omit=()):
-    """frames: depth record bytes; accel: (x, y, z) counts written before every frame, or None;
-    omit: frame numbers the recorder "dropped" (gaps in the device timestamps)."""
+def recording(name, frames, accel, omit=(), period=1 / 30.0, accel_once=False):
+    """frames: depth record bytes; accel: (x, y, z) counts written before every frame (before the
+    first only, with accel_once), or None; omit: frame numbers the recorder "dropped" (gaps in the
+    device timestamps); period: host seconds between frames."""
     d = os.path.join(work, name)
     os.makedirs(d)
     index = []
     for k, data in enumerate(frames):
         if k in omit:
             continue
-        t, ticks = 1000.0 + k / 30.0, 2000000 * (k + 1)
-        if accel is not None:
+        t, ticks = 1000.0 + k * period, 2000000 * (k + 1)
+        if accel is not None and (k == 0 or not accel_once):
             a = "a-%.6f-%d.dump" % (t - 0.005, ticks)
             open(os.path.join(d, a), "wb").write(accel_record(*accel))
             index.append(a)
@@ -116,4 +119,25 @@ expect([r["table"] for r in rows] == [True] * 5 + [False] * 2, f"hold tables: {r
 _, p = replay(recording("gap", [wall] * 8, DOWN, omit={2, 3, 6}))
 expect("depth_records 5, frames_missing 3, without_gravity 0, accel_skipped 0" in p.stdout + p.stderr,
        f"gap: {p.stdout} {p.stderr}")
+# Frames out of time order: INDEX.txt lists frame 3 before frame 2. Frame 2 is skipped and counted
+# (and, missing from the replay, counted as a missing frame), never replayed backwards in time.
+d = recording("out_of_order", [wall] * 6, DOWN)
+lines = open(os.path.join(d, "INDEX.txt")).read().split()
+depth = [k for k, n in enumerate(lines) if n.startswith("d-")]
+lines[depth[2]], lines[depth[3]] = lines[depth[3]], lines[depth[2]]
+open(os.path.join(d, "INDEX.txt"), "w").write("\n".join(lines) + "\n")
+rows, p = replay(d)
+expect(len(rows) == 5, f"out_of_order: {len(rows)} frames")
+expect("depth_records 5, frames_missing 1, without_gravity 0, accel_skipped 0, out_of_order 1"
+       in p.stdout + p.stderr, f"out_of_order: {p.stdout} {p.stderr}")
+expect("1 depth records skipped: INDEX.txt lists them after a later one" in p.stderr,
+       f"out_of_order stderr: {p.stderr}")
+
+# A stale accelerometer: one reading before the first frame, frames 0.6 s apart. A reading older
+# than the table node's max_up_age_ms (1000) is not trusted: gravity none, and the age is reported.
+rows, p = replay(recording("stale", [wall] * 4, DOWN, period=0.6, accel_once=True))
+expect([r["gravity"] for r in rows] == ["sensor", "sensor", "none", "none"], f"stale: {rows}")
+expect("up_stale_ms" not in rows[1] and abs(rows[2]["up_stale_ms"] - 1205) <= 2 and
+       abs(rows[3]["up_stale_ms"] - 1805) <= 2, f"stale ages: {rows}")
+expect("up_stale 2" in p.stdout + p.stderr, f"stale counter: {p.stdout} {p.stderr}")
 print("ok")

@@ -4,9 +4,10 @@ import subprocess
 import sys
 
 
-def run(cli, *args, code=0):
-    """Runs `cli args...`; exits the check with the output when the exit code is not @p code."""
-    p = subprocess.run([cli, *map(str, args)], capture_output=True, text=True)
+def run(cli, *args, code=0, timeout=None):
+    """Runs `cli args...`; exits the check with the output when the exit code is not @p code (a run
+    past @p timeout seconds raises subprocess.TimeoutExpired, failing the check)."""
+    p = subprocess.run([cli, *map(str, args)], capture_output=True, text=True, timeout=timeout)
     if code is not None and p.returncode != code:
         sys.exit(f"FAIL: {' '.join(map(str, args))}: exit {p.returncode}, wanted {code}\n"
                  f"stdout: {p.stdout}\nstderr: {p.stderr}")
@@ -27,7 +28,7 @@ def start_ui_run(cli, graph, db, token_file, frames=9000):
                              stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     for line in robot.stdout:
         if line.startswith("ui: http://"):
-            return robot, line.split()[1].split("/?")[0]
+            return robot, line.split()[1].split("?")[0].rstrip("/")
     return robot, None
 
 

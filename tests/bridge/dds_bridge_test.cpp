@@ -63,6 +63,9 @@ TEST(DdsBridge, ObjectsFramesAndLessonsCrossToAPlainDdsNodeAndBack) {
         const ProcResult taught = plain(box, "teach", {"--points", "--teach", "mug"});
         box.check(taught.exit_code == 0, "objects, points and an ack reach the plain node", taught);
         box.check(has(taught, "frame_id camera_depth_optical_frame"), "objects' frame", taught);
+        // The simulated camera knows its pose: the table verdict crosses with its "up".
+        box.check(has(taught, "table true (accepted, gravity sensor)"), "the table verdict",
+                  taught);
         box.check(has(taught, "points: 640x480, 4 fields (x), point_step 16, row_step 10240"),
                   "an organized PointCloud2 as ROS drivers publish it", taught);
         box.check(

@@ -4,6 +4,7 @@
 // ROS 2 names (topics with rmw_cyclonedds' "rt" prefix, type names pkg::msg::dds_::Name_).
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -117,6 +118,33 @@ TEST(DdsMessages, ABadPoseIsNeverSentAsAPose) {
   auto none = list_with(0);
   EXPECT_EQ(to_ros(*none, StampClock(0), scratch, msg), 0U);
   EXPECT_EQ(msg.objects._length, 0U);
+}
+
+TEST(DdsMessages, TheTableVerdictAndWhereUpCameFromTravelWithTheObjects) {
+  auto list = list_with(0);
+  RosScratch scratch;
+  RosObjectArray msg{};
+  (void)to_ros(*list, StampClock(0), scratch, msg);  // reset_header(): nothing reported
+  EXPECT_FALSE(msg.table);
+  EXPECT_STREQ(msg.table_reason, "");
+  EXPECT_STREQ(msg.gravity, "");
+  const std::array<const char*, 6> reasons{"accepted",  "held",         "no_plane",
+                                           "not_level", "out_of_range", "too_small"};
+  for (std::uint8_t code = 1; code <= 6; ++code) {
+    list->table_reason = code;
+    list->gravity = static_cast<std::uint8_t>(1 + code % 3);
+    (void)to_ros(*list, StampClock(0), scratch, msg);
+    EXPECT_STREQ(msg.table_reason, reasons[code - 1U]);
+    EXPECT_EQ(msg.table, code <= 2) << "accepted and held are tables";
+    const std::array<const char*, 3> gravities{"none", "sensor", "configured"};
+    EXPECT_STREQ(msg.gravity, gravities[code % 3]);
+  }
+  list->table_reason = 7;  // a code from a newer sender: not reported, never read out of range
+  list->gravity = 200;
+  (void)to_ros(*list, StampClock(0), scratch, msg);
+  EXPECT_FALSE(msg.table);
+  EXPECT_STREQ(msg.table_reason, "");
+  EXPECT_STREQ(msg.gravity, "");
 }
 
 TEST(DdsMessages, AFrameBecomesAnOrganizedPointCloud2AsRosDriversPublishIt) {

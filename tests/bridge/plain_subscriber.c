@@ -139,8 +139,9 @@ int main(int argc, char** argv) {
       if (lists > 0 && a->frame_number > last_frame + 1) gaps += a->frame_number - last_frame - 1;
       last_frame = a->frame_number;
       if (lists == 0)
-        printf("objects: frame %" PRIu64 " frame_id %s, %u objects\n", a->frame_number,
-               a->header.frame_id, a->objects._length);
+        printf("objects: frame %" PRIu64 " frame_id %s, %u objects, table %s (%s, gravity %s)\n",
+               a->frame_number, a->header.frame_id, a->objects._length,
+               a->table ? "true" : "false", a->table_reason, a->gravity);
       for (uint32_t k = 0; k < a->objects._length; ++k) {
         const orthoflow_msgs_msg_dds__Object_* o = &a->objects._buffer[k];
         const double qn = sqrt(o->pose.orientation.x * o->pose.orientation.x +

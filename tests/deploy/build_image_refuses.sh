@@ -30,6 +30,18 @@ expect bad_host "hostname" 'hostname: "robot; reboot"'
 expect missing_graph "is not a file" 'graph: nowhere.yaml'
 expect missing_token "ui.token_file" 'ui: {token_file: nowhere.token}'
 expect empty "empty" ''
+# Files a config names stay inside its folder and are what they claim to be (issue 52, item 1).
+expect token_absolute "inside the config's folder" 'ui: {token_file: "/etc/shadow"}'
+expect graph_absolute "inside the config's folder" 'graph: /etc/passwd'
+expect keys_up "inside the config's folder" 'admin: {ssh_authorized_keys: ../keys}'
+ln -s /etc/shadow "$tmp/shadow.token"
+expect token_symlink "leads outside the config's folder" 'ui: {token_file: shadow.token}'
+cp /etc/passwd "$tmp/passwd.yaml"
+expect graph_not_a_graph "graph: passwd.yaml" 'graph: passwd.yaml'
+mkfifo "$tmp/fifo.token"
+expect token_fifo "is not a regular file" 'ui: {token_file: fifo.token}'
+head -c 100000 /dev/urandom | base64 -w 0 > "$tmp/huge.token"
+expect token_huge "larger than the limit of 4096 bytes" 'ui: {token_file: huge.token}'
 out=$(bash "$here/scripts/build_image.sh" --arch armhf --out "$tmp/out" --orthoflow "$bin" 2>&1)
 if [ $? = 2 ] && printf '%s' "$out" | grep -q "amd64 or arm64"; then echo "ok: bad arch"; else echo "FAIL: arch: $out"; status=1; fi
 exit $status

@@ -171,6 +171,24 @@ TEST(RobotConfig, AdminKeys) {
   EXPECT_TRUE(RobotConfig{}.admin.ssh_authorized_keys.empty());  // no remote shell unless asked
 }
 
+TEST(RobotConfig, NamedFilesAreInsideTheConfigsFolder) {
+  // The class of "token_file: /etc/shadow" (issue 52, item 1): every file a config names.
+  for (const char* key : {"graph: ", "ui: {token_file: ", "admin: {ssh_authorized_keys: "}) {
+    const std::string k(key);
+    const bool nested = k.back() == ' ' && k.find('{') != std::string::npos;
+    for (const char* path : {"/etc/shadow", "../secret", "keys/../../x", "..", "~/.ssh/id"}) {
+      const std::string text = k + "\"" + path + "\"" + (nested ? "}" : "");
+      EXPECT_NE(error_of(text).find("a relative path inside the config's folder"),
+                std::string::npos)
+          << text;
+    }
+    for (const char* path : {"g.yaml", "keys/admin.pub", "./tok", "a..b"}) {
+      const std::string text = k + "\"" + path + "\"" + (nested ? "}" : "");
+      EXPECT_EQ(error_of(text), "") << text;
+    }
+  }
+}
+
 TEST(RobotConfig, AuthorizedKeysAreKeysOnly) {
   EXPECT_TRUE(check_authorized_keys("ssh-ed25519 AAAAC3NzaC1lZDI1NTE5AAAAIG me@host\n"));
   EXPECT_TRUE(

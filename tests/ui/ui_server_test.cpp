@@ -138,7 +138,7 @@ TEST_F(UiServerTest, TokenIsCheckedOnEveryRequest) {
                                 {{"Authorization", "Bearer " + TOKEN}});
   EXPECT_EQ(taught.status, 200) << taught.body;
   ASSERT_EQ(backend_.actions.size(), 1U);
-  EXPECT_NE(server_->url().find("?token=" + TOKEN), std::string::npos);
+  EXPECT_EQ(server_->url().find(TOKEN), std::string::npos) << "the printed URL never holds it";
 }
 
 // The page loaded with ?token= sets the token cookie, with which the browser fetches the page's
@@ -189,6 +189,28 @@ TEST_F(UiServerTest, CrossOriginAndForeignHostAreRefused) {
   const std::string own = "http://127.0.0.1:" + std::to_string(port_);
   EXPECT_EQ(post_json(port_, "/api/forget", R"({"label":"mug"})", {{"Origin", own}}).status, 200);
   EXPECT_EQ(http(port_, "GET", "/api/state", {{"Host", "rebound.example"}}, "", false).status, 403);
+}
+
+TEST_F(UiServerTest, ACorsPreflightIsNeverGranted) {
+  // civetweb answers a preflight itself with "Access-Control-Allow-Origin: *" unless told not to
+  // (issue 52, item 4): with or without a token, from a foreign origin or our own.
+  for (const bool with_token : {false, true}) {
+    server_.reset();
+    start(with_token ? TOKEN : "");
+    const std::vector<std::string> origins{"http://evil.example",
+                                           "http://127.0.0.1:" + std::to_string(port_)};
+    for (const std::string& origin : origins) {
+      std::vector<std::pair<std::string, std::string>> headers{
+          {"Origin", origin},
+          {"Access-Control-Request-Method", "POST"},
+          {"Access-Control-Request-Headers", "content-type, authorization"}};
+      if (with_token) headers.emplace_back("Authorization", "Bearer " + TOKEN);
+      const auto r = http(port_, "OPTIONS", "/api/teach", headers);
+      EXPECT_GE(r.status, 400) << origin << "\n" << r.head;
+      EXPECT_EQ(r.head.find("Access-Control-Allow"), std::string::npos) << r.head;
+    }
+  }
+  EXPECT_TRUE(backend_.actions.empty());
 }
 
 TEST_F(UiServerTest, BodyLimitAndMalformedInputGet4xxWithJson) {
