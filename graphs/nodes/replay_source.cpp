@@ -11,11 +11,9 @@
 #include "drivers/kinect/kinect_gravity.hpp"
 #include "formats/fakenect.hpp"
 #include "formats/file_bytes.hpp"
-#include "graphs/nodes/decode_ahead.hpp"
 #include "graphs/nodes/fakenect_calibration.hpp"
-#include "graphs/nodes/frame_source.hpp"
 #include "graphs/nodes/node_support.hpp"
-#include "graphs/nodes/recorded_pace.hpp"
+#include "graphs/nodes/recording_source.hpp"
 #include "kernels/depth_projection.hpp"
 
 namespace orthoflow::graphs {
@@ -24,7 +22,6 @@ namespace {
 
 using engine::Message;
 using engine::ParamMap;
-using Clock = std::chrono::steady_clock;
 namespace kinect = drivers::kinect;
 
 /// "Up" for one depth record: from the last usable accelerometer record before it in INDEX.txt.
@@ -88,29 +85,26 @@ Result<std::vector<RecordedUp>, std::string> recorded_ups(
 /// converted ahead on the decoder thread with the same code as the live camera (the device's
 /// raw-to-metres table and pinhole, kinect_source), then emitted at the recorded pace (the host
 /// times in the file names) or as fast as the graph takes them.
-class ReplaySource final : public FrameSource {
+class ReplaySource final : public RecordingSource {
  public:
-  static constexpr std::chrono::milliseconds DECODE_TIMEOUT{5000};
-
   ReplaySource(std::size_t capacity, const engine::NodeContext& context,
                std::vector<formats::FakenectEntry> entries, std::vector<RecordedUp> ups,
                const RecordingStats& stats, std::filesystem::path dir,
                const kinect::Calibration& calibration, bool paced, bool loop)
-      : FrameSource(capacity, context),
+      : RecordingSource(capacity, context, paced, "replay_source: no record decoded within 5 s"),
         entries_(std::move(entries)),
         ups_(std::move(ups)),
         stats_(stats),
         dir_(std::move(dir)),
-        paced_(paced),
         raw_(kinect::DEPTH_PIXELS) {
     kinect::make_depth_table_m(calibration, table_m_);
     camera_ = kinect::depth_camera(calibration);
     std::vector<std::filesystem::path> files;
     for (const auto& e : entries_) files.push_back(dir_ / e.file);
-    decoder_ = std::make_unique<DecodeAhead>(
-        std::move(files), loop, 3, [this](std::size_t i, DecodeAhead::Slot& s) { decode(i, s); });
+    start_decoding(std::move(files), loop,
+                   [this](std::size_t i, DecodeAhead::Slot& s) { decode(i, s); });
   }
-  ~ReplaySource() override { decoder_.reset(); }  // the decoder thread uses the members above
+  ~ReplaySource() override { stop_decoding(); }  // the decoder thread uses the members below
 
   /// The recording's account: depth records, frames missing between them (gaps in the device's
   /// 60 MHz timestamps of more than one 30 Hz frame period), depth records with no accelerometer
@@ -126,23 +120,6 @@ class ReplaySource final : public FrameSource {
     const std::size_t k = std::min(out.size(), all.size());
     std::copy_n(all.begin(), k, out.begin());
     return k;
-  }
-
-  engine::SourceStatus produce(Message& out) noexcept override {
-    DecodeAhead::Slot* slot = decoder_->next(DECODE_TIMEOUT);
-    if (slot != nullptr && slot->end) return engine::SourceStatus::END;
-    if (slot != nullptr && slot->ok && paced_) pace_.wait(slot->schedule_ns);
-    if (!take_block(out)) return engine::SourceStatus::FRAME;
-    if (slot == nullptr || !slot->ok) {
-      emit_decode_failure(out, slot, "replay_source: no record decoded within 5 s");
-      return engine::SourceStatus::FRAME;
-    }
-    kernels::PointCloud& cloud = slot->cloud;
-    cloud.info.frame_id = frames_++;
-    cloud.info.host_stamp_ns = Clock::now().time_since_epoch().count();
-    emit_cloud(out, cloud);
-    decoder_->release();
-    return engine::SourceStatus::FRAME;
   }
 
  private:
@@ -182,16 +159,12 @@ class ReplaySource final : public FrameSource {
   std::vector<RecordedUp> ups_;  // one per entry
   RecordingStats stats_;
   std::filesystem::path dir_;
-  bool paced_;
   std::array<float, kernels::DISPARITY_TABLE_SIZE> table_m_{};
   kernels::DepthCamera camera_{};
   std::vector<std::uint16_t> raw_;  // decoder thread only
   double first_seconds_ = 0.0;
   std::uint64_t ticks_ = 0;
   std::uint32_t last_ticks_ = 0;
-  RecordedPace pace_;
-  std::uint64_t frames_ = 0;
-  std::unique_ptr<DecodeAhead> decoder_;  // last: its thread uses everything above
 };
 
 NodeResult make_replay(const ParamMap& params, const engine::NodeContext& context) {

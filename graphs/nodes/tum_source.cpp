@@ -7,10 +7,8 @@
 #include "formats/file_bytes.hpp"
 #include "formats/png_depth.hpp"
 #include "formats/tum_rgbd.hpp"
-#include "graphs/nodes/decode_ahead.hpp"
-#include "graphs/nodes/frame_source.hpp"
 #include "graphs/nodes/node_support.hpp"
-#include "graphs/nodes/recorded_pace.hpp"
+#include "graphs/nodes/recording_source.hpp"
 #include "kernels/depth_projection.hpp"
 
 namespace orthoflow::graphs {
@@ -19,7 +17,6 @@ namespace {
 
 using engine::Message;
 using engine::ParamMap;
-using Clock = std::chrono::steady_clock;
 
 constexpr std::size_t TUM_PIXELS = std::size_t{formats::TUM_WIDTH} * formats::TUM_HEIGHT;
 
@@ -55,27 +52,24 @@ void project_depth_image(std::span<const std::uint16_t> image, double units_per_
   }
 }
 
-class TumSource final : public FrameSource {
+class TumSource final : public RecordingSource {
  public:
-  static constexpr std::chrono::milliseconds DECODE_TIMEOUT{5000};
-
   TumSource(std::size_t capacity, const engine::NodeContext& context, formats::TumDepthList list,
             std::filesystem::path dir, const kernels::DepthCamera& camera, double units, bool paced,
             bool loop)
-      : FrameSource(capacity, context),
+      : RecordingSource(capacity, context, paced, "tum_source: no depth image decoded within 5 s"),
         list_(std::move(list)),
         missing_(frames_missing(list_.entries)),
         dir_(std::move(dir)),
         camera_(camera),
         units_(units),
-        paced_(paced),
         image_(TUM_PIXELS) {
     std::vector<std::filesystem::path> files;
     for (const auto& e : list_.entries) files.push_back(dir_ / e.file);
-    decoder_ = std::make_unique<DecodeAhead>(
-        std::move(files), loop, 3, [this](std::size_t i, DecodeAhead::Slot& s) { decode(i, s); });
+    start_decoding(std::move(files), loop,
+                   [this](std::size_t i, DecodeAhead::Slot& s) { decode(i, s); });
   }
-  ~TumSource() override { decoder_.reset(); }  // the decoder thread uses the members above
+  ~TumSource() override { stop_decoding(); }  // the decoder thread uses the members below
 
   /// The recording's account: depth images listed, frames missing between them (capture-time gaps
   /// of more than one 30 Hz period), listing lines skipped as out of time order.
@@ -87,23 +81,6 @@ class TumSource final : public FrameSource {
     const std::size_t k = std::min(out.size(), all.size());
     std::copy_n(all.begin(), k, out.begin());
     return k;
-  }
-
-  engine::SourceStatus produce(Message& out) noexcept override {
-    DecodeAhead::Slot* slot = decoder_->next(DECODE_TIMEOUT);
-    if (slot != nullptr && slot->end) return engine::SourceStatus::END;
-    if (slot != nullptr && slot->ok && paced_) pace_.wait(slot->schedule_ns);
-    if (!take_block(out)) return engine::SourceStatus::FRAME;
-    if (slot == nullptr || !slot->ok) {
-      emit_decode_failure(out, slot, "tum_source: no depth image decoded within 5 s");
-      return engine::SourceStatus::FRAME;
-    }
-    kernels::PointCloud& cloud = slot->cloud;
-    cloud.info.frame_id = frames_++;
-    cloud.info.host_stamp_ns = Clock::now().time_since_epoch().count();
-    emit_cloud(out, cloud);
-    decoder_->release();
-    return engine::SourceStatus::FRAME;
   }
 
  private:
@@ -136,11 +113,7 @@ class TumSource final : public FrameSource {
   std::filesystem::path dir_;
   kernels::DepthCamera camera_;
   double units_;
-  bool paced_;
   std::vector<std::uint16_t> image_;  // decoder thread only
-  RecordedPace pace_;
-  std::uint64_t frames_ = 0;
-  std::unique_ptr<DecodeAhead> decoder_;  // last: its thread uses everything above
 };
 
 NodeResult make_tum(const ParamMap& params, const engine::NodeContext& context) {

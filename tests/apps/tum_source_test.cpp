@@ -21,6 +21,7 @@
 #include "formats/pcd_io.hpp"
 #include "formats/png_depth.hpp"
 #include "formats/tum_rgbd.hpp"
+#include "tests/support/command_output.hpp"
 
 namespace {
 
@@ -28,29 +29,10 @@ namespace fs = std::filesystem;
 using orthoflow::formats::TUM_HEIGHT;
 using orthoflow::formats::TUM_WIDTH;
 
-struct Output {
-  int status = -1;
-  std::string text;
-};
+using orthoflow::test::pcd_files;
+using Output = orthoflow::test::CommandOutput;
 
-Output run(const std::string& command) {
-  Output out;
-  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
-  if (pipe == nullptr) return out;
-  std::array<char, 4096> buf{};
-  std::size_t n = 0;
-  while ((n = std::fread(buf.data(), 1, buf.size(), pipe)) > 0) out.text.append(buf.data(), n);
-  out.status = pclose(pipe);
-  return out;
-}
-
-std::vector<fs::path> pcd_files(const fs::path& dir) {
-  std::vector<fs::path> files;
-  for (const auto& entry : fs::directory_iterator(dir))
-    if (entry.path().extension() == ".pcd") files.push_back(entry.path());
-  std::sort(files.begin(), files.end());  // pcd_source's order
-  return files;
-}
+Output run(const std::string& command) { return orthoflow::test::run_command(command + " 2>&1"); }
 
 std::string stamp(std::size_t frame) {
   char text[32];
