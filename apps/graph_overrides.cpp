@@ -21,11 +21,12 @@ Result<void, std::string> apply_source(engine::GraphSpec& spec, const std::strin
   if (src == nullptr) src = find_kind(spec, "pcd_source");
   if (src == nullptr) src = find_kind(spec, "kinect_source");
   if (src == nullptr) src = find_kind(spec, "replay_source");
+  if (src == nullptr) src = find_kind(spec, "tum_source");
   if (src == nullptr) {
     if (!source.empty())
       return err(
           std::string("--source needs a graph whose source is synthetic_source, pcd_source, "
-                      "kinect_source or replay_source"));
+                      "kinect_source, replay_source or tum_source"));
     return {};
   }
   if (source.rfind("pcd:", 0) == 0) {
@@ -87,8 +88,9 @@ std::string check_rate(const std::string& v) {
 void apply_rate(engine::GraphSpec& spec, const std::string& rate) {
   if (rate.empty()) return;
   // A replay at a given rate (or max) is paced by the engine, not by the recorded times.
-  if (engine::NodeSpec* replay = find_kind(spec, "replay_source"))
-    replay->params.assign("pace", "max");
+  for (const char* kind : {"replay_source", "tum_source"}) {
+    if (engine::NodeSpec* replay = find_kind(spec, kind)) replay->params.assign("pace", "max");
+  }
   spec.period_ns = rate == "max" ? 0 : static_cast<std::int64_t>(1e9 / std::stod(rate));
 }
 

@@ -1,7 +1,9 @@
 #include "graphs/nodes/tum_source.hpp"
 
-#include <chrono>
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 #include "formats/file_bytes.hpp"
