@@ -17,6 +17,7 @@
 #include "apps/commands.hpp"
 #include "apps/demo_picture.hpp"
 #include "graphs/sessions/table_task_session.hpp"
+#include "manipulation/robot_frames.hpp"
 
 namespace orthoflow::apps {
 namespace {
@@ -32,6 +33,7 @@ struct DemoArgs {
   std::string event_phase = "approach";
   std::string pictures;
   std::uint32_t picture_every = 5;
+  std::string robot_frames;
   bool json = false;
 };
 
@@ -51,6 +53,9 @@ nlohmann::json to_json(const graphs::TableTaskReport& r) {
                      {"arrived", m.arrived},
                      {"held", m.held},
                      {"error_m", m.error_m},
+                     {"max_tilt_deg", m.max_tilt_deg},
+                     {"spilled", m.spilled},
+                     {"dropped", m.dropped},
                      {"failure", m.failure},
                      {"seconds", m.seconds},
                      {"decisions", m.decisions},
@@ -61,14 +66,26 @@ nlohmann::json to_json(const graphs::TableTaskReport& r) {
   for (const graphs::StayReport& s : r.stays)
     stays.push_back(
         {{"track", s.track}, {"label", s.label}, {"truth", s.truth}, {"reason", s.reason}});
-  return {{"task", r.task},           {"seed", r.seed},
-          {"scene", r.scene},         {"taught", r.taught},
-          {"perceived", r.perceived}, {"recognised", r.recognised},
-          {"refused", r.refused},     {"stopped", r.stopped},
-          {"moves", moves},           {"stays", stays},
-          {"arrived", r.arrived()},   {"frames", r.frames},
-          {"seconds", r.seconds},     {"body_dropped", r.body_dropped},
-          {"fallen", r.fallen}};
+  return {{"task", r.task},
+          {"seed", r.seed},
+          {"scene", r.scene},
+          {"taught", r.taught},
+          {"perceived", r.perceived},
+          {"recognised", r.recognised},
+          {"refused", r.refused},
+          {"stopped", r.stopped},
+          {"moves", moves},
+          {"stays", stays},
+          {"arrived", r.arrived()},
+          {"frames", r.frames},
+          {"seconds", r.seconds},
+          {"body_dropped", r.body_dropped},
+          {"fallen", r.fallen},
+          {"spills", r.spills},
+          {"drops", r.drops},
+          {"calibrated", r.calibrated},
+          {"hand_eye_error_mm", r.hand_eye_error_mm},
+          {"hand_eye_error_deg", r.hand_eye_error_deg}};
 }
 
 void print(const graphs::TableTaskReport& r) {
@@ -77,6 +94,10 @@ void print(const graphs::TableTaskReport& r) {
       "recognised right\n",
       r.task.c_str(), static_cast<unsigned long long>(r.seed), r.scene.size(), r.taught,
       r.recognised, r.perceived);
+  if (r.calibrated)
+    std::printf(
+        "  the robot's calibration is %.1f mm and %.2f degrees from the simulator's truth\n",
+        r.hand_eye_error_mm, r.hand_eye_error_deg);
   if (!r.refused.empty()) {
     std::printf("  refused: %s\n", r.refused.c_str());
     return;
@@ -91,6 +112,9 @@ void print(const graphs::TableTaskReport& r) {
                           : (m.done ? (m.held ? "done, not at the spot" : "done, missed the object")
                                     : "FAILED"),
                 m.seconds, m.failure.empty() ? "" : ": ", m.failure.c_str());
+    if (m.held)
+      std::printf("     carried tilted at most %.1f degrees%s%s\n", m.max_tilt_deg,
+                  m.spilled ? ", SPILLED" : "", m.dropped ? ", SLIPPED OUT" : "");
     std::string ops;
     for (const graphs::OperatorTime& o : m.operators) {
       char one[48];
@@ -107,10 +131,10 @@ void print(const graphs::TableTaskReport& r) {
   if (!r.stopped.empty()) std::printf("  stopped: %s\n", r.stopped.c_str());
   std::printf(
       "  %zu of %zu objects placed (%zu retried); %.1f s simulated, %llu frames, %llu dropped by "
-      "the body filter, %zu fell off the table\n",
+      "the body filter, %zu fell off the table, %zu spilled, %zu slipped out of the hand\n",
       r.arrived(), r.first_moves(), r.moves.size() - r.first_moves(), r.seconds,
       static_cast<unsigned long long>(r.frames), static_cast<unsigned long long>(r.body_dropped),
-      r.fallen);
+      r.fallen, r.spills, r.drops);
 }
 
 void run_demo(const DemoArgs& a) {
@@ -130,6 +154,14 @@ void run_demo(const DemoArgs& a) {
   for (std::size_t p = 0; p < manipulation::PHASE_COUNT; ++p) {
     const auto phase = static_cast<manipulation::Phase>(p);
     if (a.event_phase == manipulation::to_string(phase)) config.event_phase = phase;
+  }
+  if (!a.robot_frames.empty()) {
+    auto frames = manipulation::load_robot_frames(a.robot_frames);
+    if (!frames) {
+      std::cerr << "orthoflow demo: " << frames.error() << '\n';
+      throw CLI::RuntimeError(EXIT_USAGE);
+    }
+    config.robot_base_from_camera = frames->base_from_camera;
   }
   DemoMarks marks;
   if (config.task == graphs::TableTask::CLEAR_TABLE)
@@ -259,6 +291,8 @@ void add_demo_command(CLI::App& app) {
   cmd->add_option("--picture-every", a->picture_every, "every Nth frame")
       ->check(CLI::Range(1, 1000))
       ->capture_default_str();
+  cmd->add_option("--robot-frames", a->robot_frames,
+                  "the robot's calibration (calibrate hand-eye --out); the world keeps the truth");
   cmd->add_flag("--json", a->json, "one JSON document");
   cmd->callback([a] { run_demo(*a); });
 }

@@ -65,11 +65,10 @@ bool ExecutionManager::at_fingers(const ArmInput& arm, double goal) const noexce
 }
 
 bool ExecutionManager::closed_beyond_open(const ArmInput& arm) const noexcept {
-  // Stopped on the way, each finger past a quarter of the way from open to the goal (not blocked
-  // right where it started).
-  const double quarter = job_.open_fingers + 0.25 * (job_.close_fingers - job_.open_fingers);
+  // Stopped on the way, each finger past where the object begins (not blocked right where it
+  // started).
   for (double f : arm.fingers) {
-    if (!(f >= quarter)) return false;
+    if (!(f >= job_.touch_fingers)) return false;
   }
   return true;
 }

@@ -198,8 +198,13 @@ ArmRequest ExecutionManager::step(std::int64_t now_ns, const ArmInput& arm,
       if (at_joints(arm, job_.grasp)) return enter(Phase::CLOSE, now_ns, {}, "at the grasp pose");
       break;
     case Phase::CLOSE:
-      if (at_fingers(arm, job_.close_fingers))
+      if (at_fingers(arm, job_.close_fingers)) {
+        if (limits_.fingers_must_meet_the_object)
+          return abort(now_ns, AbortReason::GRASP_MISSED,
+                       "the hand closed to its goal: nothing of the object's width between the "
+                       "fingers");
         return enter(Phase::LIFT, now_ns, {}, "the hand is closed");
+      }
       // A rigid object stops the fingers short of a goal narrower than it: closed on it.
       if (arm.idle && arm.fingers_blocked && closed_beyond_open(arm))
         return enter(Phase::LIFT, now_ns, {}, "the hand is closed on the object");

@@ -89,7 +89,11 @@ struct PickPlaceJob {
   drivers::jaco::JointAngles aside{};
   double open_fingers = 0.0;   ///< the model's units (0 open)
   double close_fingers = 0.0;  ///< the model's units
-  double lift_m = 0.10;        ///< how far the lift raises the hand (the grasp check uses half)
+  /// Fingers stalled past this value are on the object (the close phase's grasp); stalled before
+  /// it, they were blocked right where they started (JobOptions::touch_travel_m from the open
+  /// hand).
+  double touch_fingers = 0.0;
+  double lift_m = 0.10;  ///< how far the lift raises the hand (the grasp check uses half)
 };
 
 /// @brief Limits. Timeouts are per phase, indexed by Phase.
@@ -120,6 +124,11 @@ struct ExecutionLimits {
   /// calls 1 % of it reached).
   double finger_tolerance = 130.0;
   double approach_speed = 0.3;  ///< of the speed cap: approach, close, lift, place, backing
+  /// A hand that closes all the way to its goal (JobOptions::close_to_m: closed) held
+  /// nothing: a rigid object stalls the fingers short of it (fingers_blocked). The close phase then
+  /// aborts as a missed grasp. false only where nothing can stop the fingers: a simulated arm
+  /// without a world between them (`orthoflow task run --sim`).
+  bool fingers_must_meet_the_object = true;
 };
 
 /// @brief The arm's newest state, as the manager needs it.
@@ -239,7 +248,7 @@ class ExecutionManager {
                                const drivers::jaco::JointAngles& goal) const noexcept;
   [[nodiscard]] bool at_fingers(const ArmInput& arm, double goal) const noexcept;
   [[nodiscard]] const drivers::jaco::JointAngles* joint_goal(Phase phase) const noexcept;
-  /// True if every finger closed past a quarter of the way from the open value to the close one.
+  /// True if every finger closed past the job's touch_fingers.
   [[nodiscard]] bool closed_beyond_open(const ArmInput& arm) const noexcept;
   /// True if the target seen at @p seen has moved from the plan (ExecutionLimits::target_moved_m).
   [[nodiscard]] bool moved(const Eigen::Vector3d& seen) const noexcept;

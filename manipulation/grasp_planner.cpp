@@ -47,6 +47,10 @@ struct Candidate {
   Vector3d closing;
   Vector3d centre;
   double width;
+  /// The box's larger horizontal extent: a partial view shows an object's width across the view
+  /// but half its depth, so the hand opens to this, not to the width (issue 51: the fingers met a
+  /// bottle's far side on the way in).
+  double span;
 };
 
 struct Planner {
@@ -91,7 +95,7 @@ struct Planner {
       g.grasp = grasp;
       g.approach = c.approach;
       g.width_m = c.width;
-      g.opening_m = std::min(c.width + hand.clearance_m, hand.max_opening_m);
+      g.opening_m = std::min(std::max(c.width, c.span) + hand.clearance_m, hand.max_opening_m);
       g.pre_grasp_joints = pre_joints.value();
       g.grasp_joints = grasp_joints.value();
       g.joint_travel_deg = joint_distance(options.seed, g.pre_grasp_joints) +
@@ -254,7 +258,8 @@ Result<GraspPlan, ObjectRejection> plan_grasp(const ObjectBox& box,
 
   // Top grasps: straight down, the fingers wrapping the top finger_reach of the box.
   for (const Vector3d& closing : {d1, d2}) {
-    const Candidate c{GraspKind::TOP, -up, closing, centre, extent_along(box, closing)};
+    const Candidate c{GraspKind::TOP,  -up, closing, centre, extent_along(box, closing),
+                      std::max(w1, w2)};
     place(c, std::max(centre_height, top - hand.finger_reach_m));
   }
   // Side grasps: horizontally along a principal direction, from the arm's side of the object.
@@ -264,7 +269,8 @@ Result<GraspPlan, ObjectRejection> plan_grasp(const ObjectBox& box,
   for (const Vector3d& approach : {d1, Vector3d(-d1), d2, Vector3d(-d2)}) {
     if (has_radial && approach.dot(radial) < -1e-9) { continue; }
     const Vector3d closing = up.cross(approach);
-    const Candidate c{GraspKind::SIDE, approach, closing, centre, extent_along(box, closing)};
+    const Candidate c{GraspKind::SIDE, approach, closing, centre, extent_along(box, closing),
+                      std::max(w1, w2)};
     place(c, centre_height);
   }
 

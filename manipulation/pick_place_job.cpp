@@ -61,7 +61,8 @@ Result<PickPlaceJob, std::string> make_pick_place_job(std::uint32_t track_id,
   job.grasp = grasp.grasp_joints;
   job.lift_m = options.lift_m;
   job.open_fingers = finger_for_opening(grasp.opening_m, options);
-  job.close_fingers = finger_for_opening(std::max(0.0, grasp.width_m - options.squeeze_m), options);
+  job.close_fingers = finger_for_opening(options.close_to_m, options);
+  job.touch_fingers = finger_for_opening(grasp.opening_m - options.touch_travel_m, options);
   // The place keeps the object's height above the table: the same offset from the grasp centre.
   Eigen::Vector3d shift = place_centre - target_centre;
   shift -= shift.dot(up) * up;  // along the table only

@@ -24,8 +24,15 @@ namespace orthoflow::manipulation {
 struct JobOptions {
   GraspOptions grasp{};  ///< the planner's options: table, hand, limits, geometry
   drivers::jaco::JointAngles initial = drivers::jaco::HOME_JOINTS;
-  double lift_m = 0.10;           ///< lift and carry height above the grasp
-  double squeeze_m = 0.02;        ///< the fingers close this much narrower than the width
+  double lift_m = 0.10;  ///< lift and carry height above the grasp
+  /// The fingers' goal when closing, as an opening (m); 0: closed. The object between them stops
+  /// them short of it (the driver sees the stall: fingers_blocked) at its width where the hand
+  /// holds it, which the perceived box does not tell (a bottle's neck under a top grasp is
+  /// narrower than its body); a hand that reaches this goal held nothing (issue 51).
+  double close_to_m = 0.0;
+  /// Fingers that stall before closing this far from the open hand were blocked where they
+  /// started, not closed on the object (the hand opens 2 cm wider than the object when it can).
+  double touch_travel_m = 0.01;
   double finger_closed = 6400.0;  ///< the model's finger value when closed (JACO2 ~6400)
 };
 

@@ -18,7 +18,7 @@ void TaskLoop::take_objects() noexcept {
   bool got = false;
   while (objects_->poll(list_)) got = true;
   if (!got || perception_dead_) return;
-  seen_objects(list_, base_from_camera_, job_options_.grasp.table, seen_);
+  seen_objects(list_, robot_base_from_camera_, job_options_.grasp.table, seen_);
   runner_->on_objects(seen_, list_.host_stamp_ns);
 }
 
@@ -65,9 +65,30 @@ void TaskLoop::fire_event() {
 
 void TaskLoop::arm_cycle() noexcept {
   const jaco::ArmSnapshot s = arm_->snapshot();
-  const Vector3d tool = camera_from_base_ * jaco::forward_kinematics(s.joints).translation();
+  const Isometry3d hand = camera_from_base_ * jaco::forward_kinematics(s.joints);
+  const Vector3d tool = hand.translation();
+  simulation::HandAxes axes{};
+  for (int k = 0; k < 3; ++k)
+    axes[static_cast<std::size_t>(k)] = {hand.linear()(0, k), hand.linear()(1, k),
+                                         hand.linear()(2, k)};
+  const std::size_t spills = world_->spills(), drops = world_->drops();
   world_->update({tool.x(), tool.y(), tool.z()},
-                 manipulation::opening_for_finger(s.fingers[0], job_options_));
+                 manipulation::opening_for_finger(s.fingers[0], job_options_), axes);
+  if (runner_->state() == manipulation::TableTaskRunner::State::RUNNING &&
+      runner_->move_index() < report_.moves.size()) {
+    // The world's account of the carry, checked at the arm's 100 Hz.
+    MoveReport& move = report_.moves[runner_->move_index()];
+    move.max_tilt_deg = std::max(move.max_tilt_deg, world_->held_tilt_deg());
+    move.spilled = move.spilled || world_->spills() > spills;
+    move.dropped = move.dropped || world_->drops() > drops;
+  }
+  // What is between the fingers stops them (a rigid object): the hand stalls on it, or closes
+  // on nothing to its goal.
+  const std::optional<double> width = world_->grip_width({tool.x(), tool.y(), tool.z()}, axes[1]);
+  if (sim_.present(0))
+    sim_.arm(0).set_finger_stop(
+        width ? std::optional<double>(manipulation::finger_for_opening(*width, job_options_))
+              : std::nullopt);
   const bool running = runner_->state() == manipulation::TableTaskRunner::State::RUNNING;
   if (running && world_->held() >= 0 &&
       static_cast<int>(world_->scene().objects[static_cast<std::size_t>(world_->held())].id) ==
@@ -168,7 +189,11 @@ const simulation::Scene* TaskLoop::next_frame(kernels::PointCloud& cloud) noexce
   body.margin_m = 0.0;
   const std::size_t n = manipulation::arm_body_capsules(joints, base_from_camera_, body,
                                                         jaco::jaco2_geometry(), capsules_);
-  runner_->on_arm_body(std::span(capsules_).first(n));  // the runner adds the filter's margin
+  // Where the robot believes its arm is in the image (its calibration): the runner adds the
+  // filter's margin.
+  const std::size_t m = manipulation::arm_body_capsules(joints, robot_base_from_camera_, body,
+                                                        jaco::jaco2_geometry(), robot_capsules_);
+  runner_->on_arm_body(std::span(robot_capsules_).first(m));
   std::vector<simulation::BodyCapsule>& robot = world_->robot();
   robot.resize(n);
   for (std::size_t i = 0; i < n; ++i) {

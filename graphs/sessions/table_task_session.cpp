@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <numbers>
 #include <optional>
 
 #include "engine/engine.hpp"
@@ -76,7 +77,7 @@ void TaskLoop::make_runner() {
   o.user_place = config_.user_place;
   o.limits = config_.limits;
   o.job = job_options_;
-  o.base_from_camera = base_from_camera_;
+  o.base_from_camera = robot_base_from_camera_;
   runner_.emplace(std::move(o));
   runner_->on_move_started = [this](std::size_t m, const manipulation::SeenObject& s) {
     move_started(m, s);
@@ -89,6 +90,15 @@ Result<TableTaskReport, std::string> TaskLoop::run() {
   if (auto ok = build_world(); !ok) return err(ok.error());
   if (auto ok = open_arm(); !ok) return err(ok.error());
   camera_from_base_ = base_from_camera_.inverse();
+  robot_base_from_camera_ = config_.robot_base_from_camera.value_or(base_from_camera_);
+  if (config_.robot_base_from_camera) {
+    report_.calibrated = true;
+    report_.hand_eye_error_mm =
+        1e3 * (robot_base_from_camera_.translation() - base_from_camera_.translation()).norm();
+    const Eigen::AngleAxisd off(robot_base_from_camera_.linear().transpose() *
+                                base_from_camera_.linear());
+    report_.hand_eye_error_deg = off.angle() * 180.0 / std::numbers::pi;
+  }
   world_->robot().reserve(simulation::MAX_SCENE_CAPSULES);
   job_options_.lift_m = 0.20;
   report_.task = manipulation::to_string(config_.task);
@@ -114,8 +124,8 @@ Result<TableTaskReport, std::string> TaskLoop::run() {
   }
   spec->period_ns = 0;      // simulated time: as fast as the graph goes
   spec->max_in_flight = 1;  // lock step: each frame's objects arrive before the next frame
-  const Eigen::Quaterniond q(base_from_camera_.linear());
-  const Vector3d t = base_from_camera_.translation();
+  const Eigen::Quaterniond q(robot_base_from_camera_.linear());
+  const Vector3d t = robot_base_from_camera_.translation();
   char frames[256];
   std::snprintf(frames, sizeof frames, "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g", t.x(), t.y(),
                 t.z(), q.w(), q.x(), q.y(), q.z());
@@ -131,6 +141,8 @@ Result<TableTaskReport, std::string> TaskLoop::run() {
   report_.frames = frame_;
   report_.seconds = 1e-9 * static_cast<double>(now() - TASK_LOOP_START_NS);
   report_.fallen = world_->fallen();
+  report_.spills = world_->spills();
+  report_.drops = world_->drops();
   if (const engine::Node* filter = engine.node("body"); filter != nullptr) {
     std::array<engine::DeviceCounter, engine::MAX_DEVICE_COUNTERS> c{};
     const std::size_t k = filter->device_counters(c);

@@ -19,6 +19,7 @@
 /// holding stops the whole task; any other abort fails that move and the task goes on.
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -71,6 +72,10 @@ struct TableTaskConfig {
   TaskEvent event = TaskEvent::NONE;
   manipulation::Phase event_phase = manipulation::Phase::APPROACH;  ///< of the first move
   manipulation::ExecutionLimits limits = default_limits();
+  /// The camera's pose in the arm's base frame as the robot believes it: a hand-eye calibration
+  /// (`orthoflow calibrate ...`, `orthoflow demo --robot-frames`). Perception's objects, the grasps
+  /// and the body filter use it; the world keeps the simulator's true pose. nullopt: the truth.
+  std::optional<Eigen::Isometry3d> robot_base_from_camera;
   /// Called after every frame's objects arrived (the picture sequence); may be empty.
   std::function<void(const TaskFrameView&)> on_frame;
 
@@ -92,6 +97,10 @@ struct MoveReport : manipulation::MoveRecord {
   bool arrived = false;
   double error_m = -1.0;  ///< that displacement's error (m); -1 when it was not moved
   bool held = false;      ///< the world's object was in the hand at some point (ground truth)
+  /// The held object's worst tilt from upright during the move, at every arm cycle (ground truth).
+  double max_tilt_deg = 0.0;
+  bool spilled = false;  ///< an open container tilted past simulation::SPILL_TILT_DEG
+  bool dropped = false;  ///< it slipped out of the hand, tilted past simulation::DROP_TILT_DEG
 };
 
 struct StayReport {
@@ -113,9 +122,14 @@ struct TableTaskReport {
   std::vector<MoveReport> moves;
   std::vector<StayReport> stays;
   std::uint64_t frames = 0;
-  double seconds = 0.0;            ///< simulated
-  std::uint64_t body_dropped = 0;  ///< frames the body filter dropped (no fresh arm state)
-  std::size_t fallen = 0;          ///< objects that fell off the table
+  double seconds = 0.0;             ///< simulated
+  std::uint64_t body_dropped = 0;   ///< frames the body filter dropped (no fresh arm state)
+  std::size_t fallen = 0;           ///< objects that fell off the table
+  std::size_t spills = 0;           ///< carries in which an open container spilled
+  std::size_t drops = 0;            ///< objects that slipped out of the hand, tilted
+  bool calibrated = false;          ///< the robot used a calibration, not the simulator's truth
+  double hand_eye_error_mm = 0.0;   ///< that calibration's translation error against the truth
+  double hand_eye_error_deg = 0.0;  ///< and its rotation error (angle of R_used^T R_true)
   [[nodiscard]] std::size_t arrived() const noexcept;
   /// @brief Moves of the first pass: the objects the task moves (the rest are retries).
   [[nodiscard]] std::size_t first_moves() const noexcept;

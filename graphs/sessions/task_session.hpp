@@ -79,8 +79,11 @@ class TaskLoop final : public WorldFeed {
 
   TableTaskConfig config_;
   TableTaskReport report_;
+  // The simulator's true camera pose (the world, its render, the report's ground truth) and the
+  // one the robot believes (perception's objects, the grasps, the body filter): a calibration's.
   Isometry3d base_from_camera_ = Isometry3d::Identity();
   Isometry3d camera_from_base_ = Isometry3d::Identity();
+  Isometry3d robot_base_from_camera_ = Isometry3d::Identity();
   std::optional<simulation::TableWorld> world_;
   simulation::SimJacoTransport sim_;
   std::unique_ptr<jaco::JacoController> arm_;
@@ -105,6 +108,7 @@ class TaskLoop final : public WorldFeed {
   Vector3d target_start_ = Vector3d::Zero();  // the world's object centre at the move's start
   bool event_fired_ = false, perception_dead_ = false;
   std::array<kernels::Capsule, manipulation::ARM_BODY_CAPSULES> capsules_{};
+  std::array<kernels::Capsule, manipulation::ARM_BODY_CAPSULES> robot_capsules_{};
 };
 
 }  // namespace orthoflow::graphs

@@ -6,6 +6,7 @@
 // missed grasp, the emergency stop, a refused command, a timeout, a person's stop.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <functional>
 #include <optional>
 #include <string>
@@ -48,8 +49,10 @@ struct World {
   Vector3d mug = ::orthoflow::manipulation::mug().base_from_object.translation();
   bool attached = false;
   bool slippery = false;  ///< the fingers never hold it
-  /// The mug is rigid: around it, the fingers stop at the finger value `contact`.
+  /// The mug is rigid: around it, the fingers stop at the finger value `contact` (unset: half way
+  /// from the job's open to its close, the mug's width).
   std::optional<double> contact;
+  bool empty_hand = false;  ///< nothing between the fingers: they close to their goal
   Vector3d grip_offset = Vector3d::Zero();
   Vector3d seen_offset = Vector3d::Zero();  ///< perception's error on the mug's centre
   std::vector<Obstacle> obstacles;
@@ -70,9 +73,10 @@ struct World {
   void update_world(const PickPlaceJob& job) {
     const auto s = rig.controller->snapshot();
     const bool around = (tool() - mug).norm() < 0.04;
-    rig.arm().set_finger_stop(contact && around ? contact : std::nullopt);
-    const bool closed = s.fingers[0] >= (contact ? *contact - 50.0 : job.close_fingers - 100.0);
-    if (!attached && closed && !slippery && around) {
+    const double stop = contact.value_or(0.5 * (job.open_fingers + job.close_fingers));
+    rig.arm().set_finger_stop(around && !empty_hand ? std::optional<double>(stop) : std::nullopt);
+    const bool closed = s.fingers[0] >= stop - 50.0;
+    if (!attached && closed && !slippery && !empty_hand && around) {
       attached = true;
       grip_offset = mug - tool();
     } else if (attached && !closed) {
@@ -182,7 +186,7 @@ TEST(ExecutionManager, FingersBlockedRightWhereTheyStartAreNotAGrasp) {
   World world;
   ExecutionManager manager;
   const PickPlaceJob job = mug_job();
-  world.contact = job.open_fingers + 0.1 * (job.close_fingers - job.open_fingers);
+  world.contact = job.open_fingers + 0.1 * (job.touch_fingers - job.open_fingers);
   world.run(manager, job);
   EXPECT_EQ(manager.phase(), Phase::ABORTED) << log_text(manager);
   EXPECT_EQ(manager.abort_reason(), AbortReason::TIMEOUT) << log_text(manager);
@@ -379,6 +383,39 @@ TEST(ExecutionManager, AMissedGraspOpensAndBacksAway) {
   EXPECT_EQ(manager.phase(), Phase::ABORTED);
   EXPECT_LT(joint_distance(world.rig.controller->snapshot().joints, job.pre_grasp), 1.0);
   EXPECT_LT(world.rig.controller->snapshot().fingers[0], job.open_fingers + 100.0) << "opened";
+}
+
+TEST(ExecutionManager, AHandThatClosesToItsGoalHeldNothingAndBacksAway) {
+  // Nothing between the fingers (the arm is off by a few centimetres: a bad calibration): they
+  // reach their goal, narrower than the object, which a rigid object never lets them do.
+  World world;
+  world.empty_hand = true;
+  ExecutionManager manager;
+  const PickPlaceJob job = mug_job();
+  world.run(manager, job);
+  EXPECT_EQ(manager.abort_reason(), AbortReason::GRASP_MISSED) << log_text(manager);
+  EXPECT_NE(log_text(manager).find("close -> backing_away (grasp_missed: the hand closed to its "
+                                   "goal"),
+            std::string::npos)
+      << log_text(manager);
+  EXPECT_EQ(manager.phase(), Phase::ABORTED);
+  const std::vector<Phase> phases = phases_of(manager);
+  EXPECT_EQ(std::count(phases.begin(), phases.end(), Phase::LIFT), 0) << "never lifted";
+}
+
+TEST(ExecutionManager, WithoutTheFingerCheckAClosedHandLiftsAndTheLiftCheckDecides) {
+  // A simulated arm with no world between its fingers (`orthoflow task run --sim`) turns the
+  // check off; the mug that does not rise with the hand is still a missed grasp, at the lift.
+  World world;
+  world.empty_hand = true;
+  ExecutionLimits limits;
+  limits.fingers_must_meet_the_object = false;
+  ExecutionManager manager(limits);
+  const PickPlaceJob job = mug_job();
+  world.run(manager, job);
+  EXPECT_EQ(manager.abort_reason(), AbortReason::GRASP_MISSED) << log_text(manager);
+  EXPECT_NE(log_text(manager).find("the target did not rise with the hand"), std::string::npos)
+      << log_text(manager);
 }
 
 TEST(ExecutionManager, TheEmergencyStopEndsTheJobWithNoFurtherCommand) {

@@ -44,6 +44,9 @@ class LiveRig {
     LiveTaskSettings settings;
     settings.options.base_from_camera = base_from_camera_;
     settings.options.limits = TableTaskConfig::default_limits();
+    // No world here (the objects are lists): nothing stops the simulated fingers, as in `orthoflow
+    // task run --sim`.
+    settings.options.limits.fingers_must_meet_the_object = false;
     LiveTaskPorts ports;
     ports.snapshot = [this] { return arm_->snapshot(); };
     ports.submit = [this](const jaco::ArmCommand& c) {

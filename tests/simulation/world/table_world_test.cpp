@@ -1,7 +1,11 @@
 // The closed-loop world's contact rule (simulation/world/table_world.hpp): fingers closing around
 // an object hold it, a hand elsewhere holds nothing, a held object follows the hand upright and
-// rests on the table when released, one released beyond the edge falls off, a person can move one.
+// rests on the table when released, one released beyond the edge falls off, a person can move one,
+// and what is between the fingers stops them at its width.
 #include <gtest/gtest.h>
+
+#include <cmath>
+#include <optional>
 
 #include "simulation/world/table_world.hpp"
 
@@ -41,6 +45,82 @@ TEST(TableWorld, ClosingFingersAroundAnObjectHoldItAndItFollowsTheHand) {
   EXPECT_EQ(w.held(), -1);
   EXPECT_NEAR(w.scene().objects[0].base_m, 0.0, 1e-12);
   EXPECT_NEAR(w.scene().objects[0].table_x, 0.3, 1e-9);
+}
+
+TEST(TableWorld, WhatIsBetweenTheFingersStopsThemAtItsWidthAndIsHeldThere) {
+  TableWorld w(one_mug());
+  const double h = w.scene().objects[0].model.height,
+               r = w.scene().objects[0].model.footprint_radius;
+  const Vec3 across = w.table().forward;  // the fingers close along the table's y
+  const Vec3 around = at(w, 0.1, -0.1, h / 2);
+  const std::optional<double> width = w.grip_width(around, across);
+  ASSERT_TRUE(width.has_value());
+  EXPECT_GT(*width, 0.03) << "the mug's body, not a sliver";
+  EXPECT_LE(*width, 2 * r + 1e-9) << "within its footprint";
+  EXPECT_FALSE(w.grip_width(at(w, 0.1 + r + GRIP_SLACK_M + 0.01, -0.1, h / 2), across));
+  EXPECT_FALSE(w.grip_width(at(w, 0.1, -0.1, h + GRIP_SLACK_M + 0.01), across));
+  // Inside the bounding cylinder's slack but beside the solid: the line misses it.
+  EXPECT_FALSE(w.grip_width(at(w, 0.1, -0.1 + r + 0.5 * GRIP_SLACK_M, h / 2), w.table().right));
+  const HandAxes hand{w.table().right, across, w.table().normal};
+  w.update(around, *width + 0.03, hand);
+  w.update(around, *width + GRIP_CONTACT_M + 0.002, hand);  // closing, not yet touching
+  EXPECT_EQ(w.held(), -1);
+  w.update(around, *width, hand);  // stopped by it: touching, held
+  ASSERT_EQ(w.held(), 0);
+  const Vec3 carried = at(w, 0.4, 0.1, h / 2 + 0.2);
+  w.update(carried, *width, hand);
+  ASSERT_TRUE(w.grip_width(carried, across).has_value()) << "it stays between the fingers";
+  EXPECT_NEAR(*w.grip_width(carried, across), *width, 1e-12);
+}
+
+/// The hand's axes turned by @p deg about the table's x axis (right), from @p axes.
+HandAxes turned(const TableWorld& w, double deg) {
+  const double a = deg * 3.14159265358979323846 / 180.0;
+  const Vec3 x = w.table().right, y = w.table().forward, z = w.table().normal;
+  const auto mix = [](const Vec3& p, double cp, const Vec3& q, double cq) {
+    return Vec3{cp * p[0] + cq * q[0], cp * p[1] + cq * q[1], cp * p[2] + cq * q[2]};
+  };
+  return {x, mix(y, std::cos(a), z, std::sin(a)), mix(z, std::cos(a), y, -std::sin(a))};
+}
+
+TEST(TableWorld, AHeldMugTurnsWithTheHandSpillsPastItsLimitAndSlipsOutFurther) {
+  TableWorld w(one_mug());
+  const double h = w.scene().objects[0].model.height,
+               r = w.scene().objects[0].model.footprint_radius;
+  const Vec3 around = at(w, 0.1, -0.1, h / 2);
+  w.update(around, 2 * r + 0.03, turned(w, 0.0));
+  const double width = *w.grip_width(around, w.table().forward);
+  w.update(around, width, turned(w, 0.0));
+  ASSERT_EQ(w.held(), 0);
+  const Vec3 up = at(w, 0.1, -0.1, h / 2 + 0.2);
+  w.update(up, width, turned(w, SPILL_TILT_DEG - 5.0));
+  EXPECT_NEAR(w.held_tilt_deg(), SPILL_TILT_DEG - 5.0, 1e-6);
+  EXPECT_EQ(w.spills(), 0U);
+  w.update(up, width, turned(w, SPILL_TILT_DEG + 5.0));
+  EXPECT_EQ(w.spills(), 1U);
+  w.update(up, width, turned(w, SPILL_TILT_DEG + 6.0));
+  EXPECT_EQ(w.spills(), 1U) << "one spill per carry";
+  EXPECT_EQ(w.held(), 0);
+  w.update(up, width, turned(w, DROP_TILT_DEG + 1.0));
+  EXPECT_EQ(w.held(), -1) << "it slipped out";
+  EXPECT_EQ(w.drops(), 1U);
+  EXPECT_NEAR(w.scene().objects[0].base_m, 0.0, 1e-12) << "on the table below the hand";
+}
+
+TEST(TableWorld, ACanTiltedPastTheSpillLimitDoesNotSpill) {
+  Scene scene = one_mug();
+  scene.objects[0].model = make_object_model(Category::CAN, 0);
+  TableWorld w(scene);
+  const double h = w.scene().objects[0].model.height,
+               r = w.scene().objects[0].model.footprint_radius;
+  const Vec3 around = at(w, 0.1, -0.1, h / 2);
+  w.update(around, 2 * r + 0.03, turned(w, 10.0));
+  w.update(around, 0.0, turned(w, 10.0));  // taken with the hand already turned: upright
+  ASSERT_EQ(w.held(), 0);
+  EXPECT_NEAR(w.held_tilt_deg(), 0.0, 1e-6);
+  w.update(around, 0.0, turned(w, 10.0 + SPILL_TILT_DEG + 5.0));
+  EXPECT_EQ(w.spills(), 0U);
+  EXPECT_EQ(w.held(), 0);
 }
 
 TEST(TableWorld, AGraspThatMissesLeavesTheObjectWhereItWas) {
