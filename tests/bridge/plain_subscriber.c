@@ -127,6 +127,12 @@ int main(int argc, char** argv) {
   const uint64_t client = 0x5eedULL ^ (uint64_t)wall_ns();
   const int64_t end = wall_ns() + (int64_t)(seconds * 1e9);
   int want_command = teach != NULL || raw_kind >= 0;
+  /* Acks are volatile: one the bridge writes before its ack writer has matched this reader (under
+   * loss, discovery is matched one direction before the other) reaches no one. So, as a client
+   * should, the command is sent again, as a new request, when no ack came in 3 s (at most 3 times). */
+  int64_t sent_ns = 0;
+  int resends = 0;
+  uint64_t request = 0;
   while (wall_ns() < end) {
     void* samples[8] = {0};
     dds_sample_info_t infos[8];
@@ -154,7 +160,7 @@ int main(int argc, char** argv) {
           orthoflow_msgs_msg_dds__LearningCommand_ c;
           memset(&c, 0, sizeof c);
           c.client = client;
-          c.request = 1;
+          c.request = ++request;
           c.kind = (uint8_t)(raw_kind >= 0 ? raw_kind : 0);
           c.track_id = track >= 0 ? (uint32_t)track : (uint32_t)o->track_id;
           c.label = (char*)(raw_kind >= 0 ? raw_label : teach);
@@ -162,6 +168,7 @@ int main(int argc, char** argv) {
           if (rc < 0) fprintf(stderr, "command: %s\n", dds_strretcode(rc));
           else {
             sent = 1;
+            sent_ns = wall_ns();
             taught_track = c.track_id;
             printf("command: kind %d track %" PRIu64 " label '%s'\n", c.kind, taught_track, c.label);
           }
@@ -197,6 +204,11 @@ int main(int argc, char** argv) {
       ++acks;
     }
     if (k > 0) dds_return_loan(r_ack, as, k);
+    if (sent && acks == 0 && resends < 3 && wall_ns() - sent_ns > 3000000000LL) {
+      sent = 0; /* the next object list with a track sends it again */
+      ++resends;
+      printf("command: no ack in 3 s, sending again\n");
+    }
     if (wall_ns() >= next_second) {
       if (all) printf("second %d: %d object lists, %d clouds, %d acks\n", ++second, lists, clouds, acks);
       fflush(stdout);
