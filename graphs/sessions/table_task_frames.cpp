@@ -74,8 +74,8 @@ void TaskLoop::arm_cycle() noexcept {
   const std::size_t spills = world_->spills(), drops = world_->drops();
   world_->update({tool.x(), tool.y(), tool.z()},
                  manipulation::opening_for_finger(s.fingers[0], job_options_), axes);
-  if (runner_->state() == manipulation::TableTaskRunner::State::RUNNING &&
-      runner_->move_index() < report_.moves.size()) {
+  const bool running = runner_->state() == manipulation::TableTaskRunner::State::RUNNING;
+  if (running && runner_->move_index() < report_.moves.size()) {
     // The world's account of the carry, checked at the arm's 100 Hz.
     MoveReport& move = report_.moves[runner_->move_index()];
     move.max_tilt_deg = std::max(move.max_tilt_deg, world_->held_tilt_deg());
@@ -83,13 +83,13 @@ void TaskLoop::arm_cycle() noexcept {
     move.dropped = move.dropped || world_->drops() > drops;
   }
   // What is between the fingers stops them (a rigid object): the hand stalls on it, or closes
-  // on nothing to its goal.
+  // on nothing to its goal. The fingers close along the hand's y axis (grasp_planner's
+  // hand_pose: column 1 is the closing direction).
   const std::optional<double> width = world_->grip_width({tool.x(), tool.y(), tool.z()}, axes[1]);
   if (sim_.present(0))
     sim_.arm(0).set_finger_stop(
         width ? std::optional<double>(manipulation::finger_for_opening(*width, job_options_))
               : std::nullopt);
-  const bool running = runner_->state() == manipulation::TableTaskRunner::State::RUNNING;
   if (running && world_->held() >= 0 &&
       static_cast<int>(world_->scene().objects[static_cast<std::size_t>(world_->held())].id) ==
           target_object_)

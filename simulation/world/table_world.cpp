@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <numbers>
 #include <utility>
 
 namespace orthoflow::simulation {
@@ -103,7 +104,7 @@ void TableWorld::update(const Vec3& tool, double opening_m, const HandAxes& hand
   Vec3 up{};
   for (std::size_t k = 0; k < 3; ++k) up = up + up_in_hand_[k] * hand[k];
   const double c = std::clamp(dot(up, frame_.normal) / std::sqrt(dot(up, up)), -1.0, 1.0);
-  tilt_deg_ = std::acos(c) * 180.0 / 3.14159265358979323846;
+  tilt_deg_ = std::acos(c) * 180.0 / std::numbers::pi;
   const PlacedObject& o = scene_.objects[static_cast<std::size_t>(held_)];
   if (!spilled_ && tilt_deg_ > SPILL_TILT_DEG && open_container(o.model.category)) {
     spilled_ = true;
