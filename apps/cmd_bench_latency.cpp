@@ -27,6 +27,7 @@
 
 #include "apps/commands.hpp"
 #include "apps/graph_overrides.hpp"
+#include "core/file_output.hpp"
 #include "engine/engine.hpp"
 #include "engine/graph.hpp"
 #include "engine/histogram.hpp"
@@ -193,9 +194,8 @@ void run_bench(const BenchArgs& a) {
                                 {"period_ns", stats.period_ns},
                                 {"machine", machine},
                                 {"telemetry", nlohmann::json::parse(engine::to_json(stats))}};
-    std::ofstream f(a.json);
-    f << out.dump(2) << '\n';
-    if (!f.flush()) fail("cannot write " + a.json, EXIT_FAILURE_GENERIC);
+    if (auto written = core::write_whole_file(a.json, out.dump(2) + '\n'); !written)
+      fail("cannot write " + written.error(), EXIT_FAILURE_GENERIC);
   }
   if (!a.plot.empty()) {
     evaluation::PlotSpec plot;

@@ -18,6 +18,7 @@
 
 #include "apps/commands.hpp"
 #include "apps/graph_run.hpp"
+#include "core/file_output.hpp"
 #include "engine/ipc_runtime.hpp"
 #ifdef ORTHOFLOW_HAVE_DDS
 #include "bridge/bridge_loop.hpp"
@@ -150,9 +151,9 @@ void run_bridge(const BridgeOptions& o) {
   std::signal(SIGTERM, previous_term);
   print_report(bridge);
   if (!o.telemetry_json.empty()) {
-    std::ofstream out(o.telemetry_json);
-    out << engine::to_json(bridge.stats()) << "\n";
-    if (!out) fail("cannot write " + o.telemetry_json);
+    if (auto w = core::write_whole_file(o.telemetry_json, engine::to_json(bridge.stats()) + "\n");
+        !w)
+      fail("cannot write " + w.error());
   }
   if (lost) fail(roudi_lost_text("bridging to DDS"), EXIT_ROUDI_LOST);
 }

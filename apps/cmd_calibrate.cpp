@@ -15,6 +15,7 @@
 #include <iostream>
 #include <numbers>
 #include <random>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -22,6 +23,7 @@
 
 #include "apps/calibrate_target.hpp"
 #include "apps/commands.hpp"
+#include "core/file_output.hpp"
 #include "manipulation/hand_eye.hpp"
 #include "manipulation/robot_frames.hpp"
 
@@ -112,9 +114,8 @@ void run_hand_eye(const HandEyeArgs& a) {
         "written by orthoflow calibrate hand-eye from %s\n%zu samples, residual rms %.2f mm, max "
         "%.2f mm (line %zu)",
         a.samples.c_str(), r.samples, r.rms_position_m * 1e3, r.max_position_m * 1e3, worst_line);
-    std::ofstream file(a.out, std::ios::trunc);
-    file << manipulation::format_robot_frames({r.base_from_camera}, comment);
-    if (!file) fail(a.out + ": cannot write", EXIT_FAILURE_GENERIC);
+    const auto text = manipulation::format_robot_frames({r.base_from_camera}, comment);
+    if (auto w = core::write_whole_file(a.out, text); !w) fail(w.error(), EXIT_FAILURE_GENERIC);
     out["written"] = a.out;
   }
   if (a.json) {
@@ -173,8 +174,7 @@ void run_simulate(const SimulateArgs& a) {
   std::mt19937_64 rng(a.seed);
   std::uniform_real_distribution<double> jog(-45.0, 45.0);
   std::normal_distribution<double> n(0.0, 1.0);
-  std::ofstream file(a.out, std::ios::trunc);
-  if (!file) fail(a.out + ": cannot write", EXIT_FAILURE_GENERIC);
+  std::ostringstream file;
   file << "# SIMULATED samples (orthoflow calibrate simulate-samples --seed " << a.seed
        << "): not a robot\n";
   for (std::size_t i = 0; i < a.count; ++i) {
@@ -198,10 +198,11 @@ void run_simulate(const SimulateArgs& a) {
     }
     file << line.dump() << '\n';
   }
+  if (auto w = core::write_whole_file(a.out, file.str()); !w) fail(w.error(), EXIT_FAILURE_GENERIC);
   if (!a.truth.empty()) {
-    std::ofstream truth(a.truth, std::ios::trunc);
-    truth << manipulation::format_robot_frames({x}, "the simulated rig's true camera pose");
-    if (!truth) fail(a.truth + ": cannot write", EXIT_FAILURE_GENERIC);
+    const auto truth =
+        manipulation::format_robot_frames({x}, "the simulated rig's true camera pose");
+    if (auto w = core::write_whole_file(a.truth, truth); !w) fail(w.error(), EXIT_FAILURE_GENERIC);
   }
   std::printf("wrote %zu simulated samples to %s\n", a.count, a.out.c_str());
 }

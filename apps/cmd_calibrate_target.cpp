@@ -17,6 +17,7 @@
 #include <fstream>
 #include <iostream>
 #include <random>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -24,6 +25,7 @@
 
 #include "apps/calibrate_target.hpp"
 #include "apps/commands.hpp"
+#include "core/file_output.hpp"
 #include "drivers/jaco/jaco_kinematics.hpp"
 #include "formats/pcd_io.hpp"
 #include "graphs/sessions/table_task_session.hpp"
@@ -80,8 +82,7 @@ void run_find(const FindArgs& a) {
   if (!(a.radius >= 0.005 && a.radius <= 0.5))
     fail("--radius must be in [0.005, 0.5] m", EXIT_USAGE);
   const std::vector<Pose> poses = read_poses(a.poses);
-  std::ofstream out(a.out, std::ios::trunc);
-  if (!out) fail(a.out + ": cannot write", EXIT_FAILURE_GENERIC);
+  std::ostringstream out;
   out << "# orthoflow calibrate find-target --poses " << a.poses << " --radius " << a.radius
       << '\n';
   kernels::SphereTargetParams params;
@@ -123,7 +124,7 @@ void run_find(const FindArgs& a) {
     }
     report.push_back(row);
   }
-  if (!out) fail(a.out + ": write failed", EXIT_FAILURE_GENERIC);
+  if (auto w = core::write_whole_file(a.out, out.str()); !w) fail(w.error(), EXIT_FAILURE_GENERIC);
   if (a.json) {
     std::cout
         << nlohmann::json{{"poses", poses.size()}, {"found", found}, {"frames", report}}.dump()
@@ -155,8 +156,9 @@ void run_simulate_frames(const SimulateFramesArgs& a) {
   gripper_from_ball.translation() = Vector3d(0.0, 0.0, a.stick);
   std::error_code ec;
   fs::create_directories(a.out, ec);
-  std::ofstream poses(fs::path(a.out) / "poses.jsonl", std::ios::trunc);
-  if (ec || !poses) fail(a.out + ": cannot write", EXIT_FAILURE_GENERIC);
+  if (ec || !fs::is_directory(a.out))
+    fail(a.out + ": cannot create the directory", EXIT_FAILURE_GENERIC);
+  std::ostringstream poses;
   poses << "# SIMULATED frames (orthoflow calibrate simulate-frames --seed " << a.seed
         << " --radius " << a.radius << " --stick " << a.stick << "): not a robot\n";
   std::mt19937_64 rng(a.seed);
@@ -199,11 +201,12 @@ void run_simulate_frames(const SimulateFramesArgs& a) {
     poses << nlohmann::json{{"frame", name}, {"joints", q}}.dump() << '\n';
     ++i;
   }
+  if (auto w = core::write_whole_file(fs::path(a.out) / "poses.jsonl", poses.str()); !w)
+    fail(w.error(), EXIT_FAILURE_GENERIC);
   if (!a.truth.empty()) {
-    std::ofstream truth(a.truth, std::ios::trunc);
-    truth << manipulation::format_robot_frames({base_from_camera},
-                                               "the simulated rig's true camera pose");
-    if (!truth) fail(a.truth + ": cannot write", EXIT_FAILURE_GENERIC);
+    const auto truth = manipulation::format_robot_frames({base_from_camera},
+                                                         "the simulated rig's true camera pose");
+    if (auto w = core::write_whole_file(a.truth, truth); !w) fail(w.error(), EXIT_FAILURE_GENERIC);
   }
   std::printf("wrote %zu simulated frames and %s/poses.jsonl\n", a.count, a.out.c_str());
 }

@@ -13,6 +13,7 @@
 
 #include "apps/commands.hpp"
 #include "apps/graph_segmentation.hpp"
+#include "core/file_output.hpp"
 #include "evaluation/segmentation_eval.hpp"
 
 namespace orthoflow::apps {
@@ -34,9 +35,8 @@ struct SegEvalArgs {
 }
 
 void write_text(const std::filesystem::path& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary);
-  out << text;
-  if (!out.flush()) fail("cannot write " + path.string(), EXIT_FAILURE_GENERIC);
+  if (auto written = core::write_whole_file(path, text); !written)
+    fail("cannot write " + written.error(), EXIT_FAILURE_GENERIC);
 }
 
 void run_evaluate_segmentation(const SegEvalArgs& a) {

@@ -10,6 +10,7 @@
 
 #include "apps/commands.hpp"
 #include "apps/graph_run.hpp"
+#include "core/file_output.hpp"
 #include "engine/engine.hpp"
 #include "engine/ipc_nodes.hpp"
 #include "engine/roudi_watch.hpp"
@@ -55,9 +56,8 @@ void write_json(const GraphRunArgs& args, const std::string& json) {
   if (args.json == "-") {
     std::cout << json << "\n";
   } else if (!args.json.empty()) {
-    std::ofstream out(args.json);
-    if (!(out << json << "\n")) {
-      std::cerr << args.command << ": cannot write telemetry JSON to '" << args.json << "'\n";
+    if (auto written = core::write_whole_file(args.json, json + "\n"); !written) {
+      std::cerr << args.command << ": cannot write telemetry JSON: " << written.error() << "\n";
       throw CLI::RuntimeError(EXIT_FAILURE_GENERIC);
     }
   }

@@ -15,6 +15,7 @@
 
 #include "apps/commands.hpp"
 #include "apps/graph_run.hpp"
+#include "core/file_output.hpp"
 #include "core/regular_file.hpp"
 #include "deploy/image_files.hpp"
 #include "deploy/robot_config.hpp"
@@ -96,11 +97,9 @@ LoadedConfig load_or_throw(const std::string& path) {
 void write_file(const fs::path& path, const std::string& text, unsigned mode) {
   std::error_code ec;
   fs::create_directories(path.parent_path(), ec);
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out << text;
-  out.close();
-  if (!out || ::chmod(path.c_str(), mode) != 0)
-    fail("cannot write " + path.string(), EXIT_FAILURE_GENERIC);
+  if (auto written = core::write_whole_file(path, text); !written)
+    fail("cannot write " + written.error(), EXIT_FAILURE_GENERIC);
+  if (::chmod(path.c_str(), mode) != 0) fail("cannot chmod " + path.string(), EXIT_FAILURE_GENERIC);
 }
 
 void render(const ImageArgs& a) {

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "apps/commands.hpp"
+#include "core/file_output.hpp"
 #include "formats/pcd_io.hpp"
 #include "simulation/world/object_dataset.hpp"
 #include "simulation/world/synthetic_scene.hpp"
@@ -121,10 +122,8 @@ void run_synth(const SynthArgs& a) {
   }
   const nlohmann::json gt = ground_truth(scene, cloud, a.seed);
   if (!a.ground_truth.empty()) {
-    std::ofstream file(a.ground_truth);
-    file << gt.dump(2) << "\n";
-    if (!file) {
-      std::cerr << a.ground_truth << ": cannot write the ground truth file\n";
+    if (auto written = core::write_whole_file(a.ground_truth, gt.dump(2) + "\n"); !written) {
+      std::cerr << written.error() << ": cannot write the ground truth file\n";
       throw CLI::RuntimeError(EXIT_FAILURE_GENERIC);
     }
   }

@@ -5,15 +5,14 @@
 
 #include <algorithm>
 #include <array>
-#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
 #include <memory>
 #include <numbers>
 #include <optional>
 
+#include "core/file_output.hpp"
 #include "evaluation/detail/line_plot_frame.hpp"
 
 namespace orthoflow::evaluation {
@@ -203,7 +202,14 @@ Result<void, PlotError> write_plot_png(const PlotSpec& spec, const std::filesyst
   const SurfacePtr surface(cairo_image_surface_create(CAIRO_FORMAT_ARGB32, spec.width, spec.height),
                            cairo_surface_destroy);
   if (auto r = render(surface.get(), spec, path); !r) return r;
-  return cairo_checked(cairo_surface_write_to_png(surface.get(), path.c_str()), path);
+  std::string png;  // encoded in memory: the file is written whole, or not at all
+  if (auto r = cairo_checked(
+          cairo_surface_write_to_png_stream(surface.get(), append_to_string, &png), path);
+      !r)
+    return r;
+  if (auto written = core::write_whole_file(path, png); !written)
+    return write_failed(path, written.error().c_str());
+  return {};
 }
 
 Result<void, PlotError> write_plot_svg(const PlotSpec& spec, const std::filesystem::path& path) {
@@ -219,10 +225,8 @@ Result<void, PlotError> write_plot_svg(const PlotSpec& spec, const std::filesyst
     if (auto r = cairo_checked(cairo_surface_status(surface.get()), path); !r) return r;
   }
   fix_surface_id(svg);
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out.write(svg.data(), static_cast<std::streamsize>(svg.size()));
-  out.close();
-  if (!out) return write_failed(path, std::strerror(errno));
+  if (auto written = core::write_whole_file(path, svg); !written)
+    return write_failed(path, written.error().c_str());
   return {};
 }
 

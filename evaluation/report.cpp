@@ -1,4 +1,5 @@
 #include "evaluation/report.hpp"
+#include "core/file_output.hpp"
 
 #include <cstdio>
 #include <fstream>
@@ -86,10 +87,8 @@ json variant_json(const VariantResult& v) {
 }
 
 Result<void, EvalError> write_text(const std::filesystem::path& path, const std::string& text) {
-  std::ofstream f(path, std::ios::binary | std::ios::trunc);
-  f << text;
-  if (!f.flush()) {
-    return err(EvalError{EvalError::Code::WRITE_FAILED, "cannot write " + path.string()});
+  if (auto written = core::write_whole_file(path, text); !written) {
+    return err(EvalError{EvalError::Code::WRITE_FAILED, "cannot write " + written.error()});
   }
   return {};
 }

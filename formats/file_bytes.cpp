@@ -1,28 +1,13 @@
 #include "formats/file_bytes.hpp"
 
-#include <cerrno>
-#include <cstdio>
 #include <cstdlib>
-#include <cstring>
-#include <memory>
 #include <string>
 
+#include "core/file_output.hpp"
 #include "core/input_limit.hpp"
 #include "core/regular_file.hpp"
 
 namespace orthoflow::formats {
-namespace {
-
-struct FileCloser {
-  void operator()(std::FILE* f) const noexcept { std::fclose(f); }
-};
-using File = std::unique_ptr<std::FILE, FileCloser>;
-
-IoError io_error(IoError::Code code, const std::filesystem::path& path, const char* what) {
-  return IoError{code, path.string() + ": " + what + ": " + std::strerror(errno)};
-}
-
-}  // namespace
 
 Result<std::vector<char>, IoError> read_file_bytes(const std::filesystem::path& path,
                                                    std::size_t max_bytes) {
@@ -47,23 +32,8 @@ std::string read_failure_reason(const IoError& error, const std::filesystem::pat
 
 Result<void, IoError> write_file_atomically(const std::filesystem::path& path,
                                             std::string_view bytes) {
-  std::filesystem::path tmp = path;
-  tmp += ".tmp";
-  {
-    File file(std::fopen(tmp.c_str(), "wb"));
-    if (!file) { return err(io_error(IoError::Code::WRITE_FAILED, tmp, "cannot create")); }
-    if (std::fwrite(bytes.data(), 1, bytes.size(), file.get()) != bytes.size() ||
-        std::fflush(file.get()) != 0) {
-      auto e = io_error(IoError::Code::WRITE_FAILED, tmp, "write failed");
-      std::remove(tmp.c_str());
-      return err(e);
-    }
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    auto e = io_error(IoError::Code::WRITE_FAILED, path, "rename failed");
-    std::remove(tmp.c_str());
-    return err(e);
-  }
+  auto written = core::write_whole_file(path, bytes);
+  if (!written) return err(IoError{IoError::Code::WRITE_FAILED, std::move(written.error())});
   return {};
 }
 

@@ -22,8 +22,9 @@ namespace orthoflow::formats {
 /// "<path>: " (for callers that name the file their own way).
 [[nodiscard]] std::string read_failure_reason(const IoError& error,
                                               const std::filesystem::path& path);
-/// @brief Writes @p bytes to a temporary file beside @p path, then renames it over @p path,
-/// so that readers never see a half-written file.
+/// @brief Writes @p bytes as the whole of @p path (core::write_whole_file): a regular file through
+/// a temporary file renamed over it, so readers never see half of it; a device or FIFO such as
+/// /dev/stdout or /dev/full is written into, never replaced, and a refused write is an error.
 [[nodiscard]] Result<void, IoError> write_file_atomically(const std::filesystem::path& path,
                                                           std::string_view bytes);
 

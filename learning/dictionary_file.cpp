@@ -1,16 +1,14 @@
 // The dictionary's file (learning/dictionary.hpp): encode, parse (fuzzed), save durably, load.
 #include "learning/dictionary.hpp"
 
-#include <fcntl.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <bit>
-#include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <fstream>
 #include <sstream>
+
+#include "core/file_output.hpp"
 
 namespace orthoflow::learning {
 
@@ -138,35 +136,8 @@ Result<kernels::VisualDictionary, std::string> parse_dictionary(std::span<const 
 }
 
 std::string save_dictionary(const kernels::VisualDictionary& d, const std::filesystem::path& path) {
-  const std::string bytes = encode_dictionary(d);
-  const std::filesystem::path tmp = path.string() + ".tmp" + std::to_string(::getpid());
-  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) return "cannot create " + tmp.string() + ": " + std::strerror(errno);
-  std::size_t done = 0;
-  while (done < bytes.size()) {
-    const ssize_t w = ::write(fd, bytes.data() + done, bytes.size() - done);
-    if (w < 0 && errno == EINTR) continue;
-    if (w <= 0) {
-      const std::string why = std::strerror(errno);
-      ::close(fd);
-      std::filesystem::remove(tmp);
-      return "cannot write " + tmp.string() + ": " + why;
-    }
-    done += static_cast<std::size_t>(w);
-  }
-  const bool synced = ::fsync(fd) == 0;
-  ::close(fd);
-  std::error_code ec;
-  if (!synced) {
-    std::filesystem::remove(tmp, ec);
-    return "cannot sync " + tmp.string();
-  }
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) {
-    std::filesystem::remove(tmp, ec);
-    return "cannot rename the dictionary into " + path.string() + ": " + ec.message();
-  }
-  return {};
+  auto written = core::write_whole_file(path, encode_dictionary(d), /*synced=*/true);
+  return written ? std::string() : std::move(written.error());
 }
 
 Result<kernels::VisualDictionary, std::string> load_dictionary(const std::filesystem::path& path) {

@@ -20,7 +20,8 @@ namespace fs = std::filesystem;
 using Code = FileReadFailure::Code;
 
 fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("orthoflow_regular_file_" + name);
+  const fs::path dir = fs::temp_directory_path() /
+                       ("orthoflow_regular_file_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;

@@ -2,6 +2,7 @@
 // fakenect writes, and strict refusal of what is not a fakenect record.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -14,7 +15,8 @@ namespace orthoflow::formats {
 namespace {
 
 std::filesystem::path scratch(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / ("orthoflow_fakenect_" + name);
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("orthoflow_fakenect_" + name + "_" + std::to_string(::getpid()));
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
 #include <filesystem>
 #include <string>
 
@@ -50,7 +51,8 @@ std::vector<RoundTripCase> round_trip_cases() {
 INSTANTIATE_TEST_SUITE_P(Encodings, PcdRoundTrip, ::testing::ValuesIn(round_trip_cases()));
 
 TEST(PcdIo, WritesAndReadsFiles) {
-  const auto dir = std::filesystem::temp_directory_path() / "orthoflow_pcd_io_test";
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("orthoflow_pcd_io_test_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   const ok::PointCloud cloud = make_cloud(20, 10, true, 5);
   const auto path = dir / "cloud.pcd";

@@ -6,6 +6,7 @@
 #include <pcl/io/pcd_io.h>
 #include <pcl/point_types.h>
 
+#include <unistd.h>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -81,7 +82,8 @@ TEST(PclCrossCheck, EverySharedPcdReadsIdentically) {
 
 TEST(PclCrossCheck, PclReadsWhatWeWrite) {
   const ok::PointCloud cloud = orthoflow::test::make_cloud(32, 24, true, 11);
-  const fs::path dir = fs::temp_directory_path() / "orthoflow_pcl_xcheck_ours";
+  const fs::path dir =
+      fs::temp_directory_path() / ("orthoflow_pcl_xcheck_ours_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   for (auto e : {ofmt::PcdEncoding::ASCII, ofmt::PcdEncoding::BINARY,
                  ofmt::PcdEncoding::BINARY_COMPRESSED}) {
@@ -116,7 +118,8 @@ TEST(PclCrossCheck, WeReadWhatPclWrites) {
       ref, std::span<pcl::PointXYZRGBA>(typed.points.data(), typed.points.size()));
   typed.sensor_origin_ = Eigen::Vector4f(0.25F, -2.0F, 1.5F, 0.0F);
   typed.sensor_orientation_ = Eigen::Quaternionf(0.5F, -0.5F, 0.5F, -0.5F);  // w x y z
-  const fs::path dir = fs::temp_directory_path() / "orthoflow_pcl_xcheck_pcl";
+  const fs::path dir =
+      fs::temp_directory_path() / ("orthoflow_pcl_xcheck_pcl_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   pcl::PCDWriter writer;
   const fs::path a = dir / "a.pcd", b = dir / "b.pcd", c = dir / "c.pcd";
@@ -160,7 +163,8 @@ TEST(PclCrosscheck, LabelsOutFileReadsIntoPclsLabelledPoints) {
   ASSERT_TRUE(seg) << seg.error().to_string();
   ok::frame_labels(frame->points(), seg->plane.plane, 0.02F, ok::SegmentationParams{}.roi,
                    seg->labels, seg->candidate_of, frame->label());
-  const fs::path dir = fs::temp_directory_path() / "orthoflow_labels_out";
+  const fs::path dir =
+      fs::temp_directory_path() / ("orthoflow_labels_out_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   const fs::path file = dir / "labels.pcd";
   ASSERT_TRUE(ofmt::write_pcd(*frame, file));

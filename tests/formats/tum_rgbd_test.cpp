@@ -4,6 +4,7 @@
 // outside the folder, or a time that is not a time, is an error naming the line.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
 #include <array>
 #include <filesystem>
 #include <fstream>
@@ -20,7 +21,8 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path scratch(const std::string& name) {
-  const auto dir = fs::temp_directory_path() / ("orthoflow_tum_" + name);
+  const auto dir =
+      fs::temp_directory_path() / ("orthoflow_tum_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include "core/rng.hpp"
 #include "kernels/descriptor_spec.hpp"
@@ -181,7 +182,8 @@ TEST(DictionaryFile, RoundTripsAndRefusesDamage) {
   EXPECT_NE(bad.error().find("corrupt"), std::string::npos) << bad.error();
   EXPECT_FALSE(ol::parse_dictionary(std::string("OFDC") + bytes.substr(4)));
   // Saved and loaded through a file.
-  const auto path = std::filesystem::temp_directory_path() / "orthoflow_dictionary_test.ofwd";
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("orthoflow_dictionary_test_" + std::to_string(::getpid()) + ".ofwd");
   ASSERT_EQ(ol::save_dictionary(*d, path), "");
   auto loaded = ol::load_dictionary(path);
   ASSERT_TRUE(loaded);
