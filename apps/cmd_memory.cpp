@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "apps/commands.hpp"
+#include "apps/option_checks.hpp"
 #include "apps/spin_set_options.hpp"
 #include "formats/pcd_io.hpp"
 #include "kernels/descriptor_spec.hpp"
@@ -245,11 +246,15 @@ void add_memory_command(CLI::App& app) {
   cmd->fallthrough();
   auto* teach =
       cmd->add_subcommand("teach", "Store the views of FILE.pcd... under LABEL (one synced write)");
-  teach->add_option("label", o->label, "category label (1-63 bytes)")->required();
+  teach->add_option("label", o->label, "category label (1-63 bytes)")
+      ->required()
+      ->transform(composed_label());
   teach->add_option("files", o->files, "object PCD files")->required()->check(CLI::ExistingFile);
   teach->callback([o] { run_teach(*o, false); });
   auto* correct = cmd->add_subcommand("correct", "Store one view after a wrong answer");
-  correct->add_option("label", o->label, "the right label")->required();
+  correct->add_option("label", o->label, "the right label")
+      ->required()
+      ->transform(composed_label());
   correct->add_option("file", o->files, "object PCD file")
       ->required()
       ->expected(1)
@@ -262,7 +267,7 @@ void add_memory_command(CLI::App& app) {
   cmd->add_subcommand("list", "Categories: id, label, views")->callback([o] { run_list(*o); });
   cmd->add_subcommand("stats", "Totals as JSON")->callback([o] { run_stats(*o); });
   auto* forget = cmd->add_subcommand("forget", "Delete a category and its views");
-  forget->add_option("label", o->label, "category label")->required();
+  forget->add_option("label", o->label, "category label")->required()->transform(composed_label());
   forget->callback([o] { run_forget(*o); });
   auto* exp = cmd->add_subcommand("export", "Write the memory as JSON lines");
   exp->add_option("file", o->file, "output file")->required();

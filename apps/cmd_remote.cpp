@@ -8,6 +8,7 @@
 #include <string>
 
 #include "apps/commands.hpp"
+#include "apps/option_checks.hpp"
 #include "core/label_text.hpp"
 #include "ui/server_config.hpp"
 #include "ui/ui_client.hpp"
@@ -166,7 +167,8 @@ void add_remote_commands(CLI::App& app) {
           ->required()
           ->check(CLI::Range(1U, 4294967295U));
     }
-    if (s.label) sub->add_option("LABEL", o->label, "category label")->required();
+    if (s.label)
+      sub->add_option("LABEL", o->label, "category label")->required()->transform(composed_label());
     const std::string name = s.name;
     sub->callback([o, name] { run_remote(name, *o); });
   }

@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/commands.hpp"
+#include "apps/option_checks.hpp"
 #include "apps/perceived_scene.hpp"
 #include "manipulation/pick_place_job.hpp"
 #include "manipulation/table_tasks.hpp"
@@ -154,6 +155,7 @@ void add_task_command(CLI::App& app) {
   cmd->add_option("--keep", a->keep, "clear_table: categories that are table items and stay")
       ->delimiter(',');
   cmd->add_option("--bring", a->bring, "serve_a_meal: the categories to bring, in order")
+      ->transform(composed_label())
       ->delimiter(',');
   cmd->add_option("--user-place", a->user_place,
                   "serve_a_meal: the user's place X,Y on the table, base frame (m)")

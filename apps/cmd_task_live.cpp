@@ -21,6 +21,7 @@
 
 #include "apps/arm_cli.hpp"
 #include "apps/commands.hpp"
+#include "apps/option_checks.hpp"
 #include "apps/perceived_scene.hpp"
 #include "apps/task_live_cli.hpp"
 #include "graphs/channels/task_payloads.hpp"
@@ -85,6 +86,7 @@ void add_live_task_commands(CLI::App* task) {
   run->add_option("--graph", a->graph, "the graph's name in its topics (default tabletop)");
   run->add_option("--start", a->start, "start this task at once: clear_table or serve_a_meal");
   run->add_option("--bring", a->bring, "with --start serve_a_meal: the categories, in order")
+      ->transform(composed_label())
       ->delimiter(',');
   add_area_options(run, a);
   run->add_option("--max-perception-age-ms", a->perception_age_ms,
@@ -104,6 +106,7 @@ void add_live_task_commands(CLI::App* task) {
   auto* start = task->add_subcommand("start", "start a task on a running `orthoflow task run`");
   start->add_option("task", a->start, "clear_table or serve_a_meal")->required();
   start->add_option("--bring", a->bring, "serve_a_meal: the categories to bring, in order")
+      ->transform(composed_label())
       ->delimiter(',');
   for (CLI::App* sub :
        {start, task->add_subcommand("stop", "stop the running task (it backs away)"),

@@ -6,6 +6,8 @@
 #include <cstdlib>
 #include <string>
 
+#include "core/label_text.hpp"
+
 namespace orthoflow::apps {
 
 namespace {
@@ -57,6 +59,15 @@ void check_numeric_options(CLI::App& app) {
     }
   }
   for (CLI::App* sub : app.get_subcommands({})) check_numeric_options(*sub);
+}
+
+CLI::Validator composed_label() {
+  return CLI::Validator(
+      [](std::string& text) {
+        if (auto composed = core::normalized_label(text)) text = std::move(*composed);
+        return std::string();
+      },
+      "", "composed label");
 }
 
 }  // namespace orthoflow::apps

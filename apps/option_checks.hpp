@@ -15,4 +15,9 @@ namespace orthoflow::apps {
 /// recursively. Call once, after every command is added.
 void check_numeric_options(CLI::App& app);
 
+/// @brief For an option that names a category: composes what a person typed into Unicode NFC
+/// (core::normalized_label), so a decomposed "café" is the same category as the composed one. Text
+/// that is no label at all passes unchanged, and the command's own check says what is wrong.
+[[nodiscard]] CLI::Validator composed_label();
+
 }  // namespace orthoflow::apps

@@ -15,6 +15,7 @@ set_target_properties(leveldb::leveldb PROPERTIES INTERFACE_LINK_LIBRARIES Threa
 find_package(PkgConfig REQUIRED)
 pkg_check_modules(LZF REQUIRED IMPORTED_TARGET liblzf)
 pkg_check_modules(CAIRO REQUIRED IMPORTED_TARGET cairo)
+pkg_check_modules(UTF8PROC REQUIRED IMPORTED_TARGET libutf8proc)  # labels: NFC and invisible characters (core/label_text.cpp)
 pkg_check_modules(PNG REQUIRED IMPORTED_TARGET libpng)  # the web view's camera image (ui/png_encode.cpp), TUM depth PNGs (formats/png_depth.cpp)
 
 if(BUILD_TESTS)

@@ -37,6 +37,7 @@ orthoflow_package_rule(leveldb LINKS leveldb::leveldb CODE [=[find_dependency(Th
   set_target_properties(leveldb::leveldb PROPERTIES INTERFACE_LINK_LIBRARIES Threads::Threads)]=])
 orthoflow_package_rule(liblzf LINKS PkgConfig::LZF CODE [=[_orthoflow_pkg_config(LZF liblzf)]=])
 orthoflow_package_rule(cairo LINKS PkgConfig::CAIRO CODE [=[_orthoflow_pkg_config(CAIRO cairo)]=])
+orthoflow_package_rule(libutf8proc LINKS PkgConfig::UTF8PROC CODE [=[_orthoflow_pkg_config(UTF8PROC libutf8proc)]=])
 orthoflow_package_rule(libpng LINKS PkgConfig::PNG CODE [=[_orthoflow_pkg_config(PNG libpng)]=])
 orthoflow_package_rule(libusb LINKS PkgConfig::LIBUSB CODE [=[_orthoflow_pkg_config(LIBUSB libusb-1.0)]=])
 

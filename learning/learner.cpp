@@ -16,7 +16,8 @@ const char* to_string(LearnError error) noexcept {
     case LearnError::EMPTY_LABEL:
       return "empty label: a category needs a name";
     case LearnError::BAD_CHARACTERS:
-      return "label is not valid UTF-8 or holds a control character (newline, tab, NUL, ...)";
+      return "label is not valid UTF-8 in Unicode NFC, or holds a control character (newline, tab, "
+             "NUL, ...) or an invisible or direction-control one (U+200B, U+202E, ...)";
     case LearnError::LABEL_TOO_LONG:
       return "label longer than 63 bytes";
     case LearnError::NO_VIEWS:
@@ -53,6 +54,8 @@ Result<void, LearnError> validate_label(std::string_view label) noexcept {
       return err(LearnError::LABEL_TOO_LONG);
     case core::LabelProblem::NOT_UTF8:
     case core::LabelProblem::CONTROL_CHARACTER:
+    case core::LabelProblem::INVISIBLE_CHARACTER:
+    case core::LabelProblem::NOT_NFC:
       return err(LearnError::BAD_CHARACTERS);
   }
   return err(LearnError::BAD_CHARACTERS);

@@ -52,7 +52,7 @@ struct Prediction {
 enum class LearnError : std::uint8_t {
   EMPTY_LABEL,      ///< the label is ""
   LABEL_TOO_LONG,   ///< the label has more than LABEL_MAX_BYTES bytes
-  BAD_CHARACTERS,   ///< the label is not valid UTF-8 or holds a control character
+  BAD_CHARACTERS,   ///< not UTF-8 in NFC, or a control, invisible or direction-control character
                     ///< (core/label_text.hpp)
   NO_VIEWS,         ///< the batch holds no view
   WRONG_LENGTH,     ///< a descriptor's length differs from descriptor_length()

@@ -15,7 +15,7 @@ ARM64_EXTRA="${ARM64_EXTRA:-/opt/orthoflow-arm64}"
 PACKAGES=(
   crossbuild-essential-arm64 qemu-user-static dpkg-dev
   libtbb-dev:arm64 libxsimd-dev:arm64 libusb-1.0-0-dev:arm64 liblzf-dev:arm64 libcairo2-dev:arm64 libpng-dev:arm64
-  libleveldb-dev:arm64 libyaml-cpp0.7:arm64 libcivetweb-dev:arm64
+  libleveldb-dev:arm64 libyaml-cpp0.7:arm64 libcivetweb-dev:arm64 libutf8proc-dev:arm64
   libiceoryx-posh-dev:arm64 libiceoryx-hoofs-dev:arm64
   cyclonedds-dev:arm64  # the DDS bridge (bridge/); idlc runs natively (cyclonedds-tools)
   libgtest-dev:arm64 libgmock-dev:arm64 libbenchmark-dev:arm64

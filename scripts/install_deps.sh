@@ -7,7 +7,7 @@ PACKAGES=(
   cmake ninja-build g++ pkg-config git
   ccache  # scripts/test.sh: the four presets' builds reuse what an earlier build compiled
   libeigen3-dev libxsimd-dev libtbb-dev libyaml-cpp-dev nlohmann-json3-dev libcli11-dev
-  liblzf-dev libcairo2-dev libpng-dev libleveldb-dev libusb-1.0-0-dev
+  liblzf-dev libcairo2-dev libpng-dev libleveldb-dev libusb-1.0-0-dev libutf8proc-dev
   libcivetweb-dev  # the web view's HTTP + WebSocket server (ui/, `orthoflow run --ui`)
   iceoryx libiceoryx-posh-dev libiceoryx-hoofs-dev
   cyclonedds-dev cyclonedds-tools  # the DDS bridge (bridge/, issue 23): libddsc and idlc

@@ -72,11 +72,11 @@ Result<core::Text, ApiError> label_of(const Json& body) {
   const auto it = body.find("label");
   if (it == body.end()) return refuse(400, "missing field 'label'");
   if (!it->is_string()) return refuse(400, "'label' must be a string");
-  const auto& text = it->get_ref<const std::string&>();
-  if (const auto problem = core::check_label(text); problem != core::LabelProblem::NONE)
-    return refuse(400, std::string(core::to_string(problem)));
+  // What a person typed, composed (NFC); invisible and direction-control characters are refused.
+  const auto text = core::normalized_label(it->get_ref<const std::string&>());
+  if (!text) return refuse(400, std::string(core::to_string(text.error())));
   core::Text label;
-  if (!label.try_assign(text)) return refuse(400, "label does not fit");  // checked above
+  if (!label.try_assign(*text)) return refuse(400, "label does not fit");  // checked above
   return label;
 }
 
@@ -121,10 +121,9 @@ Result<ApiRequest, ApiError> decode_task(Kind kind, const Json& body) {
         400, "'bring' must list 1 to " + std::to_string(graphs::TASK_MAX_BRING) + " categories");
   for (const Json& label : *bring) {
     if (!label.is_string()) return refuse(400, "'bring' must list category names");
-    const auto& text = label.get_ref<const std::string&>();
-    if (const auto problem = core::check_label(text); problem != core::LabelProblem::NONE)
-      return refuse(400, "'bring': " + std::string(core::to_string(problem)));
-    decoded.task.bring.push_back(text);
+    const auto text = core::normalized_label(label.get_ref<const std::string&>());
+    if (!text) return refuse(400, "'bring': " + std::string(core::to_string(text.error())));
+    decoded.task.bring.push_back(*text);
   }
   return decoded;
 }

@@ -128,7 +128,44 @@ TEST(LabelText, OneRuleForEveryLabel) {
   EXPECT_EQ(check_label("\xE0\x80\xAF"), LabelProblem::NOT_UTF8);       // overlong
   EXPECT_EQ(check_label("\xF4\x90\x80\x80"), LabelProblem::NOT_UTF8);   // beyond U+10FFFF
   EXPECT_EQ(check_label("\xE2\x82"), LabelProblem::NOT_UTF8);           // cut short
-  static_assert(check_label("constexpr") == LabelProblem::NONE);
+}
+
+// Look-alike labels (issue 52, item 7): each of these displays as "mug" (or "café") beside the
+// plain one, so each is refused; a person's decomposed text is composed by normalized_label.
+TEST(LabelText, LabelsThatDisplayAlikeAreOneLabel) {
+  for (const char* hidden :
+       {"\u200B", "\u200C", "\u200D", "\u200E", "\u200F",     "\u202A", "\u202E",
+        "\u2066", "\u2069", "\u2060", "\uFEFF", "\u00AD",     "\u034F", "\uFE0F",
+        "\u180E", "\u2028", "\u2029", "\u061C", "\U000E0041", "\u3164"}) {
+    SCOPED_TRACE(hidden);
+    EXPECT_EQ(check_label(std::string("mug") + hidden), LabelProblem::INVISIBLE_CHARACTER);
+    EXPECT_EQ(check_label(std::string("m") + hidden + "ug"), LabelProblem::INVISIBLE_CHARACTER);
+    auto typed = normalized_label(std::string("m") + hidden + "ug");
+    ASSERT_FALSE(typed.has_value());
+    EXPECT_EQ(typed.error(), LabelProblem::INVISIBLE_CHARACTER);
+  }
+  const std::string composed = "caf\u00E9";     // é as one code point
+  const std::string decomposed = "cafe\u0301";  // e and a combining acute accent
+  EXPECT_EQ(check_label(composed), LabelProblem::NONE);
+  EXPECT_EQ(check_label(decomposed), LabelProblem::NOT_NFC);
+  auto typed = normalized_label(decomposed);
+  ASSERT_TRUE(typed.has_value());
+  EXPECT_EQ(*typed, composed);
+  // Combining marks in non-canonical order (dot below after acute) are not NFC either.
+  EXPECT_EQ(check_label("q\u0301\u0323"), LabelProblem::NOT_NFC);
+  EXPECT_EQ(check_label("q\u0323\u0301"), LabelProblem::NONE);
+  EXPECT_EQ(check_label("\u212B"), LabelProblem::NOT_NFC);  // ANGSTROM SIGN: NFC is U+00C5
+  EXPECT_EQ(*normalized_label("\u212B"), "\u00C5");
+  // What stays allowed: scripts, emoji without selectors, inner spaces, Hangul, Arabic, Devanagari.
+  for (const char* fine : {"\u00E9clair", "\U0001F375 cup", "tea cup", "\uD55C\uAE00",
+                           "\u0643\u0648\u0628", "\u0915\u092A", "\u30DE\u30B0", "Stra\u00DFe"}) {
+    SCOPED_TRACE(fine);
+    EXPECT_EQ(check_label(fine), LabelProblem::NONE);
+    EXPECT_EQ(*normalized_label(fine), fine);
+  }
+  EXPECT_EQ(normalized_label("\xC3").error(), LabelProblem::NOT_UTF8);
+  EXPECT_EQ(normalized_label("").error(), LabelProblem::EMPTY);
+  EXPECT_EQ(normalized_label(std::string(TEXT_MAX_BYTES + 1, 'a')).error(), LabelProblem::TOO_LONG);
 }
 
 TEST(SpscRing, FullEmptyAndAllOrNothing) {

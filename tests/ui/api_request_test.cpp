@@ -144,6 +144,16 @@ TEST(ApiRequest, LabelsFollowTheLabelRule) {
                                  : R"({"track":2,"label":"a\u0007"})";
     EXPECT_EQ(decode("POST", path, body).error().message, "label holds a control character");
   }
+  // Look-alike labels (issue 52, item 7): invisible and direction-control characters are refused; a
+  // decomposed accent is composed (NFC), so "café" typed either way is one category.
+  for (const char* hidden : {R"("mug\u200b")", R"("m\u202eug")", R"("mug\ufe0f")", R"("\u2066mug")",
+                             R"("mu\u00adg")"})
+    EXPECT_EQ(teach(hidden).error().message,
+              "label holds an invisible or direction-control character")
+        << hidden;
+  auto composed = teach(R"("cafe\u0301")");
+  ASSERT_TRUE(composed);
+  EXPECT_EQ(composed->label.view(), "caf\u00e9");
 }
 
 TEST(ApiRequest, StreamRateMustBeAPositiveNumber) {
