@@ -5,6 +5,8 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "core/regular_file.hpp"
+#include "core/yaml_keys.hpp"
 #include "graphs/services/learning_ipc_bridge.hpp"
 
 namespace orthoflow::bridge {
@@ -54,10 +56,15 @@ Result<void, std::string> read_qos(const YAML::Node& node, const std::string& ke
 }  // namespace
 
 Result<BridgeConfig, std::string> load_bridge_config(const std::string& path, BridgeConfig c) {
+  // A regular file of at most 1 MiB, never a FIFO waited on (core/regular_file.hpp).
+  auto text = core::read_regular_text(path, std::size_t{1} << 20);
+  if (!text) return err(text.error().message);
   YAML::Node root;
   try {
-    root = YAML::LoadFile(path);
+    root = YAML::Load(*text);
   } catch (const std::exception& e) { return err(path + ": " + e.what()); }
+  if (auto unique = core::check_unique_keys(root); !unique)
+    return err(path + ": " + unique.error().to_string());
   if (!root.IsMap()) return err(path + ": a map of bridge settings");
   try {
     for (const auto& kv : root) {

@@ -12,6 +12,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "core/regular_file.hpp"
+#include "core/yaml_keys.hpp"
 
 namespace orthoflow::deploy {
 namespace {
@@ -131,6 +132,8 @@ Result<RobotConfig, std::string> parse_robot_config(const std::string& text,
   try {
     root = YAML::Load(text);
   } catch (const std::exception& e) { return err(name + ": not YAML: " + e.what()); }
+  if (auto unique = core::check_unique_keys(root); !unique)
+    return err(name + ": " + unique.error().to_string());
   if (root.IsNull()) return err(name + ": empty (a map of robot settings; docs/DEPLOY.md)");
   if (!root.IsMap()) return err(name + ": a map of robot settings (docs/DEPLOY.md)");
   try {

@@ -8,6 +8,7 @@
 #include <set>
 
 #include "core/regular_file.hpp"
+#include "core/yaml_keys.hpp"
 #include "engine/graph.hpp"
 
 namespace orthoflow::engine {
@@ -199,6 +200,8 @@ Result<GraphSpec, GraphError> parse_graph(const std::string& text, const std::st
   spec.file = file;
   try {
     const YAML::Node root = YAML::Load(text);
+    if (auto unique = core::check_unique_keys(root); !unique)
+      throw Fail{GraphError{Code::BAD_STRUCTURE, file, unique.error().line, unique.error().what}};
     if (!root.IsMap())
       fail(Code::BAD_STRUCTURE, file, root, "a graph file must be a map with 'nodes' and 'edges'");
     for (const auto& item : root) {

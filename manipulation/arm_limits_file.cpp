@@ -8,6 +8,8 @@
 #include <cmath>
 #include <set>
 
+#include "core/yaml_keys.hpp"
+
 namespace orthoflow::manipulation {
 namespace {
 
@@ -42,22 +44,6 @@ Result<jaco::Box, std::string> box(const YAML::Node& node, const std::string& ke
   if (!(b.min.array() < b.max.array()).all())
     return fail(key, "an inverted or empty box (each min must be below its max)");
   return b;
-}
-
-// Refuses duplicate keys anywhere (yaml-cpp keeps both and answers with one of them).
-Result<void, std::string> unique_keys(const YAML::Node& node, const std::string& where) {
-  if (node.IsMap()) {
-    std::set<std::string> seen;
-    for (const auto& kv : node) {
-      const std::string key = kv.first.as<std::string>();
-      if (!seen.insert(key).second) return fail(where + key, "appears twice");
-      if (auto ok = unique_keys(kv.second, where + key + "."); !ok) return ok;
-    }
-  } else if (node.IsSequence()) {
-    for (std::size_t i = 0; i < node.size(); ++i)
-      if (auto ok = unique_keys(node[i], where + std::to_string(i) + "."); !ok) return ok;
-  }
-  return {};
 }
 
 Result<jaco::BodyPart, std::string> part_named(const std::string& text, const std::string& key) {
@@ -228,6 +214,8 @@ Result<ArmLimitsFile, std::string> parse_arm_limits(std::string_view yaml, std::
   try {
     root = YAML::Load(std::string(yaml));
   } catch (const YAML::Exception& e) { return err(source + ": not YAML: " + e.what()); }
+  if (auto unique = core::check_unique_keys(root); !unique)
+    return err(source + ": " + unique.error().to_string());
   ArmLimitsFile f;
   f.source = source;
   if (!root.IsNull() && !root.IsMap()) return err(source + ": a map of keys is expected");
@@ -236,7 +224,6 @@ Result<ArmLimitsFile, std::string> parse_arm_limits(std::string_view yaml, std::
     return {};
   };
   try {
-    if (auto ok = located(unique_keys(root, "")); !ok) return err(ok.error());
     for (const auto& kv : root)
       if (!KNOWN.count(kv.first.as<std::string>()))
         return err(source + ": " + kv.first.as<std::string>() + ": unknown key");

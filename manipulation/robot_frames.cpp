@@ -9,6 +9,8 @@
 #include <yaml-cpp/yaml.h>
 #include <nlohmann/json.hpp>
 
+#include "core/yaml_keys.hpp"
+
 namespace orthoflow::manipulation {
 namespace {
 
@@ -71,6 +73,8 @@ Result<RobotFrames, std::string> parse_robot_frames(std::string_view yaml) {
   } catch (const YAML::Exception& e) {
     return err("robot frames: not YAML (line " + std::to_string(e.mark.line + 1) + "): " + e.msg);
   }
+  if (auto unique = core::check_unique_keys(root); !unique)
+    return err("robot frames: " + unique.error().to_string());
   if (!root.IsMap() || !root["base_from_camera"] || !root["base_from_camera"].IsMap()) {
     return err(std::string(
         "robot frames: expected a map with base_from_camera: {translation_m, rotation_wxyz}"));

@@ -6,6 +6,9 @@
 #include <cmath>
 #include <initializer_list>
 #include <optional>
+#include <set>
+#include <string>
+#include <vector>
 
 #include "core/label_text.hpp"
 
@@ -131,8 +134,21 @@ Result<ApiRequest, ApiError> decode_task(Kind kind, const Json& body) {
 Result<ApiRequest, ApiError> decode_action(Kind kind, const RawRequest& request) {
   if (!is_json_type(find_header(request.headers, "Content-Type")))
     return refuse(415, "an action needs Content-Type: application/json");
-  const Json body = Json::parse(request.body, nullptr, /*allow_exceptions=*/false);
+  // A key twice in one object is refused (nlohmann keeps the last one without a word): a body that
+  // says two things is not acted on (issue 52, item 11).
+  std::vector<std::set<std::string>> keys;  // one set per open object
+  std::optional<std::string> repeated;
+  const auto once = [&](int, Json::parse_event_t event, Json& parsed) {
+    if (event == Json::parse_event_t::object_start) keys.emplace_back();
+    if (event == Json::parse_event_t::object_end && !keys.empty()) keys.pop_back();
+    if (event == Json::parse_event_t::key && !keys.empty() && !repeated &&
+        !keys.back().insert(parsed.get<std::string>()).second)
+      repeated = parsed.get<std::string>();
+    return true;
+  };
+  const Json body = Json::parse(request.body, once, /*allow_exceptions=*/false);
   if (body.is_discarded()) return refuse(400, "the body is not valid JSON");
+  if (repeated) return refuse(400, "the key '" + *repeated + "' appears twice in one object");
   if (!body.is_object()) return refuse(400, "the body must be a JSON object");
   if (kind == Kind::TASK_START || kind == Kind::TASK_STOP) return decode_task(kind, body);
   if (kind == Kind::ARM_STOP) {  // POST /api/arm/stop {}

@@ -75,6 +75,11 @@ TEST(RobotConfig, MalformedFilesAreRefusedWithTheirName) {
   EXPECT_NE(error_of("hostname: [unclosed").find("robot.yaml"), std::string::npos);
   EXPECT_NE(error_of("hostname: {a: 1}").find("robot.yaml"), std::string::npos);
   EXPECT_NE(error_of("threads: lots").find("robot.yaml"), std::string::npos);
+  // A key twice: refused with its line, never "the last one wins" (issue 52, item 11).
+  EXPECT_NE(error_of("hostname: a\nhostname: b\n").find("line 2: key 'hostname' appears twice"),
+            std::string::npos);
+  EXPECT_NE(error_of("ui: {token_file: a, token_file: b}").find("key 'token_file' appears twice"),
+            std::string::npos);
   auto missing = load_robot_config("/nonexistent/robot.yaml");
   ASSERT_FALSE(missing);
   EXPECT_NE(missing.error().find("/nonexistent/robot.yaml: cannot be read"), std::string::npos);

@@ -63,6 +63,36 @@ TEST(GraphValidation, BadStructure) {
   expect_error(HEADER + SRC + "  - {name: sink}\n", Code::BAD_STRUCTURE, 6, "'kind'");
 }
 
+// A key twice in one map is an error naming the second one's line, at any depth (issue 52, item
+// 11): yaml-cpp keeps both and the loader would silently take one of them.
+TEST(GraphValidation, AKeyTwiceInOneMap) {
+  expect_error(HEADER + "  - {name: src, kind: ticker, params: {frames: 5, frames: 9}}\n" + SINK,
+               Code::BAD_STRUCTURE, 5, "key 'frames' appears twice in one map");
+  expect_error("graph:\n  name: t\n  name: u\n", Code::BAD_STRUCTURE, 3,
+               "key 'name' appears twice in one map");
+  expect_error(HEADER + SRC + SINK + "edges:\n  - src.out -> sink.in\nnodes: []\n",
+               Code::BAD_STRUCTURE, 9, "key 'nodes' appears twice");
+  // The same key in two maps is fine.
+  const auto built = build_yaml(HEADER + SRC + SINK + "edges:\n  - src.out -> sink.in\n");
+  EXPECT_TRUE(built.graph) << to_string(built.error);
+}
+
+// Aliases can make a small file a tree of billions of nodes: the key check stops at
+// core::YAML_MAX_NODES instead of walking it.
+TEST(GraphValidation, AnAliasBombIsRefusedQuickly) {
+  std::string yaml = "a0: &a0 [x, x, x, x, x, x, x, x, x, x]\n";
+  for (int i = 1; i < 12; ++i) {
+    yaml += "a" + std::to_string(i) + ": &a" + std::to_string(i) + " [";
+    for (int k = 0; k < 10; ++k) yaml += (k ? ", *a" : "*a") + std::to_string(i - 1);
+    yaml += "]\n";
+  }
+  const auto built = build_yaml(yaml, "bad.yaml");
+  ASSERT_FALSE(built.graph);
+  EXPECT_EQ(built.error.code, Code::BAD_STRUCTURE);
+  EXPECT_NE(to_string(built.error).find("YAML nodes (aliases?)"), std::string::npos)
+      << to_string(built.error);
+}
+
 TEST(GraphValidation, DuplicateNode) {
   expect_error(HEADER + SRC + "  - {name: src, kind: count}\n", Code::DUPLICATE_NODE, 6, "'src'");
 }

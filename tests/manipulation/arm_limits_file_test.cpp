@@ -103,8 +103,9 @@ TEST(ArmLimitsFile, TheCameraAndItsMountArePlacedFromTheRobotFrames) {
 
 TEST(ArmLimitsFile, RefusalsNameTheKey) {
   EXPECT_NE(refusal("speed: 10").find("speed: unknown key"), std::string::npos);
-  EXPECT_NE(refusal("speed_deg_s: 10\nspeed_deg_s: 20").find("speed_deg_s: appears twice"),
-            std::string::npos);
+  EXPECT_NE(
+      refusal("speed_deg_s: 10\nspeed_deg_s: 20").find("line 2: key 'speed_deg_s' appears twice"),
+      std::string::npos);
   EXPECT_NE(refusal("speed_deg_s: 50").find("speed_deg_s"), std::string::npos);  // > 36 deg/s
   EXPECT_NE(refusal("speed_deg_s: .nan").find("not a finite number"), std::string::npos);
   EXPECT_NE(refusal("speed_deg_s: -1").find("speed_deg_s"), std::string::npos);

@@ -48,6 +48,9 @@ TEST(RobotFrames, MalformedFramesGetAClearError) {
       {"base_from_camera: {translation_m: [0, 0, 0], rotation_wxyz: [1, 1, 0, 0]}",
        "not a unit quaternion"},
       {"base_from_camera: {translation_m: [0, 0, 0]}", "rotation_wxyz: expected a list of 4"},
+      {"base_from_camera: {translation_m: [0, 0, 0], translation_m: [1, 0, 0], rotation_wxyz: "
+       "[1, 0, 0, 0]}",
+       "key 'translation_m' appears twice in one map"},
   };
   for (const auto& [text, message] : cases) {
     const auto parsed = parse_robot_frames(text);

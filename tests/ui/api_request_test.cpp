@@ -116,6 +116,11 @@ TEST(ApiRequest, FieldsAreCheckedOneByOne) {
   EXPECT_EQ(message("/api/undo", "[]"), "the body must be a JSON object");
   EXPECT_EQ(message("/api/teach", R"({"track":1,"label":"x","lable":"y"})"),
             "unknown field 'lable'");
+  // A key twice is refused, never "the last one wins" (issue 52, item 11).
+  EXPECT_EQ(message("/api/teach", R"({"track":1,"label":"mug","label":"bowl"})"),
+            "the key 'label' appears twice in one object");
+  EXPECT_EQ(message("/api/ask", R"({"track":1,"track":2})"),
+            "the key 'track' appears twice in one object");
 }
 
 TEST(ApiRequest, LabelsFollowTheLabelRule) {
@@ -146,8 +151,8 @@ TEST(ApiRequest, LabelsFollowTheLabelRule) {
   }
   // Look-alike labels (issue 52, item 7): invisible and direction-control characters are refused; a
   // decomposed accent is composed (NFC), so "café" typed either way is one category.
-  for (const char* hidden : {R"("mug\u200b")", R"("m\u202eug")", R"("mug\ufe0f")", R"("\u2066mug")",
-                             R"("mu\u00adg")"})
+  for (const char* hidden :
+       {R"("mug\u200b")", R"("m\u202eug")", R"("mug\ufe0f")", R"("\u2066mug")", R"("mu\u00adg")"})
     EXPECT_EQ(teach(hidden).error().message,
               "label holds an invisible or direction-control character")
         << hidden;
