@@ -4,7 +4,7 @@
 #  - consumer/: no COMPONENTS (everything loaded); links kernels+formats, and every library in consumer_full;
 #  - consumer_components/: COMPONENTS kernels formats, configured where TBB, iceoryx, LevelDB, yaml-cpp
 #    and nlohmann_json cannot be found (CMAKE_DISABLE_FIND_PACKAGE_*) and pkg-config knows only liblzf
-#    and libpng (formats' private dependencies; no cairo, no libusb);
+#    and libpng (formats' private dependencies) and libutf8proc (core's; no cairo, no libusb);
 #  - controls: under those restrictions consumer/ must fail (on TBB), and consumer_components/ must
 #    fail once liblzf is hidden too (formats' private dependency is looked for): the restrictions bite.
 set -euo pipefail
@@ -42,13 +42,15 @@ cmake --build "$scratch/full" >"$scratch/full.build.log" || { cat "$scratch/full
 "$scratch/full/consumer"
 "$scratch/full/consumer_full"
 
-# Only liblzf and libpng (with the zlib its .pc requires) are visible to pkg-config; the CMake packages
-# of the heavy dependencies are disabled.
+# Only liblzf, libpng (with the zlib its .pc requires) and libutf8proc are visible to pkg-config; the
+# CMake packages of the heavy dependencies are disabled. The last control sees libutf8proc alone.
 pc_only_lzf="$scratch/pkgconfig_lzf" pc_none="$scratch/pkgconfig_none"
 mkdir -p "$pc_only_lzf" "$pc_none"
 cp "$(pkg-config --variable=pcfiledir liblzf)/liblzf.pc" "$pc_only_lzf/"
 cp -L "$(pkg-config --variable=pcfiledir libpng)/libpng.pc" "$pc_only_lzf/libpng.pc"
 cp "$(pkg-config --variable=pcfiledir zlib)/zlib.pc" "$pc_only_lzf/"
+cp "$(pkg-config --variable=pcfiledir libutf8proc)/libutf8proc.pc" "$pc_only_lzf/"
+cp "$(pkg-config --variable=pcfiledir libutf8proc)/libutf8proc.pc" "$pc_none/"
 restricted=(-DCMAKE_DISABLE_FIND_PACKAGE_TBB=ON -DCMAKE_DISABLE_FIND_PACKAGE_iceoryx_posh=ON
   -DCMAKE_DISABLE_FIND_PACKAGE_iceoryx_hoofs=ON -DCMAKE_DISABLE_FIND_PACKAGE_leveldb=ON
   -DCMAKE_DISABLE_FIND_PACKAGE_yaml-cpp=ON -DCMAKE_DISABLE_FIND_PACKAGE_nlohmann_json=ON)
