@@ -172,7 +172,7 @@ set(CPACK_STRIP_FILES ON)
 if(CMAKE_CROSSCOMPILING)
   set(CPACK_DEBIAN_PACKAGE_ARCHITECTURE arm64)
   set(CPACK_DEBIAN_PACKAGE_DEPENDS
-    "libc6 (>= 2.35), libstdc++6 (>= 12), libgcc-s1 (>= 3.0), libtbb12 (>= 2021.4.0), libyaml-cpp0.7 (>= 0.7.0), libcairo2 (>= 1.2.4), libpng16-16 (>= 1.6.2), libcivetweb1 (>= 1.15), liblzf1 (>= 1.5), libleveldb1d (>= 1.23), libiceoryx-hoofs2 (>= 2.0.3+dfsg), libiceoryx-posh2 (>= 2.0.3+dfsg), libiceoryx-posh-config2 (>= 2.0.3+dfsg), libiceoryx-posh-roudi2 (>= 2.0.3+dfsg), libusb-1.0-0 (>= 2:1.0.26)")
+    "libc6 (>= 2.35), libstdc++6 (>= 12), libgcc-s1 (>= 3.0), libtbb12 (>= 2021.4.0), libyaml-cpp0.7 (>= 0.7.0), libcairo2 (>= 1.2.4), libpng16-16 (>= 1.6.2), libcivetweb1 (>= 1.15), liblzf1 (>= 1.5), libleveldb1d (>= 1.23), libiceoryx-hoofs2 (>= 2.0.3+dfsg), libiceoryx-posh2 (>= 2.0.3+dfsg), libiceoryx-posh-config2 (>= 2.0.3+dfsg), libiceoryx-posh-roudi2 (>= 2.0.3+dfsg), libusb-1.0-0 (>= 2:1.0.26), libutf8proc2 (>= 2.1)")
   if(TARGET orthoflow_bridge)  # the DDS bridge links Cyclone DDS (bridge/CMakeLists.txt)
     string(APPEND CPACK_DEBIAN_PACKAGE_DEPENDS ", libddsc0debian (>= 0.10.2)")
   endif()

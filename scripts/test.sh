@@ -149,7 +149,26 @@ run_fuzzers() {
   note_time "fuzz" "$t0"
 }
 
-# check_deb BUILD_DIR ARCH: cpack -G DEB into BUILD_DIR/deb, then the file name and its Architecture field.
+# undeclared_libraries DEB ARCH: each shared library /usr/bin/orthoflow in DEB needs (readelf NEEDED) whose
+# ARCH package (dpkg -S) the deb's Depends does not name; nothing when all are named. The arm64 Depends
+# is a written list (cross builds run no dpkg-shlibdeps): a new library must not reach the image unnamed.
+undeclared_libraries() {
+  local deb=$1 arch=$2 tmp depends soname owner missing="" triplet=x86_64-linux-gnu
+  [ "$arch" = arm64 ] && triplet=aarch64-linux-gnu
+  tmp=$(mktemp -d)
+  dpkg-deb -x "$deb" "$tmp"
+  depends=" $(dpkg-deb -f "$deb" Depends | tr ',|' '  ') "
+  for soname in $(readelf -d "$tmp/usr/bin/orthoflow" | sed -n 's/.*(NEEDED).*\[\(.*\)\]/\1/p'); do
+    owner=$(dpkg -S "*/$triplet/$soname" 2>/dev/null | head -n 1 | sed 's/[:,].*//')
+    [ -z "$owner" ] && { missing="$missing $soname(no $arch package)"; continue; }
+    case "$depends" in *" $owner "*) ;; *) missing="$missing $soname($owner)" ;; esac
+  done
+  rm -rf "$tmp"
+  echo "${missing# }"
+}
+
+# check_deb BUILD_DIR ARCH: cpack -G DEB into BUILD_DIR/deb, then the file name, its Architecture field and
+# a Depends that names every library the binary needs.
 check_deb() {
   local dir=$1 arch=$2 deb
   rm -rf "$dir/deb"
@@ -162,7 +181,13 @@ check_deb() {
   fi
   deb=$(ls "$dir"/deb/orthoflow_*_"$arch".deb 2>/dev/null | head -1)
   [ -n "$deb" ] && dpkg-deb -c "$deb" >"$logdir/contents_$arch.txt"
-  if [ -n "$deb" ] && [ "$(dpkg-deb -f "$deb" Architecture)" = "$arch" ] && grep -q "/usr/bin/orthoflow$" "$logdir/contents_$arch.txt"; then
+  local missing=""
+  [ -n "$deb" ] && missing=$(undeclared_libraries "$deb" "$arch")
+  if [ -n "$missing" ]; then
+    echo "package $arch: /usr/bin/orthoflow needs libraries its Depends does not name: $missing"
+    failed=$((failed + 1))
+    failures="${failures}package $arch: Depends"$'\n'
+  elif [ -n "$deb" ] && [ "$(dpkg-deb -f "$deb" Architecture)" = "$arch" ] && grep -q "/usr/bin/orthoflow$" "$logdir/contents_$arch.txt"; then
     echo "package $arch: $(basename "$deb") ($(du -k "$deb" | cut -f1) KiB; Depends: $(dpkg-deb -f "$deb" Depends))"
     passed=$((passed + 1))
   else
